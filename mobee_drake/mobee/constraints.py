@@ -1,0 +1,103 @@
+"""MoBeE's joint-space constraints in conjunctive normal form (dissertation eq. 5.14-5.17).
+
+A *literal* is one linear constraint on joint positions, written ``a . q + b >= 0``. Its
+*clearance* is the signed joint-space distance of ``q`` from the constraint's hyperplane,
+
+    g(q) = (a . q + b) / |a|        (positive where the constraint holds),
+
+and its repelling force (eq. 5.15) is a linear spring of length ``delta`` along the unit normal,
+
+    f(q) = f_max (delta - g) / delta * a / |a|     if g < delta,  else 0,
+
+so it is ``f_max`` on the boundary, zero ``delta`` inside, and grows linearly beyond the boundary.
+
+Eq. 5.16-5.17 group literals into clauses. We read the literal ``f_cst,i <-> 0`` as "literal i is
+clear of its band" (``g_i >= delta``). A *clause* is a disjunction: it is safe while any of its
+literals is clear. **A clause's forces switch on exactly when none of its literals is clear, that
+is when every one of its literals is inside its band (or violated); then the forces of all its
+literals act together.** The constraint set is the conjunction of its clauses, so the total
+constraint force is the sum over the clauses that are switched on. A single-literal clause is an
+ordinary constraint; the iCub's forearm clause "elbow below 90 deg OR pronation within 45 deg"
+stays silent while either holds with margin, and pushes both joints once both are near or beyond
+their bounds.
+
+Literals are given in degrees (as IIT and the original MoBeE publish them) and evaluated in
+radians: ``a . q_deg + b >= 0`` is ``a . q_rad + b pi/180 >= 0``, so clearances and ``delta`` are in
+radians of joint space.
+"""
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from mobee_drake.robots.overlay import Clause
+
+
+class ClauseSet:
+    """The clauses of one robot, vectorised over its controlled joints.
+
+    Args:
+        clauses: the overlay's clauses.
+        joints: names of the controlled joints, in the order of ``q``.
+        source: what to name in error messages (the overlay file).
+
+    Clauses that name no controlled joint at all are dropped (they constrain a part of the robot
+    this MoBeE does not move). A clause that names both controlled and other joints is an error.
+    """
+
+    def __init__(self, clauses: Sequence[Clause], joints: Sequence[str], source: str = "overlay"):
+        column = {name: i for i, name in enumerate(joints)}
+        rows, offsets, membership, self.names = [], [], [], []
+        for clause in clauses:
+            names = {j for literal in clause.literals for j in literal.coefficients}
+            controlled = names & column.keys()
+            if not controlled:
+                continue
+            if controlled != names:
+                raise ValueError(
+                    f"{source}: clause '{clause.name}' names joints that are not controlled: "
+                    + ", ".join(sorted(names - controlled)))
+            members = []
+            for literal in clause.literals:
+                a = np.zeros(len(joints))
+                for name, coefficient in literal.coefficients.items():
+                    a[column[name]] = coefficient
+                members.append(len(rows))
+                rows.append(a)
+                offsets.append(np.radians(literal.offset))
+            membership.append(members)
+            self.names.append(clause.name)
+        n_literals = len(rows)
+        A = np.array(rows).reshape(n_literals, len(joints))
+        norms = np.linalg.norm(A, axis=1)
+        self._normals = A / norms[:, None] if n_literals else A  # a / |a|
+        self._offsets = np.array(offsets) / norms if n_literals else np.zeros(0)  # b / |a|
+        # C[c, l] = 1 when literal l belongs to clause c.
+        self._C = np.zeros((len(membership), n_literals))
+        for c, members in enumerate(membership):
+            self._C[c, members] = 1.0
+
+    @property
+    def num_clauses(self) -> int:
+        return self._C.shape[0]
+
+    def Clearances(self, q: np.ndarray) -> np.ndarray:
+        """The clearance ``g`` of every literal, in radians (clause by clause, in order)."""
+        return self._normals @ q + self._offsets
+
+    def ActiveClauses(self, q: np.ndarray, delta: float) -> np.ndarray:
+        """Which clauses have their forces switched on: all of their literals within ``delta``."""
+        return self._Active(self.Clearances(q) < delta)
+
+    def _Active(self, inside: np.ndarray) -> np.ndarray:
+        return self._C @ (~inside) == 0
+
+    def Force(self, q: np.ndarray, delta: float, f_max: float) -> np.ndarray:
+        """The total constraint force ``f_cst`` (eq. 5.15-5.17 as described in the module)."""
+        g = self.Clearances(q)
+        inside = g < delta
+        if not inside.any():  # The common case: every literal clear, no clause can switch on.
+            return np.zeros_like(q)
+        # How many switched-on clauses each literal belongs to.
+        weight = self._Active(inside).astype(float) @ self._C
+        return self._normals.T @ (f_max * (delta - g) / delta * weight)

@@ -1,0 +1,414 @@
+"""MoBeE 2.0 as a Drake LeafSystem: the forces of dissertation eq. 5.7-5.17, one port per term."""
+
+import dataclasses as dc
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.geometry import GeometryId, QueryObject
+from pydrake.multibody.math import SpatialForce
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
+from pydrake.systems.framework import LeafSystem, ValueProducer
+from pydrake.systems.primitives import MatrixGain
+
+from mobee_drake.mobee.constraints import ClauseSet
+from mobee_drake.mobee.joint_limits import JointLimitForce
+from mobee_drake.mobee.params import MobeeParams
+from mobee_drake.mobee.squash import Squash
+from mobee_drake.robots.overlay import RobotOverlay
+
+# The force terms of eq. 5.7, in the order of the rows of the force cache; "total" is their sum.
+FORCE_TERMS = ("spring", "damping", "f_lim", "f_cst", "f_coll", "f_config", "f_work")
+
+
+@dc.dataclass(frozen=True)
+class FieldContact:
+    """A pair of geometries closer than the field margin of the pair (eq. 5.11).
+
+    ``geometry_A`` belongs to the robot; ``geometry_B`` is an obstacle or another robot part.
+    Moving A along ``nhat_BA_W`` increases the distance; the force on A acts at ``p_WCa``.
+    """
+
+    geometry_A: GeometryId
+    geometry_B: GeometryId
+    name_A: str
+    name_B: str
+    distance: float  # Signed distance between the solids (m); negative when they penetrate.
+    margin: float  # The pair's field margin (m): the larger of the two geometries' fields.
+    p_WCa: np.ndarray  # Witness point on A, in world.
+    p_WCb: np.ndarray  # Witness point on B, in world.
+    nhat_BA_W: np.ndarray  # Unit direction from B to A, in world.
+
+    @property
+    def penetration(self) -> float:
+        """How deep the pair is inside its field (m)."""
+        return self.margin - self.distance
+
+
+class Mobee(LeafSystem):
+    """MoBeE 2.0: the forces of the dynamical system that moves the robot (eq. 5.7).
+
+    ``M q'' + C q' + L(K(q - q*)) = f_config + f_work + f_lim + f_cst + f_coll``
+
+    .. pydrake_system::
+
+        name: Mobee
+        input_ports:
+        - state
+        - attractor
+        - config_force
+        - marker_forces
+        - geometry_query
+        output_ports:
+        - spring
+        - damping
+        - f_lim
+        - f_cst
+        - f_coll
+        - f_config
+        - f_work
+        - total
+        - marker_positions
+        - marker_directions
+        - marker_jacobians
+        - field_contacts
+
+    Inputs (n = number of controlled joints, m = number of markers):
+
+    - ``state`` (2n): positions (rad) and velocities (rad/s) of the controlled joints.
+    - ``attractor`` (n): the attractor q* (rad). Unconnected: the plant's default positions.
+    - ``config_force`` (n): the client's configuration-space force f_qRPC (eq. 5.9). Optional.
+    - ``marker_forces`` (3m): a workspace force (world frame) on each marker (eq. 5.10). Optional.
+    - ``geometry_query``: SceneGraph's query object, posed at the same configuration.
+
+    Outputs (each n, the terms of eq. 5.7 moved to the right-hand side, so that
+    ``M q'' = total``):
+
+    - ``spring`` = -L(K(q - q*)), ``damping`` = -C q', ``f_lim``, ``f_cst``, ``f_coll``,
+      ``f_config``, ``f_work``, and ``total``, their sum.
+    - ``marker_positions`` (3m) and ``marker_directions`` (3m): in world, marker after marker.
+    - ``marker_jacobians`` (3mn): the translational Jacobians dp_WM/dq, marker after marker, each
+      3 x n in row-major order (reshape with ``(m, 3, n)``).
+    - ``field_contacts``: the list of :class:`FieldContact` pairs inside their fields.
+
+    The robot's kinematics are evaluated in a plant context held in a cache entry; the system
+    keeps no state of its own.
+    """
+
+    def __init__(self, plant: MultibodyPlant, robot: RobotOverlay, *, joints: list[str],
+                 params: MobeeParams | None = None):
+        super().__init__()
+        self._plant = plant
+        self._params = params = params or MobeeParams()
+        self._joints = list(joints)
+        n = len(self._joints)
+        params.Validate(self._joints)
+        source = "MoBeE"
+        self._q_index, self._v_index, q_min, q_max = [], [], [], []
+        for name in self._joints:
+            if not plant.HasJointNamed(name, robot.instance):
+                movable = [plant.get_joint(j).name() for j in plant.GetJointIndices(robot.instance)
+                           if plant.get_joint(j).num_positions() == 1]
+                raise ValueError(f"{source}: unknown joint '{name}'; the robot's joints are: "
+                                 + ", ".join(movable))
+            joint = plant.GetJointByName(name, robot.instance)
+            self._q_index.append(joint.position_start())
+            self._v_index.append(joint.velocity_start())
+            q_min.append(joint.position_lower_limits()[0])
+            q_max.append(joint.position_upper_limits()[0])
+        self._q_index = np.array(self._q_index)
+        self._v_index = np.array(self._v_index)
+        self._q_min, self._q_max = np.array(q_min), np.array(q_max)
+        mass, damping, stiffness = (np.array(x) for x in params.PerJoint(self._joints))
+        self._mass, self._damping, self._stiffness = mass, damping, stiffness
+        self._clauses = ClauseSet(robot.overlay.clauses, self._joints, source=source)
+        self._default_positions = plant.GetPositions(plant.CreateDefaultContext())
+        self._home = self._default_positions[self._q_index]
+        self._state_names = ([f"{j} position" for j in self._joints]
+                             + [f"{j} velocity" for j in self._joints])
+
+        self._margins = dict(robot.field_margins)
+        self._geometry_names = dict(robot.geometry_names)
+        self._geometry_bodies = {geometry_id: plant.get_body(body_index)
+                                 for geometry_id, body_index in robot.geometry_bodies.items()}
+        self._max_margin = max(self._margins.values(), default=0.0)
+        self._markers = robot.markers
+        self._marker_bodies = [plant.GetBodyByName(m.body_name, robot.instance)
+                               for m in self._markers]
+        self._marker_index = {m.name: i for i, m in enumerate(self._markers)}
+        num_markers = len(self._markers)
+
+        self._state_port = self.DeclareVectorInputPort("state", 2 * n)
+        self._attractor_port = self.DeclareVectorInputPort("attractor", n)
+        self._config_force_port = self.DeclareVectorInputPort("config_force", n)
+        self._marker_forces_port = self.DeclareVectorInputPort("marker_forces", 3 * num_markers)
+        self._query_port = self.DeclareAbstractInputPort(
+            "geometry_query", AbstractValue.Make(QueryObject()))
+
+        state_ticket = self._state_port.ticket()
+        self._plant_context_entry = self.DeclareCacheEntry(
+            description="plant context at the input configuration",
+            value_producer=ValueProducer(
+                allocate=lambda: AbstractValue.Make(plant.CreateDefaultContext()),
+                calc=self._CalcPlantContext),
+            prerequisites_of_calc={state_ticket})
+        plant_ticket = self._plant_context_entry.ticket()
+        self._contacts_entry = self.DeclareCacheEntry(
+            description="geometry pairs inside their fields",
+            value_producer=ValueProducer(allocate=lambda: AbstractValue.Make([]),
+                                         calc=self._CalcFieldContacts),
+            prerequisites_of_calc={self._query_port.ticket()})
+        self._forces_entry = self.DeclareCacheEntry(
+            description="force terms of eq. 5.7",
+            value_producer=ValueProducer(
+                allocate=lambda: AbstractValue.Make(np.zeros((len(FORCE_TERMS), n))),
+                calc=self._CalcForces),
+            prerequisites_of_calc={
+                state_ticket, plant_ticket, self._contacts_entry.ticket(),
+                self._attractor_port.ticket(), self._config_force_port.ticket(),
+                self._marker_forces_port.ticket()})
+        self._marker_pose_entry = self.DeclareCacheEntry(
+            description="marker positions and directions",
+            value_producer=ValueProducer(
+                allocate=lambda: AbstractValue.Make(np.zeros((2, num_markers, 3))),
+                calc=self._CalcMarkerPoses),
+            prerequisites_of_calc={plant_ticket})
+
+        for row, term in enumerate(FORCE_TERMS):
+            self.DeclareVectorOutputPort(
+                term, n, lambda context, output, row=row: output.SetFromVector(
+                    self._forces_entry.Eval(context)[row]),
+                prerequisites_of_calc={self._forces_entry.ticket()})
+        self.DeclareVectorOutputPort(
+            "total", n, lambda context, output: output.SetFromVector(
+                self._forces_entry.Eval(context).sum(axis=0)),
+            prerequisites_of_calc={self._forces_entry.ticket()})
+        for row, name in enumerate(("marker_positions", "marker_directions")):
+            self.DeclareVectorOutputPort(
+                name, 3 * num_markers, lambda context, output, row=row: output.SetFromVector(
+                    self._marker_pose_entry.Eval(context)[row].ravel()),
+                prerequisites_of_calc={self._marker_pose_entry.ticket()})
+        self.DeclareVectorOutputPort(
+            "marker_jacobians", 3 * num_markers * n, self._CalcMarkerJacobians,
+            prerequisites_of_calc={plant_ticket})
+        self.DeclareAbstractOutputPort(
+            "field_contacts", lambda: AbstractValue.Make([]),
+            lambda context, output: output.set_value(self._contacts_entry.Eval(context)),
+            prerequisites_of_calc={self._contacts_entry.ticket()})
+
+    @staticmethod
+    def AddToBuilder(builder, *, plant: MultibodyPlant, scene_graph, robot: RobotOverlay,
+                     joints: list[str], params: MobeeParams | None = None,
+                     name: str = "mobee") -> "Mobee":
+        """Adds MoBeE to ``builder`` and connects its state and geometry query.
+
+        The state comes from ``plant``'s state output through a selector of ``joints``; the
+        attractor and the client's forces are left for the caller to connect or fix.
+        """
+        mobee = builder.AddNamedSystem(name, Mobee(plant, robot, joints=joints, params=params))
+        joint_indices = [plant.GetJointByName(j, robot.instance).index() for j in joints]
+        selector = builder.AddNamedSystem(
+            f"{name}_state_selector", MatrixGain(plant.MakeStateSelectorMatrix(joint_indices)))
+        builder.Connect(plant.get_state_output_port(), selector.get_input_port())
+        builder.Connect(selector.get_output_port(), mobee.GetInputPort("state"))
+        builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
+        return mobee
+
+    # ----------------------------------------------------------------------------------------
+    # Lookups for clients.
+
+    @property
+    def joints(self) -> list[str]:
+        """The controlled joints, in the order of every n-vector of this system."""
+        return list(self._joints)
+
+    @property
+    def marker_names(self) -> list[str]:
+        return [m.name for m in self._markers]
+
+    def marker_index(self, name: str) -> int:
+        """The index of marker ``name`` in the marker ports (its force is ``3i:3i+3``)."""
+        if name not in self._marker_index:
+            raise ValueError(f"MoBeE: unknown marker '{name}'; markers are: "
+                             + ", ".join(self.marker_names))
+        return self._marker_index[name]
+
+    def joint_index(self, name: str) -> int:
+        """The index of joint ``name`` in the n-vectors of this system."""
+        if name not in self._joints:
+            raise ValueError(f"MoBeE: unknown joint '{name}'; controlled joints are: "
+                             + ", ".join(self._joints))
+        return self._joints.index(name)
+
+    @property
+    def home(self) -> np.ndarray:
+        """The plant's default positions of the controlled joints (the default attractor)."""
+        return self._home.copy()
+
+    @property
+    def position_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        return self._q_min.copy(), self._q_max.copy()
+
+    @property
+    def mass(self) -> np.ndarray:
+        """The diagonal of M (eq. 5.7), for integrating ``M q'' = total``."""
+        return self._mass.copy()
+
+    @property
+    def clauses(self) -> ClauseSet:
+        return self._clauses
+
+    # ----------------------------------------------------------------------------------------
+    # Input checks.
+
+    def _CheckFinite(self, what: str, value: np.ndarray, names: list[str]) -> None:
+        if not np.isfinite(value).all():
+            i = np.flatnonzero(~np.isfinite(value))[0]
+            raise ValueError(f"MoBeE: {what} for '{names[i]}' is not finite: {value[i]}")
+
+    def _ReadState(self, context) -> tuple[np.ndarray, np.ndarray]:
+        x = self._state_port.Eval(context)
+        n = len(self._joints)
+        self._CheckFinite("state", x, self._state_names)
+        return x[:n], x[n:]
+
+    def _ReadAttractor(self, context) -> np.ndarray:
+        if not self._attractor_port.HasValue(context):
+            return self._home
+        q_star = self._attractor_port.Eval(context)
+        self._CheckFinite("attractor", q_star, self._joints)
+        outside = (q_star < self._q_min) | (q_star > self._q_max)
+        if outside.any():
+            i = np.flatnonzero(outside)[0]
+            raise ValueError(
+                f"MoBeE: attractor for joint '{self._joints[i]}' is {np.degrees(q_star[i]):.6g} "
+                f"deg, outside its limits [{np.degrees(self._q_min[i]):.6g}, "
+                f"{np.degrees(self._q_max[i]):.6g}] deg")
+        return q_star
+
+    # ----------------------------------------------------------------------------------------
+    # Cache computations.
+
+    def _CalcPlantContext(self, context, value) -> None:
+        plant_context = value.get_mutable_value()
+        q, _ = self._ReadState(context)
+        positions = self._default_positions.copy()
+        positions[self._q_index] = q
+        self._plant.SetPositions(plant_context, positions)
+
+    def _CalcFieldContacts(self, context, value) -> None:
+        query = self._query_port.Eval(context)
+        contacts = []
+        if self._max_margin > 0:
+            margins, names = self._margins, self._geometry_names
+            for pair in query.ComputeSignedDistancePairwiseClosestPoints(self._max_margin):
+                id_A, id_B = pair.id_A, pair.id_B
+                margin_A, margin_B = margins.get(id_A), margins.get(id_B)
+                if margin_A is None and margin_B is None:
+                    continue  # Neither geometry is ours.
+                margin = max(margin_A or 0.0, margin_B or 0.0)
+                distance = pair.distance
+                if distance >= margin:
+                    continue
+                p_WCa = query.GetPoseInWorld(id_A) @ pair.p_ACa
+                p_WCb = query.GetPoseInWorld(id_B) @ pair.p_BCb
+                nhat = pair.nhat_BA_W
+                if margin_A is None:  # Make A the robot's geometry.
+                    id_A, id_B, p_WCa, p_WCb, nhat = id_B, id_A, p_WCb, p_WCa, -nhat
+                inspector = query.inspector()
+                contacts.append(FieldContact(
+                    geometry_A=id_A, geometry_B=id_B,
+                    name_A=names.get(id_A) or inspector.GetName(id_A),
+                    name_B=names.get(id_B) or inspector.GetName(id_B),
+                    distance=distance, margin=margin,
+                    p_WCa=p_WCa, p_WCb=p_WCb, nhat_BA_W=np.asarray(nhat)))
+        value.set_value(contacts)
+
+    def _ProjectWorkspaceForces(self, plant_context, points) -> np.ndarray:
+        """Sum of J^T f over (body, p_WP, f_W) triples, for the controlled joints.
+
+        Forces on the same body are combined into one spatial force about the body origin, so the
+        plant projects each body once (``CalcGeneralizedForces`` is J^T F for all bodies at once).
+        """
+        per_body: dict[int, list] = {}
+        for body, p_WP, f_W in points:
+            p_WBo = body.EvalPoseInWorld(plant_context).translation()
+            entry = per_body.setdefault(int(body.index()), [body, np.zeros(3), np.zeros(3)])
+            r = p_WP - p_WBo
+            entry[1] += (r[1] * f_W[2] - r[2] * f_W[1], r[2] * f_W[0] - r[0] * f_W[2],
+                         r[0] * f_W[1] - r[1] * f_W[0])
+            entry[2] += f_W
+        forces = MultibodyForces(self._plant)
+        for body, torque, force in per_body.values():
+            body.AddInForceInWorld(plant_context, SpatialForce(torque, force), forces)
+        return self._plant.CalcGeneralizedForces(plant_context, forces)[self._v_index]
+
+    def _CollisionPoints(self, contacts: list[FieldContact]):
+        """The workspace forces of eq. 5.11: gain x field penetration, along the separation."""
+        gain = self._params.collision_gain
+        for contact in contacts:
+            f_W = gain * contact.penetration * contact.nhat_BA_W
+            yield self._geometry_bodies[contact.geometry_A], contact.p_WCa, f_W
+            if contact.geometry_B in self._margins:  # A self-collision pushes both bodies apart.
+                yield self._geometry_bodies[contact.geometry_B], contact.p_WCb, -f_W
+
+    def _CalcForces(self, context, value) -> None:
+        p = self._params
+        q, v = self._ReadState(context)
+        q_star = self._ReadAttractor(context)
+        terms = value.get_mutable_value()
+
+        terms[0] = -Squash(self._stiffness * (q - q_star), p.spring_squash.m, p.spring_squash.k)
+        terms[1] = -self._damping * v
+        terms[2] = JointLimitForce(q, self._q_min, self._q_max, p.limit_delta, p.limit_force)
+        terms[3] = self._clauses.Force(q, p.constraint_delta, p.constraint_force)
+
+        contacts = self._contacts_entry.Eval(context)
+        if contacts:
+            plant_context = self._plant_context_entry.Eval(context)
+            generalized = self._ProjectWorkspaceForces(plant_context,
+                                                       self._CollisionPoints(contacts))
+            terms[4] = Squash(generalized, p.collision_squash.m, p.collision_squash.k)
+        else:
+            terms[4] = 0.0
+
+        if self._config_force_port.HasValue(context):
+            f_q = self._config_force_port.Eval(context)
+            self._CheckFinite("config_force", f_q, self._joints)
+            terms[5] = Squash(f_q, p.config_squash.m, p.config_squash.k)
+        else:
+            terms[5] = 0.0
+
+        terms[6] = 0.0
+        if self._markers and self._marker_forces_port.HasValue(context):
+            f_m = self._marker_forces_port.Eval(context).reshape(-1, 3)
+            self._CheckFinite("marker_forces", f_m.ravel(),
+                              [f"{m.name}[{axis}]" for m in self._markers for axis in "xyz"])
+            loaded = np.flatnonzero(np.any(f_m != 0.0, axis=1))
+            if loaded.size:
+                plant_context = self._plant_context_entry.Eval(context)
+                points = []
+                for i in loaded:
+                    body = self._marker_bodies[i]
+                    p_WM = body.EvalPoseInWorld(plant_context) @ self._markers[i].p_BM
+                    points.append((body, p_WM, f_m[i]))
+                generalized = self._ProjectWorkspaceForces(plant_context, points)
+                terms[6] = Squash(generalized, p.work_squash.m, p.work_squash.k)
+
+    def _CalcMarkerPoses(self, context, value) -> None:
+        plant_context = self._plant_context_entry.Eval(context)
+        poses = value.get_mutable_value()
+        for i, (marker, body) in enumerate(zip(self._markers, self._marker_bodies)):
+            X_WB = body.EvalPoseInWorld(plant_context)
+            poses[0, i] = X_WB @ marker.p_BM
+            poses[1, i] = X_WB.rotation() @ marker.u_B
+
+    def _CalcMarkerJacobians(self, context, output) -> None:
+        plant_context = self._plant_context_entry.Eval(context)
+        world = self._plant.world_frame()
+        blocks = [self._plant.CalcJacobianTranslationalVelocity(
+                      plant_context, JacobianWrtVariable.kV, body.body_frame(), marker.p_BM,
+                      world, world)[:, self._v_index]
+                  for marker, body in zip(self._markers, self._marker_bodies)]
+        output.SetFromVector(np.concatenate([b.ravel() for b in blocks]) if blocks
+                             else np.zeros(0))

@@ -1,0 +1,92 @@
+"""The iCub humanoid from icub-models in a MultibodyPlant, mounted on its pole.
+
+As in the dissertation (ch. 2-8), the iCub stands on a pole: its ``root_link`` is welded to the
+world. The joints MoBeE controls stay revolute; every other joint (by default the legs) is replaced
+by a weld at its home angle, so the plant's positions are exactly the controlled joints.
+
+The world frame is placed at the root link (the waist) unless told otherwise. The iCub's root
+frame has x pointing backwards, y to the robot's right and z up: the robot faces -x.
+"""
+
+import dataclasses as dc
+import math
+
+from pydrake.geometry import SceneGraph
+from pydrake.math import RigidTransform
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+
+from mobee_drake.robots.assembly import FreezeJoints
+from mobee_drake.robots.model_cache import PreparedIcubModel
+from mobee_drake.robots.overlay import (
+    MODELS_DIR,
+    ApplyOverlay,
+    LoadOverlay,
+    RobotOverlay,
+    ZeroConfigurationPoses,
+)
+
+DEFAULT_ICUB_MODEL = "iCubGazeboV2_5"
+
+TORSO_JOINTS = ("torso_pitch", "torso_roll", "torso_yaw")
+NECK_JOINTS = ("neck_pitch", "neck_roll", "neck_yaw")
+ARM_JOINT_SUFFIXES = (
+    "shoulder_pitch",
+    "shoulder_roll",
+    "shoulder_yaw",
+    "elbow",
+    "wrist_prosup",
+    "wrist_pitch",
+    "wrist_yaw",
+)
+RIGHT_ARM_JOINTS = tuple(f"r_{s}" for s in ARM_JOINT_SUFFIXES)
+LEFT_ARM_JOINTS = tuple(f"l_{s}" for s in ARM_JOINT_SUFFIXES)
+UPPER_BODY_JOINTS = TORSO_JOINTS + NECK_JOINTS + RIGHT_ARM_JOINTS + LEFT_ARM_JOINTS
+
+# The home posture of the original MoBeE iCub model (degrees): arms slightly forward and out, elbows
+# bent; all other joints at zero. Joints not listed here start at zero.
+HOME_POSTURE_DEG = {
+    **{f"{side}_shoulder_pitch": -26.0 for side in "rl"},
+    **{f"{side}_shoulder_roll": 20.0 for side in "rl"},
+    **{f"{side}_elbow": 50.0 for side in "rl"},
+}
+
+
+@dc.dataclass
+class IcubConfig:
+    """Which iCub to load and which of its joints MoBeE controls."""
+
+    # Any robot of the icub-models package (see ``IcubModelNames()``).
+    model: str = DEFAULT_ICUB_MODEL
+    # The controlled joints; every other joint is welded at its home angle.
+    controlled_joints: list[str] = dc.field(default_factory=lambda: list(UPPER_BODY_JOINTS))
+    # Home angles in degrees for joints that should not start at zero.
+    home_deg: dict[str, float] = dc.field(default_factory=lambda: dict(HOME_POSTURE_DEG))
+    # MoBeE's collision overlay; a relative path is taken from the package's models/ folder.
+    overlay: str = "icub_overlay.yaml"
+
+
+def AddIcub(plant: MultibodyPlant, scene_graph: SceneGraph, config: IcubConfig | None = None,
+            X_WRoot: RigidTransform | None = None) -> RobotOverlay:
+    """Adds the iCub with its collision overlay to an unfinalized ``plant``.
+
+    The root link is welded to the world at ``X_WRoot`` (identity by default); joints that are not
+    in ``config.controlled_joints`` are welded at their home angles.
+
+    Raises:
+        ValueError: for an unknown model, an unknown joint name in ``config``, a home angle
+            outside its joint's limits, or a malformed overlay file.
+    """
+    config = config or IcubConfig()
+    urdf = str(PreparedIcubModel(config.model))
+    (instance,) = Parser(plant, f"icub_{config.model}").AddModels(urdf)
+    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("root_link", instance),
+                     X_WRoot or RigidTransform())
+    home = {name: math.radians(value) for name, value in config.home_deg.items()}
+    FreezeJoints(plant, instance, keep=config.controlled_joints, home=home,
+                 source=f"iCub model '{config.model}'")
+    overlay_file = MODELS_DIR / config.overlay
+    reference = ZeroConfigurationPoses(lambda scratch: Parser(scratch).AddModels(urdf)[0],
+                                       "root_link")
+    return ApplyOverlay(plant, scene_graph, instance, LoadOverlay(overlay_file), reference,
+                        source=str(overlay_file))

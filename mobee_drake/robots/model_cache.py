@@ -1,0 +1,125 @@
+"""Prepares the icub-models URDFs for Drake, once, in a per-user cache.
+
+Drake 1.51 does not read the binary STL meshes icub-models ships, and MoBeE does not use the
+models' mesh collision geometry (its collision overlay of primitives replaces it, see
+``models/icub_overlay.yaml``). So, the first time a model is used, we write a copy of its URDF
+into the cache with
+
+- every ``<collision>`` element removed (collision geometry comes from the overlay),
+- every ``<gazebo>`` block removed (Drake ignores them, with warnings),
+- every ``<visual>`` mesh converted from STL to OBJ (for illustration in Meshcat),
+- every massless leaf link (sensor, skin and DH frames: 174 of the 213 links of iCubGazeboV2_5)
+  turned into a Drake ``<frame>`` on its parent link. The frames keep their names, and the plant
+  gets 39 bodies instead of 213, which makes kinematics and geometry updates several times faster.
+
+Nothing is written into the repository. The cache lives in ``$MOBEE_DRAKE_CACHE`` or
+``~/.cache/mobee-drake``; each model is written into a temporary folder and renamed into place, so
+an interrupted conversion never leaves a half-written model behind.
+"""
+
+import hashlib
+import os
+import pathlib
+import shutil
+import tempfile
+import xml.etree.ElementTree as ET
+
+import icub_models
+
+_MESH_PACKAGE_PREFIX = "package://iCub/meshes/"
+# Changes whenever the conversion below changes, so that old cached models are not reused.
+_CONVERSION_VERSION = b"2"
+
+
+def CacheDirectory() -> pathlib.Path:
+    """The folder under which converted models are kept."""
+    root = os.environ.get("MOBEE_DRAKE_CACHE")
+    return pathlib.Path(root) if root else pathlib.Path.home() / ".cache" / "mobee-drake"
+
+
+def IcubModelNames() -> list[str]:
+    """The robots that the installed icub-models package provides."""
+    return sorted(icub_models.get_robot_names())
+
+
+def IcubModelSourceFile(model_name: str) -> pathlib.Path:
+    """The original URDF of ``model_name`` inside the icub-models package."""
+    if model_name not in icub_models.get_robot_names():
+        raise ValueError(
+            f"unknown iCub model '{model_name}'; icub-models provides: "
+            + ", ".join(IcubModelNames())
+        )
+    return pathlib.Path(icub_models.get_model_file(model_name))
+
+
+def _ConvertMesh(source: pathlib.Path, destination: pathlib.Path) -> None:
+    import trimesh  # Imported lazily: only the first use of a model needs it.
+
+    mesh = trimesh.load(source, force="mesh")
+    temporary = destination.with_suffix(f".{os.getpid()}.tmp.obj")
+    mesh.export(temporary)
+    os.replace(temporary, destination)
+
+
+def _LeafLinksToFrames(robot: ET.Element) -> None:
+    """Replaces each massless, invisible leaf link on a fixed joint by a ``<frame>`` of its parent."""
+    links = {link.get("name"): link for link in robot.findall("link")}
+    parents = {joint.find("parent").get("link") for joint in robot.findall("joint")}
+    for joint in robot.findall("joint"):
+        child = links[joint.find("child").get("link")]
+        if (joint.get("type") != "fixed" or child.get("name") in parents
+                or child.find("inertial") is not None or child.find("visual") is not None):
+            continue
+        origin = joint.find("origin")
+        frame = ET.SubElement(robot, "frame", name=child.get("name"),
+                              link=joint.find("parent").get("link"))
+        frame.set("xyz", origin.get("xyz", "0 0 0") if origin is not None else "0 0 0")
+        frame.set("rpy", origin.get("rpy", "0 0 0") if origin is not None else "0 0 0")
+        robot.remove(joint)
+        robot.remove(child)
+
+
+def PreparedIcubModel(model_name: str) -> pathlib.Path:
+    """Returns the Drake-ready URDF of ``model_name``, converting it on first use."""
+    source = IcubModelSourceFile(model_name)
+    text = source.read_bytes()
+    digest = hashlib.sha256(_CONVERSION_VERSION + text).hexdigest()[:12]
+    folder = CacheDirectory() / "icub" / f"{model_name}-{digest}"
+    urdf = folder / "model.urdf"
+    if urdf.is_file():
+        return urdf
+
+    mesh_root = pathlib.Path(icub_models.get_models_path()).parent / "meshes"
+    mesh_cache = CacheDirectory() / "icub" / "meshes"
+    mesh_cache.mkdir(parents=True, exist_ok=True)
+
+    tree = ET.ElementTree(ET.fromstring(text))
+    robot = tree.getroot()
+    for gazebo in robot.findall("gazebo"):
+        robot.remove(gazebo)
+    for link in robot.findall("link"):
+        for collision in link.findall("collision"):
+            link.remove(collision)
+        for mesh in link.iter("mesh"):
+            uri = mesh.get("filename", "")
+            if not uri.startswith(_MESH_PACKAGE_PREFIX):
+                raise ValueError(f"{source}: link '{link.get('name')}' has a mesh outside the iCub package: {uri}")
+            relative = pathlib.Path(uri[len(_MESH_PACKAGE_PREFIX):])
+            converted = mesh_cache / (relative.stem + ".obj")
+            if not converted.is_file():
+                _ConvertMesh(mesh_root / relative, converted)
+            mesh.set("filename", str(converted))
+
+    _LeafLinksToFrames(robot)
+
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    staging = pathlib.Path(tempfile.mkdtemp(dir=folder.parent, prefix=f".{model_name}-"))
+    try:
+        tree.write(staging / "model.urdf")
+        os.replace(staging, folder)
+    except OSError:
+        # Another process won the race and renamed its copy first; use that one.
+        shutil.rmtree(staging, ignore_errors=True)
+        if not urdf.is_file():
+            raise
+    return urdf

@@ -1,0 +1,67 @@
+"""Loads YAML files into typed dataclasses with Drake's loader, with errors that name the file and line.
+
+Drake's ``yaml_load_typed`` reports *what* is wrong ("The fields ['shap'] were unknown to the
+schema", "could not convert string to float: 'x'") but not *where*. Every file this package reads
+goes through :func:`LoadYamlFile`, which re-raises such errors as :class:`YamlFileError` carrying the
+file name and, when the offending key or value can be found in the text, its line number.
+"""
+
+import pathlib
+import re
+
+from pydrake.common.yaml import yaml_load_typed
+import yaml
+
+
+class YamlFileError(ValueError):
+    """A YAML file that does not match its schema; the message names the file and line."""
+
+
+def LineOf(text: str, names: list[str]) -> int | None:
+    """Returns the 1-based line of the first mapping key or scalar of ``text`` that is in ``names``."""
+    quoted = set(names)
+    if not quoted:
+        return None
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError:
+        return None
+    stack = [root] if root is not None else []
+    while stack:
+        node = stack.pop(0)
+        if isinstance(node, yaml.MappingNode):
+            for key, value in node.value:
+                if key.value in quoted:
+                    return key.start_mark.line + 1
+                stack.append(value)
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend(node.value)
+        elif isinstance(node, yaml.ScalarNode) and node.value in quoted:
+            return node.start_mark.line + 1
+    return None
+
+
+def LoadYamlFile(*, schema, filename, child_name: str | None = None, defaults=None):
+    """Loads ``filename`` (optionally its top-level ``child_name``) into an instance of ``schema``.
+
+    Raises:
+        YamlFileError: naming the file, the line where it can be located, and Drake's reason, when
+            the file is missing, is not valid YAML, or does not match the schema.
+    """
+    path = pathlib.Path(filename)
+    if not path.is_file():
+        raise YamlFileError(f"{path}: no such file")
+    text = path.read_text()
+    try:
+        kwargs = dict(schema=schema, data=text, child_name=child_name)
+        if defaults is not None:
+            kwargs["defaults"] = defaults
+        return yaml_load_typed(**kwargs)
+    except yaml.MarkedYAMLError as e:
+        mark = e.problem_mark
+        raise YamlFileError(f"{path}:{mark.line + 1}: invalid YAML: {e.problem}") from e
+    except (RuntimeError, ValueError, TypeError, KeyError) as e:
+        # Drake's messages quote the offending names: ['shap'], 'x'.
+        line = LineOf(text, re.findall(r"'([^']+)'", str(e)))
+        where = f"{path}:{line}" if line else f"{path}"
+        raise YamlFileError(f"{where}: {e}") from e
