@@ -26,7 +26,7 @@ radians: ``a . q_deg + b >= 0`` is ``a . q_rad + b pi/180 >= 0``, so clearances 
 radians of joint space.
 """
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
@@ -39,32 +39,43 @@ class ClauseSet:
     Args:
         clauses: the overlay's clauses.
         joints: names of the controlled joints, in the order of ``q``.
+        frozen_joints: angles (rad) of joints welded in place; their terms become constants.
         source: what to name in error messages (the overlay file).
 
-    Clauses that name no controlled joint at all are dropped (they constrain a part of the robot
-    this MoBeE does not move). A clause that names both controlled and other joints is an error.
+    A literal on frozen joints only is a constant: true (the clause can never switch on, so it is
+    dropped) or false (it never stops the clause from switching on, so it is left out of it).
+    A joint neither controlled nor frozen is an error.
     """
 
-    def __init__(self, clauses: Sequence[Clause], joints: Sequence[str], source: str = "overlay"):
+    def __init__(self, clauses: Sequence[Clause], joints: Sequence[str],
+                 frozen_joints: Mapping[str, float] | None = None, source: str = "overlay"):
         column = {name: i for i, name in enumerate(joints)}
+        frozen = {name: np.degrees(angle) for name, angle in (frozen_joints or {}).items()}
         rows, offsets, membership, self.names = [], [], [], []
         for clause in clauses:
-            names = {j for literal in clause.literals for j in literal.coefficients}
-            controlled = names & column.keys()
-            if not controlled:
-                continue
-            if controlled != names:
-                raise ValueError(
-                    f"{source}: clause '{clause.name}' names joints that are not controlled: "
-                    + ", ".join(sorted(names - controlled)))
-            members = []
+            literals = []  # (a over the controlled joints, b in degrees)
             for literal in clause.literals:
-                a = np.zeros(len(joints))
+                a, b = np.zeros(len(joints)), literal.offset
                 for name, coefficient in literal.coefficients.items():
-                    a[column[name]] = coefficient
+                    if name in column:
+                        a[column[name]] = coefficient
+                    elif name in frozen:
+                        b += coefficient * frozen[name]
+                    else:
+                        raise ValueError(f"{source}: clause '{clause.name}' names joint '{name}', "
+                                         "which is neither controlled nor frozen")
+                literals.append((a, b))
+            if any(not a.any() and b >= 0 for a, b in literals):
+                continue  # A literal that always holds: the clause can never switch on.
+            literals = [(a, b) for a, b in literals if a.any()]
+            if not literals:
+                raise ValueError(f"{source}: clause '{clause.name}' is violated by the frozen "
+                                 "joints and no controlled joint can satisfy it")
+            members = []
+            for a, b in literals:
                 members.append(len(rows))
                 rows.append(a)
-                offsets.append(np.radians(literal.offset))
+                offsets.append(np.radians(b))
             membership.append(members)
             self.names.append(clause.name)
         n_literals = len(rows)

@@ -121,7 +121,8 @@ class Mobee(LeafSystem):
         self._q_min, self._q_max = np.array(q_min), np.array(q_max)
         mass, damping, stiffness = (np.array(x) for x in params.PerJoint(self._joints))
         self._mass, self._damping, self._stiffness = mass, damping, stiffness
-        self._clauses = ClauseSet(robot.overlay.clauses, self._joints, source=source)
+        self._clauses = ClauseSet(robot.overlay.clauses, self._joints, robot.frozen_joints,
+                                  source=source)
         self._default_positions = plant.GetPositions(plant.CreateDefaultContext())
         self._home = self._default_positions[self._q_index]
         self._state_names = ([f"{j} position" for j in self._joints]

@@ -1,20 +1,66 @@
-"""Turns a parsed robot into the robot MoBeE controls: uncontrolled joints become welds."""
+"""Adds a robot for MoBeE to a plant: root welded, uncontrolled joints welded, overlay applied."""
 
 from collections.abc import Iterable, Mapping
+import pathlib
 
 import numpy as np
 from pydrake.common.eigen_geometry import AngleAxis
+from pydrake.geometry import SceneGraph
 from pydrake.math import RigidTransform
+from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex, RevoluteJoint
 
+from mobee_drake.robots.overlay import (
+    ApplyOverlay,
+    LoadOverlay,
+    RobotOverlay,
+    ZeroConfigurationPoses,
+)
+
+
+def AddRobotWithOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, *,
+                        model_file: str | pathlib.Path, overlay_file: str | pathlib.Path,
+                        controlled_joints: Iterable[str], home: Mapping[str, float] | None = None,
+                        X_WRoot: RigidTransform | None = None,
+                        model_name: str | None = None) -> RobotOverlay:
+    """Adds the robot of ``model_file`` (URDF or SDFormat) with its MoBeE overlay to ``plant``.
+
+    The overlay's ``reference_link`` is the robot's root: unless the model already fixes it, it is
+    welded to the world at ``X_WRoot``. Joints not in ``controlled_joints`` are welded at their
+    ``home`` angle (radians, zero by default). Must be called before ``plant.Finalize()``.
+
+    Raises:
+        ValueError: naming the file and the element, for unknown joints or links, home angles
+            outside their limits, or a malformed overlay.
+    """
+    model_file, overlay_file = str(model_file), str(overlay_file)
+    overlay = LoadOverlay(overlay_file)
+    (instance,) = Parser(plant, model_name).AddModels(model_file)
+    if not plant.HasBodyNamed(overlay.reference_link, instance):
+        raise ValueError(f"{overlay_file}: reference_link '{overlay.reference_link}' is not a link "
+                         f"of {model_file}")
+    root = plant.GetBodyByName(overlay.reference_link, instance)
+    if not any(plant.get_joint(j).child_body().index() == root.index()
+               for j in plant.GetJointIndices(instance)):
+        plant.WeldFrames(plant.world_frame(), root.body_frame(), X_WRoot or RigidTransform())
+    reference = ZeroConfigurationPoses(
+        lambda scratch: Parser(scratch).AddModels(model_file)[0], overlay.reference_link)
+    frozen = FreezeJoints(plant, instance, keep=controlled_joints, home=home or {},
+                          source=model_file)
+    return ApplyOverlay(plant, scene_graph, instance, overlay, reference, frozen_joints=frozen,
+                        source=overlay_file)
+
 
 def FreezeJoints(plant: MultibodyPlant, instance: ModelInstanceIndex, *, keep: Iterable[str],
-                 home: Mapping[str, float], source: str) -> None:
+                 home: Mapping[str, float], source: str) -> dict[str, float]:
     """Welds every joint of ``instance`` not named in ``keep`` at its ``home`` angle (radians).
 
     The kept joints get their ``home`` angle as default position. Must be called before
     ``plant.Finalize()``.
+
+    Returns:
+        The angle (radians) at which each welded joint was frozen.
 
     Raises:
         ValueError: naming ``source`` and the joint, for a name in ``keep`` or ``home`` that the
@@ -38,6 +84,7 @@ def FreezeJoints(plant: MultibodyPlant, instance: ModelInstanceIndex, *, keep: I
             raise ValueError(
                 f"{source}: home angle of joint '{name}' is {np.degrees(angle):.6g} deg, outside "
                 f"its limits [{np.degrees(lower):.6g}, {np.degrees(upper):.6g}] deg")
+    frozen = {}
     for name in movable:
         joint = joints[name]
         if name in keep and not isinstance(joint, RevoluteJoint):
@@ -53,3 +100,5 @@ def FreezeJoints(plant: MultibodyPlant, instance: ModelInstanceIndex, *, keep: I
         X_FM = RigidTransform(AngleAxis(angle, joint.revolute_axis()), np.zeros(3))
         plant.RemoveJoint(joint)
         plant.WeldFrames(frame_on_parent, frame_on_child, X_FM)
+        frozen[name] = angle
+    return frozen

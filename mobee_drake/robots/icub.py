@@ -13,18 +13,11 @@ import math
 
 from pydrake.geometry import SceneGraph
 from pydrake.math import RigidTransform
-from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 
-from mobee_drake.robots.assembly import FreezeJoints
+from mobee_drake.robots.assembly import AddRobotWithOverlay
 from mobee_drake.robots.model_cache import PreparedIcubModel
-from mobee_drake.robots.overlay import (
-    MODELS_DIR,
-    ApplyOverlay,
-    LoadOverlay,
-    RobotOverlay,
-    ZeroConfigurationPoses,
-)
+from mobee_drake.robots.overlay import MODELS_DIR, RobotOverlay
 
 DEFAULT_ICUB_MODEL = "iCubGazeboV2_5"
 
@@ -78,15 +71,8 @@ def AddIcub(plant: MultibodyPlant, scene_graph: SceneGraph, config: IcubConfig |
             outside its joint's limits, or a malformed overlay file.
     """
     config = config or IcubConfig()
-    urdf = str(PreparedIcubModel(config.model))
-    (instance,) = Parser(plant, f"icub_{config.model}").AddModels(urdf)
-    plant.WeldFrames(plant.world_frame(), plant.GetFrameByName("root_link", instance),
-                     X_WRoot or RigidTransform())
-    home = {name: math.radians(value) for name, value in config.home_deg.items()}
-    FreezeJoints(plant, instance, keep=config.controlled_joints, home=home,
-                 source=f"iCub model '{config.model}'")
-    overlay_file = MODELS_DIR / config.overlay
-    reference = ZeroConfigurationPoses(lambda scratch: Parser(scratch).AddModels(urdf)[0],
-                                       "root_link")
-    return ApplyOverlay(plant, scene_graph, instance, LoadOverlay(overlay_file), reference,
-                        source=str(overlay_file))
+    return AddRobotWithOverlay(
+        plant, scene_graph, model_file=PreparedIcubModel(config.model),
+        overlay_file=MODELS_DIR / config.overlay, controlled_joints=config.controlled_joints,
+        home={name: math.radians(value) for name, value in config.home_deg.items()},
+        X_WRoot=X_WRoot, model_name=f"icub_{config.model}")

@@ -232,6 +232,8 @@ class RobotOverlay:
     # The body that carries each geometry.
     geometry_bodies: Mapping[GeometryId, BodyIndex]
     markers: tuple[BodyMarker, ...]
+    # The angle (rad) of each joint of the model that was welded instead of controlled.
+    frozen_joints: Mapping[str, float] = dc.field(default_factory=dict)
 
 
 def ZeroConfigurationPoses(
@@ -258,11 +260,12 @@ def ZeroConfigurationPoses(
 
 def ApplyOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, instance: ModelInstanceIndex,
                  overlay: Overlay, reference_poses: Mapping[str, RigidTransform],
+                 frozen_joints: Mapping[str, float] | None = None,
                  source: str = "overlay") -> RobotOverlay:
     """Registers the overlay's primitives as proximity geometry of ``instance`` and its exclusions.
 
     Must be called before ``plant.Finalize()``. ``reference_poses`` comes from
-    :func:`ZeroConfigurationPoses`.
+    :func:`ZeroConfigurationPoses`; ``frozen_joints`` the angles of the joints that were welded.
 
     Raises:
         OverlayError: naming ``source`` and the element, for a link the robot does not have.
@@ -311,4 +314,5 @@ def ApplyOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, instance: Model
         markers.append(BodyMarker(name=m.name, body_name=m.link, p_BM=X_LR @ np.asarray(m.position),
                                   u_B=X_LR.rotation() @ (u / np.linalg.norm(u))))
     return RobotOverlay(overlay=overlay, instance=instance, field_margins=margins,
-                        geometry_names=names, geometry_bodies=bodies, markers=tuple(markers))
+                        geometry_names=names, geometry_bodies=bodies, markers=tuple(markers),
+                        frozen_joints=dict(frozen_joints or {}))
