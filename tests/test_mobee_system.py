@@ -1,59 +1,13 @@
 """MoBeE 2.0's LeafSystem on a three-link planar arm: every output port against closed forms."""
 
-import pathlib
 import unittest
 
+from arm_diagram import JOINTS, ArmDiagram
 import numpy as np
-from pydrake.math import RigidTransform
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-from pydrake.multibody.tree import JacobianWrtVariable
-from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake.mobee.params import MobeeParams, SquashParams
 from mobee_drake.mobee.squash import Squash
-from mobee_drake.mobee.system import FORCE_TERMS, Mobee
-from mobee_drake.robots.assembly import AddRobotWithOverlay
-from mobee_drake.scene.objects import AddBox
-
-MODELS = pathlib.Path(__file__).parent / "models"
-JOINTS = ["joint1", "joint2", "joint3"]
-
-
-class ArmDiagram:
-    """The arm, optional fixed boxes and MoBeE, with the plant's positions set by the test."""
-
-    def __init__(self, boxes=(), params=None):
-        builder = DiagramBuilder()
-        self.plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
-        self.robot = AddRobotWithOverlay(
-            self.plant, scene_graph, model_file=MODELS / "three_link_arm.urdf",
-            overlay_file=MODELS / "three_link_arm_overlay.yaml", controlled_joints=JOINTS)
-        for i, (size, center) in enumerate(boxes):
-            AddBox(self.plant, f"box{i}", size, RigidTransform(center))
-        self.plant.Finalize()
-        self.params = params or MobeeParams()
-        self.dut = Mobee.AddToBuilder(builder, plant=self.plant, scene_graph=scene_graph,
-                                      robot=self.robot, joints=JOINTS, params=self.params)
-        self.diagram = builder.Build()
-        self.root_context = self.diagram.CreateDefaultContext()
-        self.context = self.dut.GetMyMutableContextFromRoot(self.root_context)
-        self.plant_context = self.plant.GetMyMutableContextFromRoot(self.root_context)
-
-    def Set(self, q, v=(0.0, 0.0, 0.0)):
-        self.plant.SetPositions(self.plant_context, np.asarray(q, dtype=float))
-        self.plant.SetVelocities(self.plant_context, np.asarray(v, dtype=float))
-
-    def Out(self, name):
-        return self.dut.GetOutputPort(name).Eval(self.context)
-
-    def Jacobian(self, body_name, p_WP):
-        """The translational Jacobian of the world point p_WP moving with body_name."""
-        body = self.plant.GetBodyByName(body_name)
-        X_BW = body.EvalPoseInWorld(self.plant_context).inverse()
-        world = self.plant.world_frame()
-        return self.plant.CalcJacobianTranslationalVelocity(
-            self.plant_context, JacobianWrtVariable.kV, body.body_frame(), X_BW @ p_WP,
-            world, world)
+from mobee_drake.mobee.system import FORCE_TERMS
 
 
 class TestPorts(unittest.TestCase):
