@@ -1,48 +1,28 @@
 """MoBeE 2.0 as a Drake LeafSystem: the forces of dissertation eq. 5.7-5.17, one port per term."""
 
-import dataclasses as dc
-
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.geometry import GeometryId, QueryObject
-from pydrake.multibody.math import SpatialForce
+from pydrake.geometry import QueryObject
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import JacobianWrtVariable, MultibodyForces
+from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem, ValueProducer
 from pydrake.systems.primitives import MatrixGain
 
 from mobee_drake.mobee.constraints import ClauseSet
+from mobee_drake.mobee.fields import (
+    NO_FIELD_PAIRS,
+    FieldPairs,
+    FindFieldPairs,
+    ToFieldContacts,
+)
 from mobee_drake.mobee.joint_limits import JointLimitForce
 from mobee_drake.mobee.params import MobeeParams
+from mobee_drake.mobee.projection import ProjectPointForces
 from mobee_drake.mobee.squash import Squash
 from mobee_drake.robots.overlay import RobotOverlay
 
 # The force terms of eq. 5.7, in the order of the rows of the force cache; "total" is their sum.
 FORCE_TERMS = ("spring", "damping", "f_lim", "f_cst", "f_coll", "f_config", "f_work")
-
-
-@dc.dataclass(frozen=True)
-class FieldContact:
-    """A pair of geometries closer than the field margin of the pair (eq. 5.11).
-
-    ``geometry_A`` belongs to the robot; ``geometry_B`` is an obstacle or another robot part.
-    Moving A along ``nhat_BA_W`` increases the distance; the force on A acts at ``p_WCa``.
-    """
-
-    geometry_A: GeometryId
-    geometry_B: GeometryId
-    name_A: str
-    name_B: str
-    distance: float  # Signed distance between the solids (m); negative when they penetrate.
-    margin: float  # The pair's field margin (m): the larger of the two geometries' fields.
-    p_WCa: np.ndarray  # Witness point on A, in world.
-    p_WCb: np.ndarray  # Witness point on B, in world.
-    nhat_BA_W: np.ndarray  # Unit direction from B to A, in world.
-
-    @property
-    def penetration(self) -> float:
-        """How deep the pair is inside its field (m)."""
-        return self.margin - self.distance
 
 
 class Mobee(LeafSystem):
@@ -89,7 +69,7 @@ class Mobee(LeafSystem):
     - ``marker_positions`` (3m) and ``marker_directions`` (3m): in world, marker after marker.
     - ``marker_jacobians`` (3mn): the translational Jacobians dp_WM/dq, marker after marker, each
       3 x n in row-major order (reshape with ``(m, 3, n)``).
-    - ``field_contacts``: the list of :class:`FieldContact` pairs inside their fields.
+    - ``field_contacts``: the list of :class:`~mobee_drake.mobee.fields.FieldContact` pairs inside their fields.
 
     The robot's kinematics are evaluated in a plant context held in a cache entry; the system
     keeps no state of its own.
@@ -129,10 +109,9 @@ class Mobee(LeafSystem):
                              + [f"{j} velocity" for j in self._joints])
 
         self._margins = dict(robot.field_margins)
-        self._geometry_names = dict(robot.geometry_names)
-        self._geometry_bodies = {geometry_id: plant.get_body(body_index)
-                                 for geometry_id, body_index in robot.geometry_bodies.items()}
         self._max_margin = max(self._margins.values(), default=0.0)
+        self._geometry_names = dict(robot.geometry_names)
+        self._geometry_frames = {g: plant.get_frame(f) for g, f in robot.geometry_frames.items()}
         self._markers = robot.markers
         self._marker_bodies = [plant.GetBodyByName(m.body_name, robot.instance)
                                for m in self._markers]
@@ -154,10 +133,10 @@ class Mobee(LeafSystem):
                 calc=self._CalcPlantContext),
             prerequisites_of_calc={state_ticket})
         plant_ticket = self._plant_context_entry.ticket()
-        self._contacts_entry = self.DeclareCacheEntry(
+        self._field_pairs_entry = self.DeclareCacheEntry(
             description="geometry pairs inside their fields",
-            value_producer=ValueProducer(allocate=lambda: AbstractValue.Make([]),
-                                         calc=self._CalcFieldContacts),
+            value_producer=ValueProducer(allocate=lambda: AbstractValue.Make(NO_FIELD_PAIRS),
+                                         calc=self._CalcFieldPairs),
             prerequisites_of_calc={self._query_port.ticket()})
         self._forces_entry = self.DeclareCacheEntry(
             description="force terms of eq. 5.7",
@@ -165,7 +144,7 @@ class Mobee(LeafSystem):
                 allocate=lambda: AbstractValue.Make(np.zeros((len(FORCE_TERMS), n))),
                 calc=self._CalcForces),
             prerequisites_of_calc={
-                state_ticket, plant_ticket, self._contacts_entry.ticket(),
+                state_ticket, plant_ticket, self._field_pairs_entry.ticket(),
                 self._attractor_port.ticket(), self._config_force_port.ticket(),
                 self._marker_forces_port.ticket()})
         self._marker_pose_entry = self.DeclareCacheEntry(
@@ -193,9 +172,8 @@ class Mobee(LeafSystem):
             "marker_jacobians", 3 * num_markers * n, self._CalcMarkerJacobians,
             prerequisites_of_calc={plant_ticket})
         self.DeclareAbstractOutputPort(
-            "field_contacts", lambda: AbstractValue.Make([]),
-            lambda context, output: output.set_value(self._contacts_entry.Eval(context)),
-            prerequisites_of_calc={self._contacts_entry.ticket()})
+            "field_contacts", lambda: AbstractValue.Make([]), self._CalcFieldContacts,
+            prerequisites_of_calc={self._field_pairs_entry.ticket()})
 
     @staticmethod
     def AddToBuilder(builder, *, plant: MultibodyPlant, scene_graph, robot: RobotOverlay,
@@ -297,61 +275,31 @@ class Mobee(LeafSystem):
         positions[self._q_index] = q
         self._plant.SetPositions(plant_context, positions)
 
-    def _CalcFieldContacts(self, context, value) -> None:
-        query = self._query_port.Eval(context)
-        contacts = []
-        if self._max_margin > 0:
-            margins, names = self._margins, self._geometry_names
-            for pair in query.ComputeSignedDistancePairwiseClosestPoints(self._max_margin):
-                id_A, id_B = pair.id_A, pair.id_B
-                margin_A, margin_B = margins.get(id_A), margins.get(id_B)
-                if margin_A is None and margin_B is None:
-                    continue  # Neither geometry is ours.
-                margin = max(margin_A or 0.0, margin_B or 0.0)
-                distance = pair.distance
-                if distance >= margin:
-                    continue
-                p_WCa = query.GetPoseInWorld(id_A) @ pair.p_ACa
-                p_WCb = query.GetPoseInWorld(id_B) @ pair.p_BCb
-                nhat = pair.nhat_BA_W
-                if margin_A is None:  # Make A the robot's geometry.
-                    id_A, id_B, p_WCa, p_WCb, nhat = id_B, id_A, p_WCb, p_WCa, -nhat
-                inspector = query.inspector()
-                contacts.append(FieldContact(
-                    geometry_A=id_A, geometry_B=id_B,
-                    name_A=names.get(id_A) or inspector.GetName(id_A),
-                    name_B=names.get(id_B) or inspector.GetName(id_B),
-                    distance=distance, margin=margin,
-                    p_WCa=p_WCa, p_WCb=p_WCb, nhat_BA_W=np.asarray(nhat)))
-        value.set_value(contacts)
+    def _CalcFieldPairs(self, context, value) -> None:
+        value.set_value(FindFieldPairs(self._query_port.Eval(context), self._margins,
+                                       self._max_margin))
 
-    def _ProjectWorkspaceForces(self, plant_context, points) -> np.ndarray:
-        """Sum of J^T f over (body, p_WP, f_W) triples, for the controlled joints.
+    def _CalcFieldContacts(self, context, output) -> None:
+        output.set_value(ToFieldContacts(self._field_pairs_entry.Eval(context),
+                                         self._query_port.Eval(context), self._geometry_names))
 
-        Forces on the same body are combined into one spatial force about the body origin, so the
-        plant projects each body once (``CalcGeneralizedForces`` is J^T F for all bodies at once).
+    def _CollisionForce(self, plant_context, pairs: FieldPairs) -> np.ndarray:
+        """The unsquashed sum of eq. 5.11 over the controlled joints: for each pair, the force
+        gain x field penetration along the separating direction at the witness point of the
+        robot geometry, and its opposite at the other witness point when that is the robot's too.
         """
-        per_body: dict[int, list] = {}
-        for body, p_WP, f_W in points:
-            p_WBo = body.EvalPoseInWorld(plant_context).translation()
-            entry = per_body.setdefault(int(body.index()), [body, np.zeros(3), np.zeros(3)])
-            r = p_WP - p_WBo
-            entry[1] += (r[1] * f_W[2] - r[2] * f_W[1], r[2] * f_W[0] - r[0] * f_W[2],
-                         r[0] * f_W[1] - r[1] * f_W[0])
-            entry[2] += f_W
-        forces = MultibodyForces(self._plant)
-        for body, torque, force in per_body.values():
-            body.AddInForceInWorld(plant_context, SpatialForce(torque, force), forces)
-        return self._plant.CalcGeneralizedForces(plant_context, forces)[self._v_index]
-
-    def _CollisionPoints(self, contacts: list[FieldContact]):
-        """The workspace forces of eq. 5.11: gain x field penetration, along the separation."""
-        gain = self._params.collision_gain
-        for contact in contacts:
-            f_W = gain * contact.penetration * contact.nhat_BA_W
-            yield self._geometry_bodies[contact.geometry_A], contact.p_WCa, f_W
-            if contact.geometry_B in self._margins:  # A self-collision pushes both bodies apart.
-                yield self._geometry_bodies[contact.geometry_B], contact.p_WCb, -f_W
+        f_W = (self._params.collision_gain * (pairs.margin - pairs.distance))[:, None] \
+            * pairs.nhat_BA_W
+        frames = self._geometry_frames
+        generalized = 0.0
+        for i, g in enumerate(pairs.geometry_A):
+            generalized = generalized + ProjectPointForces(
+                self._plant, plant_context, frames[g], pairs.p_ACa[i:i + 1], f_W[i:i + 1])
+        for i in np.flatnonzero(pairs.b_is_robot):
+            generalized = generalized + ProjectPointForces(
+                self._plant, plant_context, frames[pairs.geometry_B[i]], pairs.p_BCb[i:i + 1],
+                -f_W[i:i + 1])
+        return generalized[self._v_index]
 
     def _CalcForces(self, context, value) -> None:
         p = self._params
@@ -364,12 +312,11 @@ class Mobee(LeafSystem):
         terms[2] = JointLimitForce(q, self._q_min, self._q_max, p.limit_delta, p.limit_force)
         terms[3] = self._clauses.Force(q, p.constraint_delta, p.constraint_force)
 
-        contacts = self._contacts_entry.Eval(context)
-        if contacts:
+        pairs = self._field_pairs_entry.Eval(context)
+        if len(pairs):
             plant_context = self._plant_context_entry.Eval(context)
-            generalized = self._ProjectWorkspaceForces(plant_context,
-                                                       self._CollisionPoints(contacts))
-            terms[4] = Squash(generalized, p.collision_squash.m, p.collision_squash.k)
+            terms[4] = Squash(self._CollisionForce(plant_context, pairs), p.collision_squash.m,
+                              p.collision_squash.k)
         else:
             terms[4] = 0.0
 
@@ -388,13 +335,10 @@ class Mobee(LeafSystem):
             loaded = np.flatnonzero(np.any(f_m != 0.0, axis=1))
             if loaded.size:
                 plant_context = self._plant_context_entry.Eval(context)
-                points = []
-                for i in loaded:
-                    body = self._marker_bodies[i]
-                    p_WM = body.EvalPoseInWorld(plant_context) @ self._markers[i].p_BM
-                    points.append((body, p_WM, f_m[i]))
-                generalized = self._ProjectWorkspaceForces(plant_context, points)
-                terms[6] = Squash(generalized, p.work_squash.m, p.work_squash.k)
+                generalized = sum(ProjectPointForces(
+                    self._plant, plant_context, self._marker_bodies[i].body_frame(),
+                    self._markers[i].p_BM[None, :], f_m[i][None, :]) for i in loaded)
+                terms[6] = Squash(generalized[self._v_index], p.work_squash.m, p.work_squash.k)
 
     def _CalcMarkerPoses(self, context, value) -> None:
         plant_context = self._plant_context_entry.Eval(context)

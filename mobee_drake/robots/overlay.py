@@ -37,7 +37,7 @@ from pydrake.geometry import (
 )
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
-from pydrake.multibody.tree import BodyIndex, ModelInstanceIndex
+from pydrake.multibody.tree import FixedOffsetFrame, FrameIndex, ModelInstanceIndex
 
 from mobee_drake.yaml_io import LineOf, LoadYamlFile
 
@@ -229,8 +229,8 @@ class RobotOverlay:
     # The field margin (m) of each of the robot's proximity geometries.
     field_margins: Mapping[GeometryId, float]
     geometry_names: Mapping[GeometryId, str]
-    # The body that carries each geometry.
-    geometry_bodies: Mapping[GeometryId, BodyIndex]
+    # A frame of the plant fixed to each geometry's frame (where SceneGraph reports witness points).
+    geometry_frames: Mapping[GeometryId, FrameIndex]
     markers: tuple[BodyMarker, ...]
     # The angle (rad) of each joint of the model that was welded instead of controlled.
     frozen_joints: Mapping[str, float] = dc.field(default_factory=dict)
@@ -277,7 +277,7 @@ def ApplyOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, instance: Model
             raise OverlayError(f"{source}: '{element}' is attached to unknown link '{link}'")
         return reference_poses[link]
 
-    margins, names, bodies, by_name = {}, {}, {}, {}
+    margins, names, frames, by_name = {}, {}, {}, {}
     for p in overlay.primitives:
         X_RL = link_pose(p.link, p.name)
         shape = p.shape
@@ -295,11 +295,12 @@ def ApplyOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, instance: Model
         properties = ProximityProperties()
         AddContactMaterial(friction=CoulombFriction(0.5, 0.5), properties=properties)
         body = plant.GetBodyByName(p.link, instance)
-        geometry_id = plant.RegisterCollisionGeometry(
-            body, X_RL.inverse() @ X_RG, drake_shape, p.name, properties)
+        X_BG = X_RL.inverse() @ X_RG
+        geometry_id = plant.RegisterCollisionGeometry(body, X_BG, drake_shape, p.name, properties)
+        frames[geometry_id] = plant.AddFrame(
+            FixedOffsetFrame(f"{p.name}_geometry", body.body_frame(), X_BG)).index()
         margins[geometry_id] = overlay.default_field if p.field is None else p.field
         names[geometry_id] = p.name
-        bodies[geometry_id] = body.index()
         by_name[p.name] = geometry_id
 
     manager = scene_graph.collision_filter_manager()
@@ -314,5 +315,5 @@ def ApplyOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, instance: Model
         markers.append(BodyMarker(name=m.name, body_name=m.link, p_BM=X_LR @ np.asarray(m.position),
                                   u_B=X_LR.rotation() @ (u / np.linalg.norm(u))))
     return RobotOverlay(overlay=overlay, instance=instance, field_margins=margins,
-                        geometry_names=names, geometry_bodies=bodies, markers=tuple(markers),
+                        geometry_names=names, geometry_frames=frames, markers=tuple(markers),
                         frozen_joints=dict(frozen_joints or {}))
