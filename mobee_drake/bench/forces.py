@@ -51,17 +51,24 @@ def _BuildIcubAmongBoxes(num_boxes: int, rng: np.random.Generator):
     return diagram, plant, mobee
 
 
-def _OscillatorPoses(mobee: Mobee, num_poses: int, rng: np.random.Generator) -> np.ndarray:
-    """Poses 10 ms apart, each joint on its own sinusoid through its whole range."""
+def _OscillatorPoses(mobee: Mobee, num_poses: int, rng: np.random.Generator,
+                     amplitude: float = 1.0) -> np.ndarray:
+    """Poses 10 ms apart, each joint on its own sinusoid.
+
+    With ``amplitude`` 1 every joint sweeps its whole range (Fig. 2.4); with a smaller amplitude it
+    sweeps that fraction of its range around the home posture (clipped to the limits).
+    """
     q_min, q_max = mobee.position_limits
     period = rng.uniform(4.0, 12.0, size=q_min.size)  # seconds per sweep
     phase = rng.uniform(0, 2 * np.pi, size=q_min.size)
     t = 0.01 * np.arange(num_poses)[:, None]
-    return (q_min + q_max) / 2 + (q_max - q_min) / 2 * np.sin(2 * np.pi * t / period + phase)
+    center = (q_min + q_max) / 2 if amplitude >= 1 else mobee.home
+    q = center + amplitude * (q_max - q_min) / 2 * np.sin(2 * np.pi * t / period + phase)
+    return np.clip(q, q_min, q_max)
 
 
 def MeasureForceEvaluations(num_obstacles: int, *, num_poses: int = 2000, repeats: int = 5,
-                            seed: int = 0) -> ForceBenchmarkResult:
+                            amplitude: float = 1.0, seed: int = 0) -> ForceBenchmarkResult:
     """Times ``repeats`` sweeps of ``num_poses`` total-force evaluations among boxes."""
     rng = np.random.default_rng(seed)
     diagram, plant, mobee = _BuildIcubAmongBoxes(num_obstacles, rng)
@@ -71,7 +78,7 @@ def MeasureForceEvaluations(num_obstacles: int, *, num_poses: int = 2000, repeat
     total, contacts = mobee.GetOutputPort("total"), mobee.GetOutputPort("field_contacts")
     # The plant's positions are the controlled joints, possibly in another order.
     order = [plant.GetJointByName(j).position_start() for j in mobee.joints]
-    poses = _OscillatorPoses(mobee, num_poses, rng)
+    poses = _OscillatorPoses(mobee, num_poses, rng, amplitude)
     x = plant.GetPositions(plant_context)
     rates = []
     for _ in range(repeats):
@@ -96,13 +103,16 @@ def main(argv=None) -> None:
     parser.add_argument("--obstacles", type=int, nargs="+", default=[0, 10, 30, 100, 300])
     parser.add_argument("--poses", type=int, default=2000, help="evaluations per sweep")
     parser.add_argument("--repeats", type=int, default=5, help="sweeps per row")
+    parser.add_argument("--amplitude", type=float, default=1.0,
+                        help="fraction of each joint's range swept (1: the whole range, Fig. 2.4)")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
     print("| boxes | evaluations/s (best) | evaluations/s (median) | us/evaluation (best) "
           "| pairs inside fields (mean) |")
     print("|---:|---:|---:|---:|---:|")
     for n in args.obstacles:
-        r = MeasureForceEvaluations(n, num_poses=args.poses, repeats=args.repeats, seed=args.seed)
+        r = MeasureForceEvaluations(n, num_poses=args.poses, repeats=args.repeats,
+                                    amplitude=args.amplitude, seed=args.seed)
         print(f"| {n} | {r.best_per_second:,.0f} | {r.median_per_second:,.0f} | "
               f"{1e6 / r.best_per_second:.0f} | {r.mean_pairs_in_fields:.2f} |", flush=True)
 

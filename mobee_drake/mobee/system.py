@@ -290,15 +290,20 @@ class Mobee(LeafSystem):
         """
         f_W = (self._params.collision_gain * (pairs.margin - pairs.distance))[:, None] \
             * pairs.nhat_BA_W
-        frames = self._geometry_frames
-        generalized = 0.0
-        for i, g in enumerate(pairs.geometry_A):
-            generalized = generalized + ProjectPointForces(
-                self._plant, plant_context, frames[g], pairs.p_ACa[i:i + 1], f_W[i:i + 1])
-        for i in np.flatnonzero(pairs.b_is_robot):
-            generalized = generalized + ProjectPointForces(
-                self._plant, plant_context, frames[pairs.geometry_B[i]], pairs.p_BCb[i:i + 1],
-                -f_W[i:i + 1])
+        geometries = pairs.geometry_A
+        if pairs.b_is_robot.any():  # A self-collision pushes both bodies apart.
+            mine = np.flatnonzero(pairs.b_is_robot)
+            geometries = geometries + [pairs.geometry_B[i] for i in mine]
+            p_G = np.vstack((pairs.p_ACa, pairs.p_BCb[mine]))
+            f_W = np.vstack((f_W, -f_W[mine]))
+        else:
+            p_G = pairs.p_ACa
+        rows: dict = {}  # The points on each geometry share one Jacobian.
+        for i, g in enumerate(geometries):
+            rows.setdefault(g, []).append(i)
+        generalized = sum(
+            ProjectPointForces(self._plant, plant_context, self._geometry_frames[g], p_G[r], f_W[r])
+            for g, r in rows.items())
         return generalized[self._v_index]
 
     def _CalcForces(self, context, value) -> None:
