@@ -4,6 +4,54 @@ import argparse
 import sys
 
 
+def _Run(args: list[str]) -> None:
+    """Runs a scenario file and prints its summary."""
+    parser = argparse.ArgumentParser(
+        prog="mobee-drake run",
+        description="Simulate a scenario (diagrams/*.yaml). Headless by default: the run is "
+                    "recorded to results/<scenario>.html unless --record or --no-record says "
+                    "otherwise; --meshcat serves the live view.")
+    parser.add_argument("scenario", help="a scenario file, e.g. diagrams/reach_around_ball.yaml")
+    parser.add_argument("--duration", type=float, help="seconds to simulate (default: the file's)")
+    parser.add_argument("--record", help="save a replayable Meshcat recording to this HTML file")
+    parser.add_argument("--no-record", action="store_true", help="do not save a recording")
+    parser.add_argument("--meshcat", action="store_true",
+                        help="serve the live view in Meshcat and run in real time")
+    parser.add_argument("--no-meshcat", action="store_true",
+                        help="no viewer at all (fastest; implies --no-record)")
+    parser.add_argument("--set", default=None,
+                        help="YAML overrides of the scenario, e.g. '{robot_model: dynamic}'")
+    known = parser.parse_args(args)
+
+    import pathlib
+
+    from mobee_drake.simulation.runner import RunScenario
+    from mobee_drake.simulation.scenario import LoadScenario
+    from mobee_drake.yaml_io import YamlFileError
+
+    try:
+        scenario = LoadScenario(known.scenario, known.set)
+    except (YamlFileError, ValueError) as e:
+        sys.exit(f"error: {e}")
+    if known.duration is not None:
+        scenario.duration = known.duration
+    record = None
+    if not (known.no_record or known.no_meshcat):
+        record = known.record or str(pathlib.Path("results") / (pathlib.Path(known.scenario).stem
+                                                                + ".html"))
+    meshcat = None
+    if known.meshcat and not known.no_meshcat:
+        from pydrake.geometry import StartMeshcat
+
+        meshcat = StartMeshcat()
+    try:
+        summary = RunScenario(scenario, meshcat=meshcat, record=record,
+                              realtime_rate=1.0 if meshcat else 0.0, progress=True)
+    except ValueError as e:
+        sys.exit(f"error: {known.scenario}: {e}")
+    print(summary.Format())
+
+
 def _Bench(args: list[str]) -> None:
     parser = argparse.ArgumentParser(prog="mobee-drake bench")
     parser.add_argument("what", choices=["forces"], help="which benchmark to run")
@@ -47,7 +95,7 @@ def _Info(args: list[str]) -> None:
     print("constraint clauses: " + ", ".join(mobee.clauses.names))
 
 
-COMMANDS = {"bench": _Bench, "info": _Info}
+COMMANDS = {"bench": _Bench, "info": _Info, "run": _Run}
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -1,0 +1,1 @@
+"""Simulating the iCub under MoBeE: scenarios, robots, world, viewer and runner."""

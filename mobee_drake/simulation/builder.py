@@ -1,0 +1,206 @@
+"""Builds the Diagram of a scenario: the iCub, its world, MoBeE, the robot model and the viewer.
+
+Two robots, chosen by ``Scenario.robot_model``:
+
+- **kinematic** (the default, for learning runs): MoBeE's virtual dynamics (eq. 5.7) are the
+  robot. :class:`VirtualDynamics` integrates them every ``time_step`` and its positions pose the
+  robot's geometry through ``MultibodyPositionToGeometryPose``; the plant only supplies
+  kinematics and geometry and is not simulated.
+- **dynamic**: the MultibodyPlant is simulated with ``plant_time_step`` and contact, and follows
+  MoBeE, which sees the plant's measured state, through one of the modalities of ch. 5.2:
+
+  - ``position``: MoBeE's virtual trajectory (q, v integrated by :class:`VirtualDynamics` from the
+    forces at the measured state, as the real iCub's MoBeE sent commands every period) is the
+    desired state of a joint-space inverse-dynamics PD controller (gravity and inertia
+    compensated, as the iCub's position control);
+  - ``velocity``: the same controller tracking the virtual velocity only (no position gain);
+  - ``force``: the robot is torque-controlled so that it accelerates as eq. 5.7 asks: the joint
+    torques are the inverse dynamics of ``q'' = total / M`` (so gravity, inertia and Coriolis
+    forces are compensated and MoBeE's virtual mass is honoured). MoBeE's total is sampled every
+    ``time_step`` and held in between.
+"""
+
+import dataclasses as dc
+
+import numpy as np
+from pydrake.geometry import (
+    Meshcat,
+    MeshcatVisualizer,
+    MeshcatVisualizerParams,
+    Role,
+    SceneGraph,
+)
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
+from pydrake.systems.controllers import (
+    InverseDynamics,
+    InverseDynamicsController,
+)
+from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
+from pydrake.systems.primitives import (
+    ConstantVectorSource,
+    Gain,
+    MatrixGain,
+    SharedPointerSystem,
+    ZeroOrderHold,
+)
+from pydrake.systems.rendering import MultibodyPositionToGeometryPose
+
+from mobee_drake.mobee.system import Mobee
+from mobee_drake.robots.icub import AddIcub
+from mobee_drake.robots.overlay import RobotOverlay
+from mobee_drake.simulation.attractors import RandomAttractorSource
+from mobee_drake.simulation.safety import SafetyMonitor
+from mobee_drake.simulation.scenario import FixedAttractor, Scenario
+from mobee_drake.simulation.virtual_dynamics import VirtualDynamics
+from mobee_drake.simulation.world import LiveWorld
+
+# Gains of the dynamic robot's joint controller, per unit of (mass-normalised) acceleration:
+# critically damped at 20 rad/s, which tracks MoBeE's virtual trajectory (time constants around
+# one second) closely.
+POSITION_GAIN, VELOCITY_GAIN = 400.0, 40.0
+
+
+@dc.dataclass
+class Simulation:
+    """A built scenario and handles to the parts a runner or a test needs."""
+
+    scenario: Scenario
+    diagram: Diagram
+    plant: MultibodyPlant
+    scene_graph: SceneGraph
+    robot: RobotOverlay
+    mobee: Mobee
+    world: LiveWorld
+    monitor: SafetyMonitor
+    # The robot's (q, v) in MoBeE's joint order, whichever robot model runs.
+    robot_state: OutputPort
+    attractor: OutputPort
+    visualizer: MeshcatVisualizer | None = None
+
+
+def _StateToPlant(plant: MultibodyPlant, mobee: Mobee) -> np.ndarray:
+    """Maps (q, v) in MoBeE's joint order to the plant's state vector."""
+    n = len(mobee.joints)
+    S = np.zeros((plant.num_multibody_states(), 2 * n))
+    for i, name in enumerate(mobee.joints):
+        joint = plant.GetJointByName(name)
+        S[joint.position_start(), i] = 1.0
+        S[plant.num_positions() + joint.velocity_start(), n + i] = 1.0
+    return S
+
+
+def _AttractorSource(scenario: Scenario, mobee: Mobee):
+    lower, upper = mobee.position_limits
+    program = scenario.attractor
+    if isinstance(program, FixedAttractor):
+        q_star = mobee.home
+        for name, value in program.joints_deg.items():
+            q_star[mobee.joint_index(name)] = np.radians(value)
+        outside = (q_star < lower) | (q_star > upper)
+        if outside.any():
+            i = np.flatnonzero(outside)[0]
+            raise ValueError(f"attractor for joint '{mobee.joints[i]}' is "
+                             f"{np.degrees(q_star[i]):.6g} deg, outside its limits "
+                             f"[{np.degrees(lower[i]):.6g}, {np.degrees(upper[i]):.6g}] deg")
+        return ConstantVectorSource(q_star)
+    babbling = np.ones(len(mobee.joints), dtype=bool)
+    if program.joints:
+        babbling[:] = False
+        for name in program.joints:
+            babbling[mobee.joint_index(name)] = True
+    return RandomAttractorSource(lower=lower, upper=upper, home=mobee.home, babbling=babbling,
+                                 range_fraction=program.range_fraction, period=program.period,
+                                 seed=scenario.random_seed)
+
+
+def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simulation:
+    """Builds the scenario's diagram; with ``meshcat``, also the viewer."""
+    builder = DiagramBuilder()
+    kinematic = scenario.robot_model == "kinematic"
+    if kinematic:
+        scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
+        plant = MultibodyPlant(0.0)
+        plant.RegisterAsSourceForSceneGraph(scene_graph)
+    else:
+        plant, scene_graph = AddMultibodyPlantSceneGraph(builder, scenario.plant_time_step)
+    robot = AddIcub(plant, scene_graph, scenario.robot)
+    world = LiveWorld(plant, scene_graph)
+    for obj in scenario.objects:
+        world.Register(obj)
+    plant.Finalize()
+
+    joints = scenario.robot.controlled_joints
+    mobee = builder.AddNamedSystem("mobee", Mobee(plant, robot, joints=joints,
+                                                  params=scenario.mobee))
+    builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
+    attractor = builder.AddNamedSystem("attractor", _AttractorSource(scenario, mobee))
+    builder.Connect(attractor.get_output_port(), mobee.GetInputPort("attractor"))
+
+    _, damping, _ = scenario.mobee.PerJoint(joints)
+    virtual = builder.AddNamedSystem("virtual_dynamics", VirtualDynamics(
+        mass=mobee.mass, damping=np.array(damping), period=scenario.time_step,
+        initial_positions=mobee.home))
+    builder.Connect(mobee.GetOutputPort("total"), virtual.GetInputPort("total"))
+    builder.Connect(mobee.GetOutputPort("damping"), virtual.GetInputPort("damping"))
+    to_plant = builder.AddNamedSystem("to_plant_state", MatrixGain(_StateToPlant(plant, mobee)))
+    builder.Connect(virtual.get_output_port(), to_plant.get_input_port())
+
+    if kinematic:
+        # The plant lives as long as the diagram; it is not a system of it.
+        builder.AddNamedSystem("plant_owner", SharedPointerSystem(plant))
+        to_pose = builder.AddNamedSystem(
+            "to_geometry_pose", MultibodyPositionToGeometryPose(plant, input_multibody_state=True))
+        builder.Connect(to_plant.get_output_port(), to_pose.get_input_port())
+        builder.Connect(to_pose.get_output_port(),
+                        scene_graph.get_source_pose_port(plant.get_source_id()))
+        builder.Connect(virtual.get_output_port(), mobee.GetInputPort("state"))
+        robot_state = virtual.get_output_port()
+    else:
+        from_plant = builder.AddNamedSystem(
+            "from_plant_state", MatrixGain(_StateToPlant(plant, mobee).T))
+        builder.Connect(plant.get_state_output_port(), from_plant.get_input_port())
+        builder.Connect(from_plant.get_output_port(), mobee.GetInputPort("state"))
+        robot_state = from_plant.get_output_port()
+        n = plant.num_velocities()
+        if scenario.control == "force":
+            held = builder.AddNamedSystem(
+                "total_hold", ZeroOrderHold(scenario.time_step, len(joints)))
+            builder.Connect(mobee.GetOutputPort("total"), held.get_input_port())
+            # q'' = total / M in MoBeE's order, then to the plant's velocity order.
+            to_acceleration = _StateToPlant(plant, mobee)[plant.num_positions():, len(joints):]
+            acceleration = builder.AddNamedSystem(
+                "acceleration", MatrixGain(to_acceleration @ np.diag(1.0 / mobee.mass)))
+            builder.Connect(held.get_output_port(), acceleration.get_input_port())
+            controller = builder.AddNamedSystem("inverse_dynamics", InverseDynamics(plant))
+            builder.Connect(plant.get_state_output_port(),
+                            controller.get_input_port_estimated_state())
+            builder.Connect(acceleration.get_output_port(),
+                            controller.get_input_port_desired_acceleration())
+        else:
+            kp = np.full(n, POSITION_GAIN if scenario.control == "position" else 0.0)
+            controller = builder.AddNamedSystem("joint_controller", InverseDynamicsController(
+                plant, kp, np.zeros(n), np.full(n, VELOCITY_GAIN), False))
+            builder.Connect(plant.get_state_output_port(),
+                            controller.get_input_port_estimated_state())
+            builder.Connect(to_plant.get_output_port(), controller.get_input_port_desired_state())
+        builder.Connect(controller.get_output_port_generalized_force(),
+                        plant.get_applied_generalized_force_input_port())
+
+    monitor = builder.AddNamedSystem("safety_monitor", SafetyMonitor(
+        names=[obj.name for obj in scenario.objects], period=scenario.time_step))
+    builder.Connect(mobee.GetOutputPort("field_contacts"), monitor.GetInputPort("field_contacts"))
+
+    visualizer = None
+    if meshcat is not None:
+        from mobee_drake.simulation.viewer import AddViewer
+
+        visualizer = AddViewer(builder, scenario=scenario, meshcat=meshcat, plant=plant,
+                               scene_graph=scene_graph, mobee=mobee,
+                               attractor=attractor.get_output_port())
+
+    diagram = builder.Build()
+    diagram.set_name("mobee_simulation")
+    return Simulation(scenario=scenario, diagram=diagram, plant=plant, scene_graph=scene_graph,
+                      robot=robot, mobee=mobee, world=world, monitor=monitor,
+                      robot_state=robot_state, attractor=attractor.get_output_port(),
+                      visualizer=visualizer)

@@ -1,0 +1,99 @@
+"""Runs a scenario: builds it, advances it with a progress bar, applies world events, reports."""
+
+import dataclasses as dc
+import os
+import pathlib
+import time
+
+from pydrake.geometry import Meshcat
+from pydrake.systems.analysis import Simulator
+
+from mobee_drake.simulation.builder import BuildSimulation, Simulation
+from mobee_drake.simulation.safety import SafetyReport
+from mobee_drake.simulation.scenario import Scenario
+
+
+@dc.dataclass
+class RunSummary:
+    simulated_time: float
+    wall_time: float
+    safety: SafetyReport
+    recording: str | None = None
+
+    @property
+    def realtime_factor(self) -> float:
+        return self.simulated_time / self.wall_time if self.wall_time > 0 else float("inf")
+
+    def Format(self) -> str:
+        lines = [f"simulated {self.simulated_time:.2f} s in {self.wall_time:.2f} s "
+                 f"({self.realtime_factor:.1f}x real time)"]
+        lines.append("closest approach of the robot's solids (m; '-' = never inside a field):")
+        for name, distance in self.safety.closest_approach.items():
+            lines.append(f"  {name:20s} {'-' if distance is None else f'{distance:+.4f}'}")
+        lines.append(f"penetrations of solid geometry: {self.safety.penetrating_steps} control "
+                     f"periods, deepest {1000 * self.safety.deepest_penetration:.2f} mm")
+        if self.recording:
+            lines.append(f"recording: {self.recording}")
+        return "\n".join(lines)
+
+
+def _WriteAtomically(path: pathlib.Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    temporary = path.with_suffix(path.suffix + ".tmp")
+    temporary.write_text(text)
+    os.replace(temporary, path)
+
+
+def Advance(simulation: Simulation, simulator: Simulator, until: float, *,
+            progress: bool = False) -> None:
+    """Advances to ``until``, applying the scenario's world events at their times."""
+    context = simulator.get_mutable_context()
+    events = sorted((e for e in simulation.scenario.world_events if e.time >= context.get_time()),
+                    key=lambda e: e.time)
+    steps = max(1, int(round(until / max(simulation.scenario.time_step, until / 500))))
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=round(until - context.get_time(), 3), leave=False,
+                   bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} s simulated "
+                              "[{elapsed}<{remaining}]")
+    for k in range(1, steps + 1):
+        target = until * k / steps
+        while events and events[0].time <= target:
+            event = events.pop(0)
+            simulator.AdvanceTo(event.time)
+            simulation.world.Apply(context, event)
+        before = context.get_time()
+        simulator.AdvanceTo(target)
+        if bar is not None:
+            bar.update(round(context.get_time() - before, 3))
+    if bar is not None:
+        bar.close()
+
+
+def RunScenario(scenario: Scenario, *, meshcat: Meshcat | None = None, record: str | None = None,
+                realtime_rate: float = 0.0, progress: bool = False) -> RunSummary:
+    """Runs ``scenario`` for its duration; with ``record`` saves a Meshcat recording (HTML)."""
+    if record and meshcat is None:
+        meshcat = Meshcat()
+    simulation = BuildSimulation(scenario, meshcat)
+    simulator = Simulator(simulation.diagram)
+    simulator.set_target_realtime_rate(realtime_rate)
+    simulator.Initialize()
+    if record:
+        simulation.visualizer.StartRecording()
+    start = time.perf_counter()
+    Advance(simulation, simulator, scenario.duration, progress=progress)
+    wall = time.perf_counter() - start
+    context = simulator.get_context()
+    recording = None
+    if record:
+        simulation.visualizer.StopRecording()
+        simulation.visualizer.PublishRecording()
+        path = pathlib.Path(record)
+        _WriteAtomically(path, meshcat.StaticHtml())
+        recording = str(path.resolve())
+    report = simulation.monitor.Report(simulation.monitor.GetMyContextFromRoot(context))
+    return RunSummary(simulated_time=context.get_time(), wall_time=wall, safety=report,
+                      recording=recording)

@@ -1,0 +1,169 @@
+"""Scenario files: what to simulate, as typed dataclasses loaded with Drake's YAML loader.
+
+A scenario (``diagrams/*.yaml``) names the robot, the objects of its world, MoBeE's parameters,
+the robot model and control modality, the attractor program, the time step and duration, what
+to show, and the random seed. :func:`LoadScenario` reads one; errors name the file, the key and,
+where YAML gives it, the line.
+"""
+
+import dataclasses as dc
+import pathlib
+
+from mobee_drake.mobee.params import MobeeParams
+from mobee_drake.robots.icub import IcubConfig
+from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
+
+ROBOT_MODELS = ("kinematic", "dynamic")
+CONTROL_MODALITIES = ("position", "velocity", "force")
+OBJECT_ROLES = ("obstacle", "target", "ghost")
+
+
+def _Zeros3() -> list[float]:
+    return [0.0, 0.0, 0.0]
+
+
+@dc.dataclass
+class Box:
+    size: list[float] = dc.field(default_factory=lambda: [0.1, 0.1, 0.1])
+
+
+@dc.dataclass
+class Sphere:
+    radius: float = 0.05
+
+
+@dc.dataclass
+class Cylinder:
+    radius: float = 0.05
+    length: float = 0.1
+
+
+@dc.dataclass
+class SceneObject:
+    """An object of the robot's world (ch. 2.3.2): MoBeE avoids obstacles and ignores the rest."""
+
+    name: str = ""
+    shape: Box | Sphere | Cylinder = dc.field(default_factory=Box)
+    # Pose in world (the iCub's root frame unless the robot is moved): metres, degrees.
+    position: list[float] = dc.field(default_factory=_Zeros3)
+    rpy_deg: list[float] = dc.field(default_factory=_Zeros3)
+    # "obstacle" (solid, repels the robot), "target" (shown, ignored by MoBeE, may be touched) or
+    # "ghost" (shown translucent, ignored).
+    role: str = "obstacle"
+
+
+@dc.dataclass
+class FixedAttractor:
+    """One attractor for the whole run: the home posture with the given joints changed."""
+
+    joints_deg: dict[str, float] = dc.field(default_factory=dict)
+
+
+@dc.dataclass
+class RandomAttractors:
+    """Motor babbling (ch. 4.1.1): a new attractor drawn uniformly inside the joint limits."""
+
+    # Seconds between two attractors.
+    period: float = 5.0
+    # The joints that babble (empty: every controlled joint); the others stay at home.
+    joints: list[str] = dc.field(default_factory=list)
+    # Draw from this fraction of each joint's range, centred in the range (1: the whole range).
+    range_fraction: float = 0.8
+
+
+@dc.dataclass
+class WorldEvent:
+    """A scripted change of the world at a time: move an object or switch its role."""
+
+    time: float = 0.0
+    object: str = ""
+    # New role, or "" to keep it.
+    role: str = ""
+    # New position, or empty to keep it.
+    position: list[float] = dc.field(default_factory=list)
+
+
+@dc.dataclass
+class Visualization:
+    # Show the run in Meshcat (a browser at the printed address).
+    meshcat: bool = True
+    # Save a replayable recording to this HTML file ("" for none).
+    record: str = ""
+    # The marker whose path is drawn as a trail ("" for none).
+    trail_marker: str = "r_palm"
+    # Draw the attractor as a translucent second robot.
+    show_attractor: bool = True
+
+
+@dc.dataclass
+class Scenario:
+    """Everything a run needs (see ``diagrams/`` for examples)."""
+
+    robot: IcubConfig = dc.field(default_factory=IcubConfig)
+    objects: list[SceneObject] = dc.field(default_factory=list)
+    mobee: MobeeParams = dc.field(default_factory=MobeeParams)
+    # "kinematic": MoBeE's virtual dynamics (eq. 5.7) move the robot, no plant dynamics;
+    # "dynamic": the MultibodyPlant is simulated and follows MoBeE through ``control``.
+    robot_model: str = "kinematic"
+    # With the dynamic robot: "position", "velocity" or "force" (ch. 5.2).
+    control: str = "position"
+    # MoBeE's period (s): the kinematic robot's integration step, the dynamic robot's control rate.
+    time_step: float = 0.01
+    # The dynamic robot's plant step (s).
+    plant_time_step: float = 0.001
+    duration: float = 10.0
+    attractor: FixedAttractor | RandomAttractors = dc.field(default_factory=FixedAttractor)
+    world_events: list[WorldEvent] = dc.field(default_factory=list)
+    visualization: Visualization = dc.field(default_factory=Visualization)
+    random_seed: int = 0
+
+
+def _Check(condition: bool, source: str, message: str) -> None:
+    if not condition:
+        raise YamlFileError(f"{source}: {message}")
+
+
+def ValidateScenario(scenario: Scenario, source: str = "scenario") -> None:
+    """Checks the choices and numbers that the schema's types cannot."""
+    _Check(scenario.robot_model in ROBOT_MODELS, source,
+           f"robot_model must be one of {ROBOT_MODELS}, got '{scenario.robot_model}'")
+    _Check(scenario.control in CONTROL_MODALITIES, source,
+           f"control must be one of {CONTROL_MODALITIES}, got '{scenario.control}'")
+    for key in ("time_step", "plant_time_step", "duration"):
+        value = getattr(scenario, key)
+        _Check(value > 0, source, f"{key} must be > 0, got {value}")
+    names = set()
+    for obj in scenario.objects:
+        _Check(bool(obj.name) and obj.name not in names, source,
+               f"every object needs a unique name, got '{obj.name}'")
+        names.add(obj.name)
+        _Check(obj.role in OBJECT_ROLES, source,
+               f"object '{obj.name}': role must be one of {OBJECT_ROLES}, got '{obj.role}'")
+        _Check(len(obj.position) == 3 and len(obj.rpy_deg) == 3, source,
+               f"object '{obj.name}': position and rpy_deg need three numbers")
+    for event in scenario.world_events:
+        _Check(event.object in names, source,
+               f"world event at {event.time} s names unknown object '{event.object}'")
+        _Check(event.role in OBJECT_ROLES + ("",), source,
+               f"world event at {event.time} s: role must be one of {OBJECT_ROLES}, "
+               f"got '{event.role}'")
+        _Check(len(event.position) in (0, 3), source,
+               f"world event at {event.time} s: position needs three numbers")
+    if isinstance(scenario.attractor, RandomAttractors):
+        _Check(scenario.attractor.period > 0, source, "attractor period must be > 0")
+        _Check(0 < scenario.attractor.range_fraction <= 1, source,
+               "attractor range_fraction must be in (0, 1]")
+
+
+def LoadScenario(filename: str | pathlib.Path, overrides: str | None = None) -> Scenario:
+    """Loads a scenario file, then applies ``overrides`` (YAML text with the same keys)."""
+    scenario = LoadYamlFile(schema=Scenario, filename=filename)
+    if overrides:
+        from pydrake.common.yaml import yaml_load_typed
+
+        try:
+            scenario = yaml_load_typed(schema=Scenario, data=overrides, defaults=scenario)
+        except (RuntimeError, ValueError) as e:
+            raise YamlFileError(f"overrides '{overrides}': {e}") from e
+    ValidateScenario(scenario, str(filename))
+    return scenario

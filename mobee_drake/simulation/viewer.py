@@ -1,0 +1,122 @@
+"""Meshcat: the robot and its world, the attractor as a translucent robot, the trail of a marker."""
+
+import re
+
+import numpy as np
+from pydrake.geometry import (
+    Meshcat,
+    MeshcatVisualizer,
+    MeshcatVisualizerParams,
+    Rgba,
+    Role,
+    SceneGraph,
+)
+from pydrake.math import RigidTransform
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem, OutputPort
+from pydrake.systems.primitives import MatrixGain, SharedPointerSystem
+from pydrake.systems.rendering import MultibodyPositionToGeometryPose
+
+from mobee_drake.mobee.system import Mobee
+from mobee_drake.robots.assembly import FreezeJoints
+from mobee_drake.robots.model_cache import PreparedIcubModel
+from mobee_drake.simulation.scenario import Scenario
+
+ATTRACTOR_ALPHA = 0.25
+TRAIL_COLOR = Rgba(0.9, 0.2, 0.2, 1.0)
+
+
+class TrailDrawer(LeafSystem):
+    """Draws the recent path of one marker as a line in Meshcat.
+
+    The last ``capacity`` positions, sampled every ``period``, are kept in the discrete state (a
+    ring buffer and its count); a periodic publish sends them to Meshcat.
+    """
+
+    def __init__(self, *, meshcat: Meshcat, marker_index: int, num_markers: int, period: float,
+                 capacity: int = 600, path: str = "/trail"):
+        super().__init__()
+        self._meshcat, self._path, self._capacity = meshcat, path, capacity
+        self._marker_index = marker_index
+        self._positions_port = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
+        self._state = self.DeclareDiscreteState(BasicVector(np.zeros(3 * capacity + 1)))
+        self.DeclarePeriodicDiscreteUpdateEvent(period_sec=period, offset_sec=0.0,
+                                                update=self._Append)
+        self.DeclarePeriodicPublishEvent(period_sec=period, offset_sec=0.0, publish=self._Draw)
+
+    def _Append(self, context, discrete_state) -> None:
+        x = context.get_discrete_state(self._state).value().copy()
+        count = int(x[-1])
+        i = 3 * self._marker_index
+        p = self._positions_port.Eval(context)[i:i + 3]
+        slot = count % self._capacity
+        x[3 * slot:3 * slot + 3] = p
+        x[-1] = count + 1
+        discrete_state.get_mutable_vector(self._state).SetFromVector(x)
+
+    def _Draw(self, context) -> None:
+        x = context.get_discrete_state(self._state).value()
+        count = int(x[-1])
+        if count < 2:
+            return
+        points = x[:-1].reshape(self._capacity, 3)
+        if count > self._capacity:  # Oldest first.
+            start = count % self._capacity
+            points = np.vstack([points[start:], points[:start]])
+        else:
+            points = points[:count]
+        self._meshcat.SetLine(self._path, points.T, 3.0, TRAIL_COLOR)
+
+
+def _AddAttractorRobot(builder: DiagramBuilder, scenario: Scenario, scene_graph: SceneGraph,
+                       mobee: Mobee, attractor: OutputPort) -> None:
+    """A second, translucent iCub (illustration only) posed at the attractor."""
+    urdf = PreparedIcubModel(scenario.robot.model).read_text()
+    translucent = re.sub(r'rgba="([\d.]+) ([\d.]+) ([\d.]+) [\d.]+"',
+                         rf'rgba="\1 \2 \3 {ATTRACTOR_ALPHA}"', urdf)
+    # A model parsed from a string must name its meshes by URI.
+    translucent = translucent.replace('filename="/', 'filename="file:///')
+    ghost = MultibodyPlant(0.0)
+    ghost.RegisterAsSourceForSceneGraph(scene_graph)
+    parser = Parser(ghost, "attractor")
+    (instance,) = parser.AddModelsFromString(translucent, "urdf")
+    ghost.RenameModelInstance(instance, "attractor")
+    ghost.WeldFrames(ghost.world_frame(), ghost.GetFrameByName("root_link", instance),
+                     RigidTransform())
+    home = {name: np.radians(v) for name, v in scenario.robot.home_deg.items()}
+    FreezeJoints(ghost, instance, keep=mobee.joints, home=home, source="attractor robot")
+    ghost.Finalize()
+    builder.AddNamedSystem("attractor_robot_owner", SharedPointerSystem(ghost))
+    select = np.zeros((ghost.num_positions(), len(mobee.joints)))
+    for i, name in enumerate(mobee.joints):
+        select[ghost.GetJointByName(name).position_start(), i] = 1.0
+    to_ghost = builder.AddNamedSystem("attractor_to_robot", MatrixGain(select))
+    to_pose = builder.AddNamedSystem("attractor_pose", MultibodyPositionToGeometryPose(ghost))
+    builder.Connect(attractor, to_ghost.get_input_port())
+    builder.Connect(to_ghost.get_output_port(), to_pose.get_input_port())
+    builder.Connect(to_pose.get_output_port(),
+                    scene_graph.get_source_pose_port(ghost.get_source_id()))
+
+
+def AddViewer(builder: DiagramBuilder, *, scenario: Scenario, meshcat: Meshcat,
+              plant: MultibodyPlant, scene_graph: SceneGraph, mobee: Mobee,
+              attractor: OutputPort) -> MeshcatVisualizer:
+    """Adds the Meshcat viewer of a scenario; returns the illustration visualizer."""
+    settings = scenario.visualization
+    if settings.show_attractor:
+        _AddAttractorRobot(builder, scenario, scene_graph, mobee, attractor)
+    visualizer = MeshcatVisualizer.AddToBuilder(
+        builder, scene_graph, meshcat, MeshcatVisualizerParams(role=Role.kIllustration,
+                                                               prefix="illustration"))
+    # MoBeE's primitives, hidden by default (toggle "collision" in Meshcat's controls).
+    MeshcatVisualizer.AddToBuilder(
+        builder, scene_graph, meshcat,
+        MeshcatVisualizerParams(role=Role.kProximity, prefix="collision",
+                                default_color=Rgba(0.2, 0.5, 0.9, 0.4), visible_by_default=False))
+    if settings.trail_marker:
+        trail = builder.AddNamedSystem("trail", TrailDrawer(
+            meshcat=meshcat, marker_index=mobee.marker_index(settings.trail_marker),
+            num_markers=len(mobee.marker_names), period=max(scenario.time_step, 0.02)))
+        builder.Connect(mobee.GetOutputPort("marker_positions"), trail.get_input_port())
+    return visualizer
