@@ -36,6 +36,10 @@ class FieldContact:
         """How deep the pair is inside its field (m)."""
         return self.margin - self.distance
 
+    def __deepcopy__(self, memo) -> "FieldContact":
+        # Immutable (and GeometryId cannot be copied): Drake's Value<object> copies share it.
+        return self
+
 
 @dc.dataclass(frozen=True)
 class FieldPairs:
@@ -57,6 +61,10 @@ class FieldPairs:
 
     def __len__(self) -> int:
         return len(self.geometry_A)
+
+    def __deepcopy__(self, memo) -> "FieldPairs":
+        # Never modified after construction (and GeometryId cannot be copied): copies share it.
+        return self
 
 
 # No pair inside any field (shared: FieldPairs are never modified).

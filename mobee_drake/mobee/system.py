@@ -52,6 +52,7 @@ class Mobee(LeafSystem):
         - marker_directions
         - marker_jacobians
         - field_contacts
+        - field_pairs
 
     Inputs (n = number of controlled joints, m = number of markers):
 
@@ -69,7 +70,10 @@ class Mobee(LeafSystem):
     - ``marker_positions`` (3m) and ``marker_directions`` (3m): in world, marker after marker.
     - ``marker_jacobians`` (3mn): the translational Jacobians dp_WM/dq, marker after marker, each
       3 x n in row-major order (reshape with ``(m, 3, n)``).
-    - ``field_contacts``: the list of :class:`~mobee_drake.mobee.fields.FieldContact` pairs inside their fields.
+    - ``field_contacts``: the list of :class:`~mobee_drake.mobee.fields.FieldContact` pairs
+      inside their fields, witness points in world.
+    - ``field_pairs``: the same pairs as arrays (:class:`~mobee_drake.mobee.fields.FieldPairs`,
+      witness points in their geometries' frames): cheaper, for monitors that run every step.
 
     The robot's kinematics are evaluated in a plant context held in a cache entry; the system
     keeps no state of its own.
@@ -173,6 +177,10 @@ class Mobee(LeafSystem):
             prerequisites_of_calc={plant_ticket})
         self.DeclareAbstractOutputPort(
             "field_contacts", lambda: AbstractValue.Make([]), self._CalcFieldContacts,
+            prerequisites_of_calc={self._field_pairs_entry.ticket()})
+        self.DeclareAbstractOutputPort(
+            "field_pairs", lambda: AbstractValue.Make(NO_FIELD_PAIRS),
+            lambda context, output: output.set_value(self._field_pairs_entry.Eval(context)),
             prerequisites_of_calc={self._field_pairs_entry.ticket()})
 
     @staticmethod

@@ -56,8 +56,8 @@ def FreezeJoints(plant: MultibodyPlant, instance: ModelInstanceIndex, *, keep: I
                  home: Mapping[str, float], source: str) -> dict[str, float]:
     """Welds every joint of ``instance`` not named in ``keep`` at its ``home`` angle (radians).
 
-    The kept joints get their ``home`` angle as default position. Must be called before
-    ``plant.Finalize()``.
+    The kept joints get their ``home`` angle as default position and an actuator (if the model
+    has none), for the dynamic robot's controllers. Must be called before ``plant.Finalize()``.
 
     Returns:
         The angle (radians) at which each welded joint was frozen.
@@ -95,6 +95,9 @@ def FreezeJoints(plant: MultibodyPlant, instance: ModelInstanceIndex, *, keep: I
         angle = home.get(name, float(np.clip(0.0, lower, upper)))
         if name in keep:
             joint.set_default_angle(angle)
+            if not any(plant.get_joint_actuator(a).joint().index() == joint.index()
+                       for a in plant.GetJointActuatorIndices(instance)):
+                plant.AddJointActuator(f"{name}_actuator", joint)
             continue
         frame_on_parent, frame_on_child = joint.frame_on_parent(), joint.frame_on_child()
         X_FM = RigidTransform(AngleAxis(angle, joint.revolute_axis()), np.zeros(3))

@@ -72,7 +72,8 @@ class Simulation:
     mobee: Mobee
     world: LiveWorld
     monitor: SafetyMonitor
-    # The robot's (q, v) in MoBeE's joint order, whichever robot model runs.
+    # The diagram's outputs: the robot's (q, v) in MoBeE's joint order, whichever robot model
+    # runs, and MoBeE's attractor.
     robot_state: OutputPort
     attractor: OutputPort
     visualizer: MeshcatVisualizer | None = None
@@ -187,8 +188,9 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simul
                         plant.get_applied_generalized_force_input_port())
 
     monitor = builder.AddNamedSystem("safety_monitor", SafetyMonitor(
-        names=[obj.name for obj in scenario.objects], period=scenario.time_step))
-    builder.Connect(mobee.GetOutputPort("field_contacts"), monitor.GetInputPort("field_contacts"))
+        objects={name: world.geometry_id(name) for name in world.names},
+        period=scenario.time_step))
+    builder.Connect(mobee.GetOutputPort("field_pairs"), monitor.GetInputPort("field_pairs"))
 
     visualizer = None
     if meshcat is not None:
@@ -198,9 +200,11 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simul
                                scene_graph=scene_graph, mobee=mobee,
                                attractor=attractor.get_output_port())
 
+    builder.ExportOutput(robot_state, "robot_state")
+    builder.ExportOutput(attractor.get_output_port(), "attractor")
     diagram = builder.Build()
     diagram.set_name("mobee_simulation")
     return Simulation(scenario=scenario, diagram=diagram, plant=plant, scene_graph=scene_graph,
                       robot=robot, mobee=mobee, world=world, monitor=monitor,
-                      robot_state=robot_state, attractor=attractor.get_output_port(),
-                      visualizer=visualizer)
+                      robot_state=diagram.GetOutputPort("robot_state"),
+                      attractor=diagram.GetOutputPort("attractor"), visualizer=visualizer)

@@ -46,20 +46,23 @@ def _WriteAtomically(path: pathlib.Path, text: str) -> None:
 
 def Advance(simulation: Simulation, simulator: Simulator, until: float, *,
             progress: bool = False) -> None:
-    """Advances to ``until``, applying the scenario's world events at their times."""
+    """Advances to ``until``, applying the scenario's world events whose time is in [now, until).
+    """
     context = simulator.get_mutable_context()
-    events = sorted((e for e in simulation.scenario.world_events if e.time >= context.get_time()),
+    start = context.get_time()
+    events = sorted((e for e in simulation.scenario.world_events if start <= e.time < until),
                     key=lambda e: e.time)
-    steps = max(1, int(round(until / max(simulation.scenario.time_step, until / 500))))
+    # Progress is reported in at most 500 chunks.
+    chunks = max(1, min(500, int(round((until - start) / simulation.scenario.time_step))))
     bar = None
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=round(until - context.get_time(), 3), leave=False,
+        bar = tqdm(total=round(until - start, 3), leave=False,
                    bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} s simulated "
                               "[{elapsed}<{remaining}]")
-    for k in range(1, steps + 1):
-        target = until * k / steps
+    for k in range(1, chunks + 1):
+        target = start + (until - start) * k / chunks
         while events and events[0].time <= target:
             event = events.pop(0)
             simulator.AdvanceTo(event.time)

@@ -1,0 +1,332 @@
+"""Scenarios, the kinematic and dynamic robots, the live world, the viewer and the runner."""
+
+import pathlib
+import tempfile
+import unittest
+
+import numpy as np
+from pydrake.systems.analysis import Simulator
+
+from mobee_drake import cli
+from mobee_drake.mobee.fields import FieldPairs
+from mobee_drake.simulation.attractors import RandomAttractorSource
+from mobee_drake.simulation.builder import BuildSimulation
+from mobee_drake.simulation.runner import Advance, RunScenario
+from mobee_drake.simulation.safety import SafetyMonitor
+from mobee_drake.simulation.scenario import LoadScenario, SceneObject, Sphere
+from mobee_drake.simulation.virtual_dynamics import VirtualDynamics
+from mobee_drake.yaml_io import YamlFileError
+
+DIAGRAMS = pathlib.Path(__file__).resolve().parents[1] / "diagrams"
+REACH = DIAGRAMS / "reach_around_ball.yaml"
+
+
+def _Palm(simulation, context):
+    mobee = simulation.mobee
+    i = mobee.marker_index("r_palm")
+    return mobee.GetOutputPort("marker_positions").Eval(
+        mobee.GetMyContextFromRoot(context))[3 * i:3 * i + 3].copy()
+
+
+def _Trajectory(scenario, times):
+    simulation = BuildSimulation(scenario)
+    simulator = Simulator(simulation.diagram)
+    simulator.Initialize()
+    palms, states = [], []
+    for t in times:
+        simulator.AdvanceTo(t)
+        context = simulator.get_context()
+        palms.append(_Palm(simulation, context))
+        states.append(simulation.robot_state.Eval(context).copy())
+    return simulation, simulator, np.array(palms), np.array(states)
+
+
+class TestScenarioFiles(unittest.TestCase):
+    def test_shipped_scenarios_load(self):
+        for path in sorted(DIAGRAMS.glob("*.yaml")):
+            scenario = LoadScenario(path)
+            self.assertGreater(scenario.duration, 0, path)
+
+    def _Write(self, text):
+        path = pathlib.Path(tempfile.mkdtemp()) / "scenario.yaml"
+        path.write_text(text)
+        return path
+
+    def test_unknown_key_names_file_and_line(self):
+        path = self._Write("robot_model: kinematic\nduraton: 3\n")
+        with self.assertRaisesRegex(YamlFileError, f"{path}:2: .*'duraton'"):
+            LoadScenario(path)
+
+    def test_wrong_type_and_bad_choice(self):
+        path = self._Write("duration: long\n")
+        with self.assertRaisesRegex(YamlFileError, f"{path}:1: .*'long'"):
+            LoadScenario(path)
+        path = self._Write("robot_model: quantum\n")
+        with self.assertRaisesRegex(YamlFileError, "robot_model must be one of .* 'quantum'"):
+            LoadScenario(path)
+
+    def test_missing_file(self):
+        with self.assertRaisesRegex(YamlFileError, "nowhere.yaml: no such file"):
+            LoadScenario("nowhere.yaml")
+
+    def test_unknown_model_joint_and_object(self):
+        path = self._Write("robot: {model: iCubMars}\n")
+        with self.assertRaisesRegex(ValueError, "unknown iCub model 'iCubMars'"):
+            BuildSimulation(LoadScenario(path))
+        path = self._Write("attractor: !FixedAttractor {joints_deg: {r_knee: 10}}\n")
+        with self.assertRaisesRegex(ValueError, "unknown joint 'r_knee'"):
+            BuildSimulation(LoadScenario(path))
+        path = self._Write("objects: [{name: a}]\nworld_events: [{time: 1, object: b}]\n")
+        with self.assertRaisesRegex(YamlFileError, "unknown object 'b'"):
+            LoadScenario(path)
+
+    def test_overrides(self):
+        scenario = LoadScenario(REACH, "{robot_model: dynamic, control: force}")
+        self.assertEqual((scenario.robot_model, scenario.control), ("dynamic", "force"))
+        with self.assertRaisesRegex(YamlFileError, "overrides"):
+            LoadScenario(REACH, "{robot_mdl: dynamic}")
+
+
+class TestVirtualDynamics(unittest.TestCase):
+    def test_one_step_is_semi_implicit_euler_with_implicit_damping(self):
+        mass, damping, h = np.array([2.0, 1.0]), np.array([10.0, 0.0]), 0.02
+        q0 = np.array([0.1, -0.2])
+        dut = VirtualDynamics(mass=mass, damping=damping, period=h, initial_positions=q0)
+        context = dut.CreateDefaultContext()
+        v0 = np.array([0.5, 1.0])
+        context.SetDiscreteState(np.concatenate([q0, v0]))
+        total, damping_term = np.array([3.0, -4.0]), np.array([-1.0, 0.0])
+        dut.GetInputPort("total").FixValue(context, total)
+        dut.GetInputPort("damping").FixValue(context, damping_term)
+        state = dut.EvalUniquePeriodicDiscreteUpdate(context).get_vector().value()
+        v1 = (v0 + h * (total - damping_term) / mass) / (1 + h * damping / mass)
+        np.testing.assert_allclose(state, np.concatenate([q0 + h * v1, v1]))
+
+    def test_spring_and_damper_settle_at_the_attractor(self):
+        # M q'' = -K (q - 1) - C q' with K = 50, C = 50: overdamped, its slow pole at -1.02/s,
+        # so after 30 s it is at q = 1 to within e^-30.
+        h, K, C = 0.02, 50.0, 50.0
+        dut = VirtualDynamics(mass=np.ones(1), damping=np.array([C]), period=h,
+                              initial_positions=np.zeros(1))
+        context = dut.CreateDefaultContext()
+        for _ in range(1500):
+            q, v = context.get_discrete_state_vector().value()
+            dut.GetInputPort("total").FixValue(context, [-K * (q - 1.0) - C * v])
+            dut.GetInputPort("damping").FixValue(context, [-C * v])
+            context.SetDiscreteState(dut.EvalUniquePeriodicDiscreteUpdate(context).value())
+        np.testing.assert_allclose(context.get_discrete_state_vector().value(), [1.0, 0.0],
+                                   atol=1e-6)
+
+
+class TestRandomAttractors(unittest.TestCase):
+    def test_reproducible_in_range_and_home_elsewhere(self):
+        lower, upper, home = np.array([-1.0, 0.0, 2.0]), np.array([1.0, 2.0, 4.0]), np.zeros(3)
+        kwargs = dict(lower=lower, upper=upper, home=home, babbling=[True, True, False],
+                      range_fraction=0.5, period=2.0, seed=7)
+        draws = []
+        for _ in range(2):
+            dut = RandomAttractorSource(**kwargs)
+            context = dut.CreateDefaultContext()
+            sequence = [dut.get_output_port().Eval(context).copy()]
+            for k in range(1, 50):
+                context.SetTime(2.0 * k)
+                context.SetDiscreteState(dut.EvalUniquePeriodicDiscreteUpdate(context).value())
+                sequence.append(dut.get_output_port().Eval(context).copy())
+            draws.append(np.array(sequence))
+        np.testing.assert_array_equal(draws[0], draws[1])
+        self.assertTrue(np.all(draws[0][:, 0] >= -0.5) and np.all(draws[0][:, 0] <= 0.5))
+        self.assertTrue(np.all(draws[0][:, 1] >= 0.5) and np.all(draws[0][:, 1] <= 1.5))
+        np.testing.assert_array_equal(draws[0][:, 2], 0.0)
+        self.assertGreater(len(np.unique(draws[0][:, 0])), 45)
+
+
+class TestSafetyMonitor(unittest.TestCase):
+    def test_keeps_closest_approach_and_penetrations(self):
+        from pydrake.geometry import GeometryId
+
+        ball, table, arm = (GeometryId.get_new_id() for _ in range(3))
+        dut = SafetyMonitor(objects={"ball": ball, "table": table}, period=0.01)
+        context = dut.CreateDefaultContext()
+
+        def Step(ids, distances):
+            k = len(ids)
+            pairs = FieldPairs([arm] * k, list(ids), np.array(distances), np.full(k, 0.03),
+                               np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)),
+                               np.array([i not in (ball, table) for i in ids]))
+            dut.GetInputPort("field_pairs").FixValue(context, pairs)
+            context.SetDiscreteState(dut.EvalUniquePeriodicDiscreteUpdate(context).value())
+
+        Step([ball], [0.02])
+        Step([ball, arm], [0.01, -0.002])
+        Step([ball], [0.015])
+        report = dut.Report(context)
+        self.assertEqual(report.closest_approach, {"ball": 0.01, "table": None, "(self)": -0.002})
+        self.assertEqual(report.penetrating_steps, 1)
+        self.assertAlmostEqual(report.deepest_penetration, 0.002)
+
+
+class TestKinematicRobot(unittest.TestCase):
+    def test_reach_bends_around_the_ball(self):
+        scenario = LoadScenario(REACH)
+        times = np.arange(0.5, scenario.duration + 1e-9, 0.5)
+        simulation, simulator, palms, _ = _Trajectory(scenario, times)
+        ball = next(o for o in scenario.objects if o.name == "ball")
+        center, radius = np.array(ball.position), ball.shape.radius
+        report = simulation.monitor.Report(
+            simulation.monitor.GetMyContextFromRoot(simulator.get_context()))
+        self.assertEqual(report.penetrating_steps, 0)
+        self.assertGreater(report.closest_approach["ball"], 0.0)
+        # The palm went past the ball (from y = 0.14 to the other side of its centre) ...
+        self.assertLess(palms[-1, 1], center[1])
+        # ... over it, never closer to its centre than its radius.
+        self.assertGreater(palms[:, 2].max(), center[2] + radius)
+        self.assertGreater(np.linalg.norm(palms - center, axis=1).min(), radius)
+
+        # Without the ball, the same attractor would have driven the hand into it: replay the
+        # free motion in the world with the ball and look at the hand's distance to it.
+        scenario.objects = [o for o in scenario.objects if o.name != "ball"]
+        _, _, _, free = _Trajectory(scenario, np.arange(0.1, scenario.duration, 0.1))
+        virtual = simulation.diagram.GetSubsystemByName("virtual_dynamics")
+        context = simulator.get_mutable_context()
+        mobee_context = simulation.mobee.GetMyContextFromRoot(context)
+        distances = []
+        for x in free:
+            virtual.GetMyMutableContextFromRoot(context).SetDiscreteState(x)
+            contacts = simulation.mobee.GetOutputPort("field_contacts").Eval(mobee_context)
+            distances += [c.distance for c in contacts if c.name_B == "ball"]
+        self.assertLess(min(distances), -0.01)
+
+    def test_settles_at_the_attractor_in_free_space(self):
+        scenario = LoadScenario(REACH, "{objects: [], duration: 12}")
+        simulation, simulator, _, states = _Trajectory(scenario, [12.0])
+        q_star = simulation.attractor.Eval(simulator.get_context())
+        n = len(q_star)
+        np.testing.assert_allclose(states[-1][:n], q_star, atol=2e-3)
+        np.testing.assert_allclose(states[-1][n:], 0.0, atol=1e-2)
+
+
+class TestDynamicRobot(unittest.TestCase):
+    """Each modality follows MoBeE: after 3 s of the reach, within a few degrees of the
+    kinematic robot, and without penetrating the ball."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.times = [1.0, 3.0]
+        _, _, cls.kinematic_palms, cls.kinematic = _Trajectory(LoadScenario(REACH), cls.times)
+
+    def _Check(self, control, tolerance_deg):
+        scenario = LoadScenario(REACH, f"{{robot_model: dynamic, control: {control}}}")
+        simulation, simulator, palms, states = _Trajectory(scenario, self.times)
+        n = states.shape[1] // 2
+        error = np.degrees(np.abs(states[:, :n] - self.kinematic[:, :n])).max()
+        self.assertLess(error, tolerance_deg, control)
+        report = simulation.monitor.Report(
+            simulation.monitor.GetMyContextFromRoot(simulator.get_context()))
+        self.assertEqual(report.penetrating_steps, 0, control)
+        np.testing.assert_allclose(palms, self.kinematic_palms, atol=0.01)
+
+    def test_position(self):
+        self._Check("position", 2.0)
+
+    def test_velocity(self):
+        self._Check("velocity", 3.0)
+
+    def test_force(self):
+        self._Check("force", 2.0)
+
+
+class TestLiveWorld(unittest.TestCase):
+    def test_roles_moves_additions_and_removals(self):
+        scenario = LoadScenario(REACH, "{duration: 2}")
+        simulation = BuildSimulation(scenario)
+        simulator = Simulator(simulation.diagram)
+        simulator.Initialize()
+        context = simulator.get_mutable_context()
+        mobee_context = simulation.mobee.GetMyContextFromRoot(context)
+        world = simulation.world
+
+        def Touching():
+            contacts = simulation.mobee.GetOutputPort("field_contacts").Eval(mobee_context)
+            return {c.name_B for c in contacts}
+
+        simulator.AdvanceTo(1.0)
+        self.assertIn("ball", Touching())
+        world.SetRole(context, "ball", "ghost")
+        self.assertEqual(world.role("ball"), "ghost")
+        self.assertNotIn("ball", Touching())
+        world.SetRole(context, "ball", "target")
+        self.assertNotIn("ball", Touching())
+        world.SetRole(context, "ball", "obstacle")
+        self.assertIn("ball", Touching())
+        world.Move(context, "ball", [-0.6, 0.0, 0.3])
+        self.assertNotIn("ball", Touching())
+        palm = _Palm(simulation, context)
+        world.Add(context, SceneObject(name="cube", shape=Sphere(radius=0.02),
+                                       position=list(palm + [-0.05, 0, 0]), role="obstacle"))
+        self.assertIn("cube", Touching())
+        simulator.AdvanceTo(1.5)  # The simulation goes on with the new object ...
+        self.assertGreater(np.linalg.norm(_Palm(simulation, context) - palm), 0.0)
+        world.Remove(context, "cube")
+        self.assertNotIn("cube", Touching())
+        with self.assertRaisesRegex(ValueError, "unknown world object 'cube'"):
+            world.Remove(context, "cube")
+        with self.assertRaisesRegex(ValueError, "unknown role 'wall'"):
+            world.SetRole(context, "ball", "wall")
+
+    def test_scenario_events(self):
+        scenario = LoadScenario(
+            REACH, "{duration: 3, world_events: [{time: 0.1, object: ball, role: ghost}]}")
+        simulation = BuildSimulation(scenario)
+        simulator = Simulator(simulation.diagram)
+        simulator.Initialize()
+        Advance(simulation, simulator, 0.05)
+        self.assertEqual(simulation.world.role("ball"), "obstacle")
+        Advance(simulation, simulator, 3.0)
+        self.assertEqual(simulation.world.role("ball"), "ghost")
+        # The hand was still outside the ball's field at 0.1 s; from then on MoBeE ignores the
+        # ball, so the motion is exactly the one without it.
+        report = simulation.monitor.Report(
+            simulation.monitor.GetMyContextFromRoot(simulator.get_context()))
+        self.assertIsNone(report.closest_approach["ball"])
+        scenario.objects = [o for o in scenario.objects if o.name != "ball"]
+        scenario.world_events = []
+        _, _, free, _ = _Trajectory(scenario, [3.0])
+        np.testing.assert_allclose(_Palm(simulation, simulator.get_context()), free[0], atol=1e-12)
+
+
+class TestRunner(unittest.TestCase):
+    def test_recording_and_summary(self):
+        from pydrake.geometry import Meshcat
+
+        path = pathlib.Path(tempfile.mkdtemp()) / "run.html"
+        meshcat = Meshcat()
+        summary = RunScenario(LoadScenario(REACH, "{duration: 1}"), meshcat=meshcat,
+                              record=str(path))
+        self.assertEqual(summary.recording, str(path.resolve()))
+        text = path.read_text()
+        self.assertTrue(text.startswith("<!DOCTYPE html>"))
+        self.assertGreater(len(text), 1_000_000)  # the meshes and the animation are embedded
+        # The robot, the translucent attractor robot, the ball, the trail.
+        for scene_path in ("/drake/illustration/icub_iCubGazeboV2_5",
+                           "/drake/illustration/attractor", "/drake/illustration/ball",
+                           "/trail"):
+            self.assertTrue(meshcat.HasPath(scene_path), scene_path)
+        self.assertAlmostEqual(summary.simulated_time, 1.0)
+        self.assertIn("penetrations of solid geometry: 0", summary.Format())
+
+    def test_cli_run(self):
+        import contextlib
+        import io
+
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            cli.main(["run", str(REACH), "--duration", "0.5", "--no-meshcat"])
+        self.assertIn("simulated 0.50 s", out.getvalue())
+        self.assertIn("ball", out.getvalue())
+        with self.assertRaises(SystemExit) as raised:
+            cli.main(["run", str(DIAGRAMS / "missing.yaml"), "--no-meshcat"])
+        self.assertIn("no such file", str(raised.exception))
+
+
+if __name__ == "__main__":
+    unittest.main()
