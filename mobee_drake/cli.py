@@ -54,12 +54,13 @@ def _Run(args: list[str]) -> None:
 
 def _Bench(args: list[str]) -> None:
     parser = argparse.ArgumentParser(prog="mobee-drake bench")
-    parser.add_argument("what", choices=["forces"], help="which benchmark to run")
+    parser.add_argument("what", choices=["forces", "simulation"], help="which benchmark to run")
     known, rest = parser.parse_known_args(args)
     if known.what == "forces":
         from mobee_drake.bench.forces import main
-
-        main(rest)
+    else:
+        from mobee_drake.bench.simulation import main
+    main(rest)
 
 
 def _Info(args: list[str]) -> None:

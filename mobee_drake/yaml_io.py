@@ -1,9 +1,10 @@
-"""Loads YAML files into typed dataclasses with Drake's loader, with errors that name the file and line.
+"""Loads YAML files into typed dataclasses with Drake's loader; errors name the file and line.
 
 Drake's ``yaml_load_typed`` reports *what* is wrong ("The fields ['shap'] were unknown to the
 schema", "could not convert string to float: 'x'") but not *where*. Every file this package reads
-goes through :func:`LoadYamlFile`, which re-raises such errors as :class:`YamlFileError` carrying the
-file name and, when the offending key or value can be found in the text, its line number.
+goes through :func:`LoadYamlFile`, which re-raises such errors as :class:`YamlFileError`
+carrying the file name and, when the offending key or value can be found in the text, its
+line number.
 """
 
 import pathlib
@@ -18,7 +19,7 @@ class YamlFileError(ValueError):
 
 
 def LineOf(text: str, names: list[str]) -> int | None:
-    """Returns the 1-based line of the first mapping key or scalar of ``text`` that is in ``names``."""
+    """The 1-based line of the first mapping key or scalar of ``text`` that is in ``names``."""
     quoted = set(names)
     if not quoted:
         return None

@@ -33,8 +33,9 @@ class TestBadCommands(unittest.TestCase):
 
     def test_attractor_outside_the_joint_limits(self):
         self._Fix("attractor", [0.0, 0.0, 3.5])
-        with self.assertRaisesRegex(ValueError, r"attractor for joint 'joint3' is 200\.5\d* deg, "
-                                                r"outside its limits \[-171\.8\d*, 171\.8\d*\] deg"):
+        with self.assertRaisesRegex(
+                ValueError, r"attractor for joint 'joint3' is 200\.5\d* deg, "
+                            r"outside its limits \[-171\.8\d*, 171\.8\d*\] deg"):
             self.arm.Out("total")
 
     def test_non_finite_forces(self):
@@ -128,7 +129,8 @@ class TestBadOverlays(unittest.TestCase):
             LoadOverlay("/nowhere.yaml")
 
     def test_bad_values_name_the_element_and_line(self):
-        path = self._Load(self.GOOD.replace("end: [0.6, 0, 0], radius: 0.03", "end: [0.6, 0, 0], radius: -0.03"))
+        path = self._Load(self.GOOD.replace("end: [0.6, 0, 0], radius: 0.03",
+                                            "end: [0.6, 0, 0], radius: -0.03"))
         line = next(i for i, text in enumerate(self.GOOD.splitlines(), 1) if "name: link2" in text)
         with self.assertRaisesRegex(ValueError, f"{path}:{line}: 'link2': radius must be > 0, "
                                                 "got -0.03"):

@@ -44,7 +44,8 @@ class TestClauses(unittest.TestCase):
         q = np.radians([-14.0, 0.0, 0.0])
         g = np.radians(-14.0 + 10.0) / np.sqrt(2)
         f = ClauseSet([Clause("x", [literal])], JOINTS).Force(q, DELTA, F_MAX)
-        np.testing.assert_allclose(f, F_MAX * (DELTA - g) / DELTA * np.array([1, -1, 0]) / np.sqrt(2))
+        normal = np.array([1, -1, 0]) / np.sqrt(2)
+        np.testing.assert_allclose(f, F_MAX * (DELTA - g) / DELTA * normal)
 
     def test_example_1_conjunction_of_literals(self):
         # f1 <-> 0  AND  f2 <-> 0  AND  f3 <-> 0: each literal acts on its own.

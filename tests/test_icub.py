@@ -1,4 +1,4 @@
-"""The iCub from icub-models with MoBeE's overlay: joints, limits, geometry, markers, constraints."""
+"""The iCub from icub-models with MoBeE's overlay: joints, limits, geometry, markers, clauses."""
 
 import unittest
 
@@ -63,8 +63,8 @@ class TestIcubModel(unittest.TestCase):
         self.assertEqual(self.icub.dut.joints, list(UPPER_BODY_JOINTS))
         for name, (lower, upper) in EXPECTED_LIMITS_DEG.items():
             joint = plant.GetJointByName(name)
-            np.testing.assert_allclose(np.degrees(joint.position_lower_limits()), [lower], atol=0.05)
-            np.testing.assert_allclose(np.degrees(joint.position_upper_limits()), [upper], atol=0.05)
+            limits = [joint.position_lower_limits()[0], joint.position_upper_limits()[0]]
+            np.testing.assert_allclose(np.degrees(limits), [lower, upper], atol=0.05)
         # The legs are welded (the iCub on its pole).
         self.assertFalse(plant.HasJointNamed("r_knee"))
         # The root is welded to the world.
@@ -159,7 +159,8 @@ class TestIcubForces(unittest.TestCase):
         self.assertLess(f[prosup], 0)
         self.assertEqual(np.count_nonzero(f), 2)
         # Either literal clear of its band keeps the clause off.
-        for angles in ({"r_elbow": 95, "r_wrist_prosup": 20}, {"r_elbow": 70, "r_wrist_prosup": 50}):
+        for angles in ({"r_elbow": 95, "r_wrist_prosup": 20},
+                       {"r_elbow": 70, "r_wrist_prosup": 50}):
             icub.SetDegrees(**angles)
             np.testing.assert_array_equal(icub.Out("f_cst"), 0.0)
 

@@ -2,7 +2,7 @@
 
 import unittest
 
-from arm_diagram import JOINTS, ArmDiagram
+from arm_diagram import ArmDiagram
 import numpy as np
 
 from mobee_drake.mobee.params import MobeeParams, SquashParams
@@ -61,7 +61,8 @@ class TestConfigurationSpaceTerms(unittest.TestCase):
         np.testing.assert_allclose(arm.Out("f_lim"),
                                    [-params.limit_force * (delta - np.radians(5)) / delta, 0, 0])
         g = np.radians(5) / np.sqrt(2)
-        magnitude = params.constraint_force * (params.constraint_delta - g) / params.constraint_delta
+        delta = params.constraint_delta
+        magnitude = params.constraint_force * (delta - g) / delta
         np.testing.assert_allclose(arm.Out("f_cst"), magnitude * np.array([0, -1, -1]) / np.sqrt(2))
 
 
@@ -71,7 +72,8 @@ class TestWorkspaceForces(unittest.TestCase):
         q = np.array([0.3, -0.7, 1.1])
         arm.Set(q)
         f_tip, f_elbow = np.array([1.0, -2.0, 0.5]), np.array([-0.5, 0.0, 0.0])
-        arm.dut.GetInputPort("marker_forces").FixValue(arm.context, np.concatenate([f_tip, f_elbow]))
+        arm.dut.GetInputPort("marker_forces").FixValue(arm.context,
+                                                       np.concatenate([f_tip, f_elbow]))
         p = arm.Out("marker_positions").reshape(2, 3)
         J_tip, J_elbow = arm.Jacobian("link3", p[0]), arm.Jacobian("link2", p[1])
         expected = Squash(J_tip.T @ f_tip + J_elbow.T @ f_elbow, 1e6, 1.0)
@@ -112,8 +114,8 @@ class TestCollisionForce(unittest.TestCase):
 
     The arm lies along +x; link3's capsule (radius 0.03) ends at x = 0.9. A box whose bottom face is
     at height 0.03 + d and which starts at x = 0.9 is nearest to the capsule at the unique witness
-    point (0.9, 0.03, 0): the force on the arm is gain (margin - d) along -y, whose torques about the
-    three joints are -0.9 F, -0.6 F and -0.3 F.
+    point (0.9, 0.03, 0): the force on the arm is gain (margin - d) along -y, whose torques about
+    the three joints are -0.9 F, -0.6 F and -0.3 F.
     """
 
     def _Arm(self, d, params):
@@ -132,8 +134,8 @@ class TestCollisionForce(unittest.TestCase):
         np.testing.assert_allclose(contact.p_WCa, [0.9, 0.03, 0.0], atol=1e-3)
         np.testing.assert_allclose(contact.nhat_BA_W, [0, -1, 0], atol=1e-2)
         F = 1e3 * (0.05 - d)
-        np.testing.assert_allclose(arm.Out("f_coll"), Squash(-F * np.array([0.9, 0.6, 0.3]), 1e6, 1.0),
-                                   rtol=1e-4)
+        np.testing.assert_allclose(arm.Out("f_coll"),
+                                   Squash(-F * np.array([0.9, 0.6, 0.3]), 1e6, 1.0), rtol=1e-4)
 
     def test_grows_with_penetration_and_vanishes_outside_the_field(self):
         params = MobeeParams()
@@ -155,7 +157,8 @@ class TestCollisionForce(unittest.TestCase):
         # Folded: link3 comes back near link1 (non-adjacent links, so not filtered), 2.7 cm apart.
         q = np.array([0.0, np.radians(100), np.radians(124)])
         arm.Set(q)
-        contacts = [c for c in arm.Out("field_contacts") if {c.name_A, c.name_B} == {"link1", "link3"}]
+        contacts = [c for c in arm.Out("field_contacts")
+                    if {c.name_A, c.name_B} == {"link1", "link3"}]
         self.assertEqual(len(contacts), 1)
         (c,) = contacts
         f_W = 1e3 * c.penetration * c.nhat_BA_W

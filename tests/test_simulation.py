@@ -142,25 +142,34 @@ class TestRandomAttractors(unittest.TestCase):
 
 class TestSafetyMonitor(unittest.TestCase):
     def test_keeps_closest_approach_and_penetrations(self):
-        from pydrake.geometry import GeometryId
+        from pydrake.geometry import GeometryInstance, SceneGraph, Sphere as DrakeSphere
+        from pydrake.math import RigidTransform
 
-        ball, table, arm = (GeometryId.get_new_id() for _ in range(3))
-        dut = SafetyMonitor(objects={"ball": ball, "table": table}, period=0.01)
+        scene_graph = SceneGraph()
+        source = scene_graph.RegisterSource("test")
+        ball, table, thing, arm, chest = (
+            scene_graph.RegisterAnchoredGeometry(
+                source, GeometryInstance(RigidTransform(), DrakeSphere(0.1), name))
+            for name in ("ball", "table", "thing", "arm", "chest"))
+        query = scene_graph.get_query_output_port().Eval(scene_graph.CreateDefaultContext())
+        dut = SafetyMonitor(names=["ball", "table"], period=0.01)
         context = dut.CreateDefaultContext()
+        dut.GetInputPort("geometry_query").FixValue(context, query)
 
         def Step(ids, distances):
             k = len(ids)
             pairs = FieldPairs([arm] * k, list(ids), np.array(distances), np.full(k, 0.03),
                                np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)),
-                               np.array([i not in (ball, table) for i in ids]))
+                               np.array([i == chest for i in ids]))
             dut.GetInputPort("field_pairs").FixValue(context, pairs)
             context.SetDiscreteState(dut.EvalUniquePeriodicDiscreteUpdate(context).value())
 
         Step([ball], [0.02])
-        Step([ball, arm], [0.01, -0.002])
+        Step([ball, chest, thing], [0.01, -0.002, 0.025])
         Step([ball], [0.015])
         report = dut.Report(context)
-        self.assertEqual(report.closest_approach, {"ball": 0.01, "table": None, "(self)": -0.002})
+        self.assertEqual(report.closest_approach, {"ball": 0.01, "table": None, "(self)": -0.002,
+                                                   "(other objects)": 0.025})
         self.assertEqual(report.penetrating_steps, 1)
         self.assertAlmostEqual(report.deepest_penetration, 0.002)
 
@@ -258,8 +267,13 @@ class TestLiveWorld(unittest.TestCase):
         self.assertNotIn("ball", Touching())
         world.SetRole(context, "ball", "obstacle")
         self.assertIn("ball", Touching())
+        palm = _Palm(simulation, context)
         world.Move(context, "ball", [-0.6, 0.0, 0.3])
         self.assertNotIn("ball", Touching())
+        world.Move(context, "ball", palm)  # Right on the palm: deep inside the hand's field.
+        self.assertIn("ball", Touching())
+        self.assertEqual(world.role("ball"), "obstacle")
+        world.Move(context, "ball", [-0.6, 0.0, 0.3])
         palm = _Palm(simulation, context)
         world.Add(context, SceneObject(name="cube", shape=Sphere(radius=0.02),
                                        position=list(palm + [-0.05, 0, 0]), role="obstacle"))
@@ -268,6 +282,9 @@ class TestLiveWorld(unittest.TestCase):
         self.assertGreater(np.linalg.norm(_Palm(simulation, context) - palm), 0.0)
         world.Remove(context, "cube")
         self.assertNotIn("cube", Touching())
+        simulator.AdvanceTo(2.0)
+        report = simulation.monitor.Report(simulation.monitor.GetMyContextFromRoot(context))
+        self.assertIsNotNone(report.closest_approach["(other objects)"])  # the cube
         with self.assertRaisesRegex(ValueError, "unknown world object 'cube'"):
             world.Remove(context, "cube")
         with self.assertRaisesRegex(ValueError, "unknown role 'wall'"):
@@ -292,6 +309,38 @@ class TestLiveWorld(unittest.TestCase):
         scenario.world_events = []
         _, _, free, _ = _Trajectory(scenario, [3.0])
         np.testing.assert_allclose(_Palm(simulation, simulator.get_context()), free[0], atol=1e-12)
+
+
+class TestInteractive(unittest.TestCase):
+    def test_sliders_move_the_attractor(self):
+        from pydrake.geometry import Meshcat
+
+        scenario = LoadScenario(DIAGRAMS / "interactive.yaml")
+        with self.assertRaisesRegex(ValueError, "slider attractor needs Meshcat"):
+            BuildSimulation(scenario)
+        meshcat = Meshcat()
+        simulation = BuildSimulation(scenario, meshcat)
+        simulator = Simulator(simulation.diagram)
+        simulator.Initialize()
+        context = simulator.get_context()
+        np.testing.assert_allclose(simulation.attractor.Eval(context), simulation.mobee.home)
+        meshcat.SetSliderValue("r_elbow", 70.0)  # degrees
+        simulator.AdvanceTo(0.1)  # The sliders are sampled every 50 ms.
+        q_star = simulation.attractor.Eval(context)
+        self.assertAlmostEqual(q_star[simulation.mobee.joint_index("r_elbow")], np.radians(70))
+        # MoBeE's field forces are drawn while the hand is near the ball: put it 1 cm off the palm.
+        mobee, mobee_context = simulation.mobee, simulation.mobee.GetMyContextFromRoot(context)
+        i = mobee.marker_index("r_palm")
+        normal = mobee.GetOutputPort("marker_directions").Eval(mobee_context)[3 * i:3 * i + 3]
+        ball = _Palm(simulation, context) + 0.05 * normal
+        simulation.world.Move(simulator.get_mutable_context(), "ball", ball)
+        simulation.diagram.ForcedPublish(context)
+        self.assertTrue(meshcat.HasPath("/field_forces"))
+        # Without the ball nothing is inside a field, and no force is drawn.
+        simulation.world.Remove(simulator.get_mutable_context(), "ball")
+        simulation.world.Remove(simulator.get_mutable_context(), "table")
+        simulation.diagram.ForcedPublish(context)
+        self.assertFalse(meshcat.HasPath("/field_forces"))
 
 
 class TestRunner(unittest.TestCase):

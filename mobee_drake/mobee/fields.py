@@ -6,8 +6,8 @@ geometries' margins (an obstacle has none): the field of either one reaches the 
 The field penetration ``margin - distance`` drives MoBeE's collision force.
 """
 
-import dataclasses as dc
 from collections.abc import Mapping
+import dataclasses as dc
 
 import numpy as np
 from pydrake.geometry import GeometryId, QueryObject

@@ -13,9 +13,20 @@ continuous everywhere, and growing linearly beyond a limit.
 import numpy as np
 
 
+class JointLimits:
+    """``f_lim`` for fixed limits and constants, with the band edges computed once."""
+
+    def __init__(self, q_min: np.ndarray, q_max: np.ndarray, delta: float, f_max: float):
+        self._lower_edge, self._upper_edge = q_min + delta, q_max - delta
+        self._slope = f_max / delta
+
+    def Force(self, q: np.ndarray) -> np.ndarray:
+        """The per-joint limit force ``f_lim(q)`` (eq. 5.12-5.13, typos corrected)."""
+        return self._slope * (np.maximum(0.0, self._lower_edge - q)
+                              - np.maximum(0.0, q - self._upper_edge))
+
+
 def JointLimitForce(q: np.ndarray, q_min: np.ndarray, q_max: np.ndarray,
                     delta: np.ndarray | float, f_max: np.ndarray | float) -> np.ndarray:
     """The per-joint limit force ``f_lim(q)`` (eq. 5.12-5.13, with the typos above corrected)."""
-    lower_spring = np.maximum(0.0, q_min + delta - q)
-    upper_spring = np.maximum(0.0, q - (q_max - delta))
-    return (f_max / delta) * (lower_spring - upper_spring)
+    return JointLimits(q_min, q_max, delta, f_max).Force(q)

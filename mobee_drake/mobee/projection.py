@@ -1,4 +1,4 @@
-"""Projects workspace point forces into joint space with the Jacobian transpose (eq. 5.4, 5.10-5.11)."""
+"""Projects workspace point forces into joint space by the Jacobian transpose (eq. 5.4, 5.10)."""
 
 import numpy as np
 from pydrake.multibody.plant import MultibodyPlant

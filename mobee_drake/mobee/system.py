@@ -15,7 +15,7 @@ from mobee_drake.mobee.fields import (
     FindFieldPairs,
     ToFieldContacts,
 )
-from mobee_drake.mobee.joint_limits import JointLimitForce
+from mobee_drake.mobee.joint_limits import JointLimits
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.mobee.projection import ProjectPointForces
 from mobee_drake.mobee.squash import Squash
@@ -105,6 +105,8 @@ class Mobee(LeafSystem):
         self._q_min, self._q_max = np.array(q_min), np.array(q_max)
         mass, damping, stiffness = (np.array(x) for x in params.PerJoint(self._joints))
         self._mass, self._damping, self._stiffness = mass, damping, stiffness
+        self._limits = JointLimits(self._q_min, self._q_max, params.limit_delta,
+                                   params.limit_force)
         self._clauses = ClauseSet(robot.overlay.clauses, self._joints, robot.frozen_joints,
                                   source=source)
         self._default_positions = plant.GetPositions(plant.CreateDefaultContext())
@@ -129,6 +131,12 @@ class Mobee(LeafSystem):
         self._query_port = self.DeclareAbstractInputPort(
             "geometry_query", AbstractValue.Make(QueryObject()))
 
+        # The attractor changes rarely: it is checked once per change, not once per evaluation.
+        self._attractor_entry = self.DeclareCacheEntry(
+            description="checked attractor",
+            value_producer=ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros(n)),
+                                         calc=self._CalcAttractor),
+            prerequisites_of_calc={self._attractor_port.ticket()})
         state_ticket = self._state_port.ticket()
         self._plant_context_entry = self.DeclareCacheEntry(
             description="plant context at the input configuration",
@@ -149,7 +157,7 @@ class Mobee(LeafSystem):
                 calc=self._CalcForces),
             prerequisites_of_calc={
                 state_ticket, plant_ticket, self._field_pairs_entry.ticket(),
-                self._attractor_port.ticket(), self._config_force_port.ticket(),
+                self._attractor_entry.ticket(), self._config_force_port.ticket(),
                 self._marker_forces_port.ticket()})
         self._marker_pose_entry = self.DeclareCacheEntry(
             description="marker positions and directions",
@@ -259,9 +267,10 @@ class Mobee(LeafSystem):
         self._CheckFinite("state", x, self._state_names)
         return x[:n], x[n:]
 
-    def _ReadAttractor(self, context) -> np.ndarray:
+    def _CalcAttractor(self, context, value) -> None:
         if not self._attractor_port.HasValue(context):
-            return self._home
+            value.set_value(self._home)
+            return
         q_star = self._attractor_port.Eval(context)
         self._CheckFinite("attractor", q_star, self._joints)
         outside = (q_star < self._q_min) | (q_star > self._q_max)
@@ -271,7 +280,7 @@ class Mobee(LeafSystem):
                 f"MoBeE: attractor for joint '{self._joints[i]}' is {np.degrees(q_star[i]):.6g} "
                 f"deg, outside its limits [{np.degrees(self._q_min[i]):.6g}, "
                 f"{np.degrees(self._q_max[i]):.6g}] deg")
-        return q_star
+        value.set_value(q_star.copy())
 
     # ----------------------------------------------------------------------------------------
     # Cache computations.
@@ -317,12 +326,12 @@ class Mobee(LeafSystem):
     def _CalcForces(self, context, value) -> None:
         p = self._params
         q, v = self._ReadState(context)
-        q_star = self._ReadAttractor(context)
+        q_star = self._attractor_entry.Eval(context)
         terms = value.get_mutable_value()
 
         terms[0] = -Squash(self._stiffness * (q - q_star), p.spring_squash.m, p.spring_squash.k)
         terms[1] = -self._damping * v
-        terms[2] = JointLimitForce(q, self._q_min, self._q_max, p.limit_delta, p.limit_force)
+        terms[2] = self._limits.Force(q)
         terms[3] = self._clauses.Force(q, p.constraint_delta, p.constraint_force)
 
         pairs = self._field_pairs_entry.Eval(context)

@@ -62,7 +62,8 @@ def _ConvertMesh(source: pathlib.Path, destination: pathlib.Path) -> None:
 
 
 def _LeafLinksToFrames(robot: ET.Element) -> None:
-    """Replaces each massless, invisible leaf link on a fixed joint by a ``<frame>`` of its parent."""
+    """Replaces each massless, invisible leaf link on a fixed joint by a ``<frame>`` of its
+    parent."""
     links = {link.get("name"): link for link in robot.findall("link")}
     parents = {joint.find("parent").get("link") for joint in robot.findall("joint")}
     for joint in robot.findall("joint"):
@@ -103,7 +104,8 @@ def PreparedIcubModel(model_name: str) -> pathlib.Path:
         for mesh in link.iter("mesh"):
             uri = mesh.get("filename", "")
             if not uri.startswith(_MESH_PACKAGE_PREFIX):
-                raise ValueError(f"{source}: link '{link.get('name')}' has a mesh outside the iCub package: {uri}")
+                raise ValueError(f"{source}: link '{link.get('name')}' has a mesh outside the "
+                                 f"iCub package: {uri}")
             relative = pathlib.Path(uri[len(_MESH_PACKAGE_PREFIX):])
             converted = mesh_cache / (relative.stem + ".obj")
             if not converted.is_file():

@@ -18,21 +18,27 @@ zero*, so a capsule is written as the two end points of the bone it covers. The 
 them into each link's frame.
 """
 
+from collections.abc import Callable, Mapping
 import dataclasses as dc
 import math
 import pathlib
-from collections.abc import Callable, Mapping
 
 import numpy as np
 from pydrake.geometry import (
     AddContactMaterial,
-    Box as DrakeBox,
-    Capsule as DrakeCapsule,
     CollisionFilterDeclaration,
     GeometryId,
     GeometrySet,
     ProximityProperties,
     SceneGraph,
+)
+from pydrake.geometry import (
+    Box as DrakeBox,
+)
+from pydrake.geometry import (
+    Capsule as DrakeCapsule,
+)
+from pydrake.geometry import (
     Sphere as DrakeSphere,
 )
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix

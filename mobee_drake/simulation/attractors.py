@@ -37,3 +37,31 @@ class RandomAttractorSource(LeafSystem):
     def _Update(self, context, discrete_state) -> None:
         k = int(round(context.get_time() / self._period))
         discrete_state.get_mutable_vector().SetFromVector(self._Draw(k))
+
+
+class SliderAttractorSource(LeafSystem):
+    """An attractor moved by hand: one Meshcat slider per joint (degrees), sampled every
+    ``period`` into the discrete state, so that a change reaches the rest of the diagram.
+
+    .. pydrake_system::
+
+        name: SliderAttractorSource
+        output_ports:
+        - attractor
+    """
+
+    def __init__(self, *, meshcat, joints: list[str], lower: np.ndarray, upper: np.ndarray,
+                 home: np.ndarray, period: float):
+        super().__init__()
+        self._meshcat, self._joints = meshcat, list(joints)
+        for name, lo, hi, value in zip(self._joints, np.degrees(lower), np.degrees(upper),
+                                       np.degrees(home)):
+            meshcat.AddSlider(name, lo, hi, 0.1, value)
+        state = self.DeclareDiscreteState(BasicVector(np.asarray(home, dtype=float)))
+        self.DeclareStateOutputPort("attractor", state)
+        self.DeclarePeriodicDiscreteUpdateEvent(period_sec=period, offset_sec=0.0,
+                                                update=self._Read)
+
+    def _Read(self, context, discrete_state) -> None:
+        degrees = [self._meshcat.GetSliderValue(name) for name in self._joints]
+        discrete_state.get_mutable_vector().SetFromVector(np.radians(degrees))

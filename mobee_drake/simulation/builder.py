@@ -26,8 +26,6 @@ import numpy as np
 from pydrake.geometry import (
     Meshcat,
     MeshcatVisualizer,
-    MeshcatVisualizerParams,
-    Role,
     SceneGraph,
 )
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
@@ -38,7 +36,6 @@ from pydrake.systems.controllers import (
 from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
 from pydrake.systems.primitives import (
     ConstantVectorSource,
-    Gain,
     MatrixGain,
     SharedPointerSystem,
     ZeroOrderHold,
@@ -48,9 +45,9 @@ from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.icub import AddIcub
 from mobee_drake.robots.overlay import RobotOverlay
-from mobee_drake.simulation.attractors import RandomAttractorSource
+from mobee_drake.simulation.attractors import RandomAttractorSource, SliderAttractorSource
 from mobee_drake.simulation.safety import SafetyMonitor
-from mobee_drake.simulation.scenario import FixedAttractor, Scenario
+from mobee_drake.simulation.scenario import FixedAttractor, Scenario, SliderAttractor
 from mobee_drake.simulation.virtual_dynamics import VirtualDynamics
 from mobee_drake.simulation.world import LiveWorld
 
@@ -58,6 +55,8 @@ from mobee_drake.simulation.world import LiveWorld
 # critically damped at 20 rad/s, which tracks MoBeE's virtual trajectory (time constants around
 # one second) closely.
 POSITION_GAIN, VELOCITY_GAIN = 400.0, 40.0
+# How often the attractor sliders are read (s).
+SLIDER_PERIOD = 0.05
 
 
 @dc.dataclass
@@ -90,9 +89,16 @@ def _StateToPlant(plant: MultibodyPlant, mobee: Mobee) -> np.ndarray:
     return S
 
 
-def _AttractorSource(scenario: Scenario, mobee: Mobee):
+def _AttractorSource(builder: DiagramBuilder, scenario: Scenario, mobee: Mobee,
+                     plant: MultibodyPlant, meshcat: Meshcat | None) -> OutputPort:
     lower, upper = mobee.position_limits
     program = scenario.attractor
+    if isinstance(program, SliderAttractor):
+        if meshcat is None:
+            raise ValueError("the slider attractor needs Meshcat (run with --meshcat)")
+        return builder.AddNamedSystem("attractor", SliderAttractorSource(
+            meshcat=meshcat, joints=mobee.joints, lower=lower, upper=upper, home=mobee.home,
+            period=SLIDER_PERIOD)).get_output_port()
     if isinstance(program, FixedAttractor):
         q_star = mobee.home
         for name, value in program.joints_deg.items():
@@ -103,15 +109,16 @@ def _AttractorSource(scenario: Scenario, mobee: Mobee):
             raise ValueError(f"attractor for joint '{mobee.joints[i]}' is "
                              f"{np.degrees(q_star[i]):.6g} deg, outside its limits "
                              f"[{np.degrees(lower[i]):.6g}, {np.degrees(upper[i]):.6g}] deg")
-        return ConstantVectorSource(q_star)
+        return builder.AddNamedSystem("attractor", ConstantVectorSource(q_star)).get_output_port()
     babbling = np.ones(len(mobee.joints), dtype=bool)
     if program.joints:
         babbling[:] = False
         for name in program.joints:
             babbling[mobee.joint_index(name)] = True
-    return RandomAttractorSource(lower=lower, upper=upper, home=mobee.home, babbling=babbling,
-                                 range_fraction=program.range_fraction, period=program.period,
-                                 seed=scenario.random_seed)
+    return builder.AddNamedSystem("attractor", RandomAttractorSource(
+        lower=lower, upper=upper, home=mobee.home, babbling=babbling,
+        range_fraction=program.range_fraction, period=program.period,
+        seed=scenario.random_seed)).get_output_port()
 
 
 def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simulation:
@@ -134,8 +141,8 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simul
     mobee = builder.AddNamedSystem("mobee", Mobee(plant, robot, joints=joints,
                                                   params=scenario.mobee))
     builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
-    attractor = builder.AddNamedSystem("attractor", _AttractorSource(scenario, mobee))
-    builder.Connect(attractor.get_output_port(), mobee.GetInputPort("attractor"))
+    attractor = _AttractorSource(builder, scenario, mobee, plant, meshcat)
+    builder.Connect(attractor, mobee.GetInputPort("attractor"))
 
     _, damping, _ = scenario.mobee.PerJoint(joints)
     virtual = builder.AddNamedSystem("virtual_dynamics", VirtualDynamics(
@@ -188,20 +195,19 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simul
                         plant.get_applied_generalized_force_input_port())
 
     monitor = builder.AddNamedSystem("safety_monitor", SafetyMonitor(
-        objects={name: world.geometry_id(name) for name in world.names},
-        period=scenario.time_step))
+        names=world.names, period=scenario.time_step))
     builder.Connect(mobee.GetOutputPort("field_pairs"), monitor.GetInputPort("field_pairs"))
+    builder.Connect(scene_graph.get_query_output_port(), monitor.GetInputPort("geometry_query"))
 
     visualizer = None
     if meshcat is not None:
         from mobee_drake.simulation.viewer import AddViewer
 
         visualizer = AddViewer(builder, scenario=scenario, meshcat=meshcat, plant=plant,
-                               scene_graph=scene_graph, mobee=mobee,
-                               attractor=attractor.get_output_port())
+                               scene_graph=scene_graph, mobee=mobee, attractor=attractor)
 
     builder.ExportOutput(robot_state, "robot_state")
-    builder.ExportOutput(attractor.get_output_port(), "attractor")
+    builder.ExportOutput(attractor, "attractor")
     diagram = builder.Build()
     diagram.set_name("mobee_simulation")
     return Simulation(scenario=scenario, diagram=diagram, plant=plant, scene_graph=scene_graph,

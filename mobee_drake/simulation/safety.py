@@ -4,12 +4,13 @@ import dataclasses as dc
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.geometry import GeometryId
+from pydrake.geometry import QueryObject
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from mobee_drake.mobee.fields import NO_FIELD_PAIRS
 
 SELF = "(self)"
+OTHERS = "(other objects)"
 
 
 @dc.dataclass
@@ -30,21 +31,22 @@ class SafetyMonitor(LeafSystem):
         name: SafetyMonitor
         input_ports:
         - field_pairs
+        - geometry_query
 
-    State: per watched object the closest distance seen (inf until inside a field), the same for
-    the robot's own pairs, the number of periods with a penetration and the deepest penetration.
-
-    Args:
-        objects: the geometry of each watched object, by name.
+    State: per watched object (by its geometry's name, so it survives the live world's changes)
+    the closest distance seen (inf until inside a field), the same for the robot's own pairs and
+    for objects added later, the number of periods with a penetration, and the deepest one.
     """
 
-    def __init__(self, *, objects: dict[str, GeometryId], period: float):
+    def __init__(self, *, names: list[str], period: float):
         super().__init__()
-        self._names = list(objects) + [SELF]
-        self._index = {geometry_id: i for i, geometry_id in enumerate(objects.values())}
-        self._self_index = len(objects)
+        self._names = list(names) + [SELF, OTHERS]
+        self._index = {name: i for i, name in enumerate(names)}
+        self._self_index, self._others_index = len(names), len(names) + 1
         self._pairs_port = self.DeclareAbstractInputPort(
             "field_pairs", AbstractValue.Make(NO_FIELD_PAIRS))
+        self._query_port = self.DeclareAbstractInputPort(
+            "geometry_query", AbstractValue.Make(QueryObject()))
         initial = np.concatenate([np.full(len(self._names), np.inf), [0.0, 0.0]])
         self._state = self.DeclareDiscreteState(BasicVector(initial))
         self.DeclarePeriodicDiscreteUpdateEvent(period_sec=period, offset_sec=0.0,
@@ -55,8 +57,13 @@ class SafetyMonitor(LeafSystem):
         n = len(self._names)
         pairs = self._pairs_port.Eval(context)
         if len(pairs):
-            for geometry_id, distance in zip(pairs.geometry_B, pairs.distance):
-                i = self._index.get(geometry_id, self._self_index)
+            inspector = self._query_port.Eval(context).inspector()
+            for geometry_id, distance, robot in zip(pairs.geometry_B, pairs.distance,
+                                                    pairs.b_is_robot):
+                if robot:
+                    i = self._self_index
+                else:
+                    i = self._index.get(inspector.GetName(geometry_id), self._others_index)
                 x[i] = min(x[i], distance)
             deepest_now = -pairs.distance.min()
             if deepest_now > 0:

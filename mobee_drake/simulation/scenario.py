@@ -72,6 +72,11 @@ class RandomAttractors:
 
 
 @dc.dataclass
+class SliderAttractor:
+    """Interactive: one Meshcat slider per controlled joint moves the attractor (needs Meshcat)."""
+
+
+@dc.dataclass
 class WorldEvent:
     """A scripted change of the world at a time: move an object or switch its role."""
 
@@ -112,7 +117,8 @@ class Scenario:
     # The dynamic robot's plant step (s).
     plant_time_step: float = 0.001
     duration: float = 10.0
-    attractor: FixedAttractor | RandomAttractors = dc.field(default_factory=FixedAttractor)
+    attractor: FixedAttractor | RandomAttractors | SliderAttractor = dc.field(
+        default_factory=FixedAttractor)
     world_events: list[WorldEvent] = dc.field(default_factory=list)
     visualization: Visualization = dc.field(default_factory=Visualization)
     random_seed: int = 0

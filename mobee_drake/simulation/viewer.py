@@ -1,8 +1,10 @@
-"""Meshcat: the robot and its world, the attractor as a translucent robot, the trail of a marker."""
+"""Meshcat: the robot and its world, the attractor as a translucent robot, the trail of a marker,
+and MoBeE's field forces at the witness points of the pairs inside their fields."""
 
 import re
 
 import numpy as np
+from pydrake.common.value import AbstractValue
 from pydrake.geometry import (
     Meshcat,
     MeshcatVisualizer,
@@ -25,6 +27,37 @@ from mobee_drake.simulation.scenario import Scenario
 
 ATTRACTOR_ALPHA = 0.25
 TRAIL_COLOR = Rgba(0.9, 0.2, 0.2, 1.0)
+CONTACT_FORCE_COLOR = Rgba(1.0, 0.55, 0.0, 1.0)
+# Length of a drawn contact force per metre of field penetration (a full 3 cm field: 15 cm).
+ARROW_LENGTH_PER_PENETRATION = 5.0
+
+
+class ContactForceDrawer(LeafSystem):
+    """Draws MoBeE's field forces: a segment from each witness point on the robot along the
+    force (the separating direction), its length proportional to the field penetration, and its
+    reaction on the other geometry of a self-collision. Publish only: it keeps no state.
+    """
+
+    def __init__(self, *, meshcat: Meshcat, period: float, path: str = "/field_forces"):
+        super().__init__()
+        self._meshcat, self._path = meshcat, path
+        self._contacts_port = self.DeclareAbstractInputPort(
+            "field_contacts", AbstractValue.Make([]))
+        self.DeclarePeriodicPublishEvent(period_sec=period, offset_sec=0.0, publish=self._Draw)
+        self.DeclareForcedPublishEvent(self._Draw)
+
+    def _Draw(self, context) -> None:
+        contacts = self._contacts_port.Eval(context)
+        if not contacts:
+            self._meshcat.Delete(self._path)
+            return
+        starts, ends = [], []
+        for c in contacts:
+            arrow = ARROW_LENGTH_PER_PENETRATION * c.penetration * c.nhat_BA_W
+            starts.append(c.p_WCa)
+            ends.append(c.p_WCa + arrow)
+        self._meshcat.SetLineSegments(self._path, np.array(starts).T, np.array(ends).T, 4.0,
+                                      CONTACT_FORCE_COLOR)
 
 
 class TrailDrawer(LeafSystem):
@@ -114,6 +147,9 @@ def AddViewer(builder: DiagramBuilder, *, scenario: Scenario, meshcat: Meshcat,
         builder, scene_graph, meshcat,
         MeshcatVisualizerParams(role=Role.kProximity, prefix="collision",
                                 default_color=Rgba(0.2, 0.5, 0.9, 0.4), visible_by_default=False))
+    forces = builder.AddNamedSystem("field_force_drawer", ContactForceDrawer(
+        meshcat=meshcat, period=max(scenario.time_step, 1 / 30)))
+    builder.Connect(mobee.GetOutputPort("field_contacts"), forces.get_input_port())
     if settings.trail_marker:
         trail = builder.AddNamedSystem("trail", TrailDrawer(
             meshcat=meshcat, marker_index=mobee.marker_index(settings.trail_marker),

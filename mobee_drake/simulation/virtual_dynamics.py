@@ -31,7 +31,10 @@ class VirtualDynamics(LeafSystem):
                  initial_positions: np.ndarray):
         super().__init__()
         n = len(mass)
-        self._mass, self._damping, self._period = np.asarray(mass), np.asarray(damping), period
+        mass, damping = np.asarray(mass, dtype=float), np.asarray(damping, dtype=float)
+        self._period = period
+        self._h_over_mass = period / mass
+        self._damping_factor = 1.0 / (1.0 + period * damping / mass)
         self._total_port = self.DeclareVectorInputPort("total", n)
         self._damping_port = self.DeclareVectorInputPort("damping", n)
         state = self.DeclareDiscreteState(
@@ -42,9 +45,8 @@ class VirtualDynamics(LeafSystem):
 
     def _Update(self, context, discrete_state) -> None:
         x = context.get_discrete_state_vector().value()
-        n = len(self._mass)
-        q, v = x[:n], x[n:]
-        h = self._period
+        n = len(self._h_over_mass)
         undamped = self._total_port.Eval(context) - self._damping_port.Eval(context)
-        v_next = (v + h * undamped / self._mass) / (1.0 + h * self._damping / self._mass)
-        discrete_state.get_mutable_vector().SetFromVector(np.concatenate([q + h * v_next, v_next]))
+        v_next = (x[n:] + self._h_over_mass * undamped) * self._damping_factor
+        discrete_state.get_mutable_vector().SetFromVector(
+            np.concatenate([x[:n] + self._period * v_next, v_next]))

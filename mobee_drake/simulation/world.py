@@ -3,8 +3,7 @@
 MoBeE's world changes while the robot moves (ch. 2.3.2, ch. 4.3.2): vision adds objects, a ball
 turns from a ghost into an obstacle. Drake cannot add frames or bodies to a built diagram, but
 SceneGraph lets the geometry itself change *in the Context* ("model versus context"): geometry can
-be registered and removed, its shape and pose changed, and its roles assigned and removed. We use
-exactly that:
+be registered and removed and its roles assigned and removed. We use exactly that:
 
 - every object is a geometry fixed to the world frame, registered by the robot's plant (so the
   dynamic robot's contact solver knows it);
@@ -13,12 +12,16 @@ exactly that:
   and a **ghost** have no proximity role (MoBeE ignores them, the palm may touch a target), the
   target drawn green, the ghost translucent;
 - :class:`LiveWorld` changes them through the diagram's Context, between simulation steps, from a
-  script or from scenario events. Changes made in the Context are not in the SceneGraph model, so
-  a Meshcat *recording* shows the objects as they were at the start (live viewing is updated).
+  script or from scenario events: roles are assigned and removed, objects registered and removed;
+  a move re-registers the object at its new pose (SceneGraph does not update the pose of a
+  world-fixed geometry whose shape is changed in a Context). Changes made in the Context are not
+  in the SceneGraph model, so a Meshcat *recording* shows the objects as they were at the start
+  (the live view is updated).
 """
 
 import numpy as np
 from pydrake.geometry import (
+    AddContactMaterial,
     Box,
     Cylinder,
     GeometryId,
@@ -32,7 +35,6 @@ from pydrake.geometry import (
     Shape,
     Sphere,
 )
-from pydrake.geometry import AddContactMaterial
 from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 
@@ -115,14 +117,18 @@ class LiveWorld:
             raise ValueError(f"world object '{obj.name}' exists already")
         if obj.role not in schema.OBJECT_ROLES:
             raise ValueError(f"world object '{obj.name}': unknown role '{obj.role}'")
-        shape, X_WO = MakeShape(obj.shape), ObjectPose(obj.position, obj.rpy_deg)
-        instance = GeometryInstance(X_WO, shape, obj.name)
-        instance.set_illustration_properties(_IllustrationProperties(obj.role))
-        if obj.role == "obstacle":
+        self._Register(root_context, obj.name, MakeShape(obj.shape),
+                       ObjectPose(obj.position, obj.rpy_deg), obj.role)
+
+    def _Register(self, root_context, name: str, shape: Shape, X_WO: RigidTransform,
+                  role: str) -> None:
+        instance = GeometryInstance(X_WO, shape, name)
+        instance.set_illustration_properties(_IllustrationProperties(role))
+        if role == "obstacle":
             instance.set_proximity_properties(_ProximityProperties())
         geometry_id = self._scene_graph.RegisterGeometry(
             self._SceneGraphContext(root_context), self._source_id, self._frame_id, instance)
-        self._objects[obj.name] = [geometry_id, shape, X_WO, obj.role]
+        self._objects[name] = [geometry_id, shape, X_WO, role]
 
     def Remove(self, root_context, name: str) -> None:
         geometry_id = self._Get(name)[0]
@@ -131,10 +137,12 @@ class LiveWorld:
         del self._objects[name]
 
     def Move(self, root_context, name: str, position, rpy_deg=(0.0, 0.0, 0.0)) -> None:
-        entry = self._Get(name)
-        entry[2] = ObjectPose(position, rpy_deg)
-        self._scene_graph.ChangeShape(self._SceneGraphContext(root_context), self._source_id,
-                                      entry[0], entry[1], entry[2])
+        """Moves an object. SceneGraph 1.51 does not update the pose of a world-fixed geometry
+        changed with ``ChangeShape`` in a Context, so the object is registered anew (its
+        GeometryId changes; its name, shape and role stay)."""
+        _, shape, _, role = self._Get(name)
+        self.Remove(root_context, name)
+        self._Register(root_context, name, shape, ObjectPose(position, rpy_deg), role)
 
     def SetRole(self, root_context, name: str, role: str) -> None:
         """Switches an object between "obstacle", "target" and "ghost"."""
