@@ -142,7 +142,8 @@ class TestRandomAttractors(unittest.TestCase):
 
 class TestSafetyMonitor(unittest.TestCase):
     def test_keeps_closest_approach_and_penetrations(self):
-        from pydrake.geometry import GeometryInstance, SceneGraph, Sphere as DrakeSphere
+        from pydrake.geometry import GeometryInstance, SceneGraph
+        from pydrake.geometry import Sphere as DrakeSphere
         from pydrake.math import RigidTransform
 
         scene_graph = SceneGraph()
