@@ -215,6 +215,31 @@ class TestKinematicRobot(unittest.TestCase):
         np.testing.assert_allclose(states[-1][n:], 0.0, atol=1e-2)
 
 
+class TestClientForces(unittest.TestCase):
+    def test_marker_force_lifts_the_palm_and_is_drawn(self):
+        from pydrake.geometry import Meshcat
+
+        scenario = LoadScenario(REACH, "{objects: [], duration: 2}")
+        meshcat = Meshcat()
+        simulation = BuildSimulation(scenario, meshcat)
+        simulator = Simulator(simulation.diagram)
+        context = simulator.get_mutable_context()
+        forces = np.zeros(3 * len(simulation.mobee.marker_names))
+        i = simulation.mobee.marker_index("r_palm")
+        forces[3 * i + 2] = 50.0  # upwards, in world
+        simulation.diagram.GetInputPort("marker_forces").FixValue(context, forces)
+        simulator.Initialize()
+        start = _Palm(simulation, context)
+        simulation.diagram.ForcedPublish(context)
+        self.assertTrue(meshcat.HasPath("/marker_forces"))
+        simulator.AdvanceTo(2.0)
+        lifted = _Palm(simulation, context)
+        # Without the force, the attractor alone moves the palm down a little.
+        _, _, free, _ = _Trajectory(scenario, [2.0])
+        self.assertGreater(lifted[2] - free[0][2], 0.05)
+        self.assertGreater(lifted[2], start[2])
+
+
 class TestDynamicRobot(unittest.TestCase):
     """Each modality follows MoBeE: after 3 s of the reach, within a few degrees of the
     kinematic robot, and without penetrating the ball."""

@@ -141,6 +141,10 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simul
     mobee = builder.AddNamedSystem("mobee", Mobee(plant, robot, joints=joints,
                                                   params=scenario.mobee))
     builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
+    # The client's forces (eq. 5.9-5.10) are inputs of the diagram, for scripts and supervisors;
+    # unfixed, they are zero.
+    builder.ExportInput(mobee.GetInputPort("config_force"), "config_force")
+    builder.ExportInput(mobee.GetInputPort("marker_forces"), "marker_forces")
     attractor = _AttractorSource(builder, scenario, mobee, plant, meshcat)
     builder.Connect(attractor, mobee.GetInputPort("attractor"))
 
@@ -204,7 +208,8 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simul
         from mobee_drake.simulation.viewer import AddViewer
 
         visualizer = AddViewer(builder, scenario=scenario, meshcat=meshcat, plant=plant,
-                               scene_graph=scene_graph, mobee=mobee, attractor=attractor)
+                               scene_graph=scene_graph, mobee=mobee, attractor=attractor,
+                               marker_forces="marker_forces")
 
     builder.ExportOutput(robot_state, "robot_state")
     builder.ExportOutput(attractor, "attractor")

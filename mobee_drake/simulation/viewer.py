@@ -1,5 +1,5 @@
 """Meshcat: the robot and its world, the attractor as a translucent robot, the trail of a marker,
-and MoBeE's field forces at the witness points of the pairs inside their fields."""
+and MoBeE's workspace forces: field forces at witness points, client forces at markers."""
 
 import re
 
@@ -28,36 +28,51 @@ from mobee_drake.simulation.scenario import Scenario
 ATTRACTOR_ALPHA = 0.25
 TRAIL_COLOR = Rgba(0.9, 0.2, 0.2, 1.0)
 CONTACT_FORCE_COLOR = Rgba(1.0, 0.55, 0.0, 1.0)
+MARKER_FORCE_COLOR = Rgba(0.85, 0.0, 0.85, 1.0)
+MARKER_ARROW_LENGTH_PER_FORCE = 0.01
 # Length of a drawn contact force per metre of field penetration (a full 3 cm field: 15 cm).
 ARROW_LENGTH_PER_PENETRATION = 5.0
 
 
-class ContactForceDrawer(LeafSystem):
-    """Draws MoBeE's field forces: a segment from each witness point on the robot along the
-    force (the separating direction), its length proportional to the field penetration, and its
-    reaction on the other geometry of a self-collision. Publish only: it keeps no state.
+class ForceDrawer(LeafSystem):
+    """Draws MoBeE's workspace forces as segments (publish only: it keeps no state).
+
+    - Field forces: from each witness point on the robot along the force (the separating
+      direction), the length proportional to the field penetration (orange, ``/field_forces``).
+    - Client forces on markers (``marker_forces``, when given): from each loaded marker along its
+      force, 1 cm per unit of force (magenta, ``/marker_forces``).
     """
 
-    def __init__(self, *, meshcat: Meshcat, period: float, path: str = "/field_forces"):
+    def __init__(self, *, meshcat: Meshcat, num_markers: int, period: float):
         super().__init__()
-        self._meshcat, self._path = meshcat, path
+        self._meshcat = meshcat
         self._contacts_port = self.DeclareAbstractInputPort(
             "field_contacts", AbstractValue.Make([]))
+        self._positions_port = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
+        self._forces_port = self.DeclareVectorInputPort("marker_forces", 3 * num_markers)
         self.DeclarePeriodicPublishEvent(period_sec=period, offset_sec=0.0, publish=self._Draw)
         self.DeclareForcedPublishEvent(self._Draw)
 
+    def _Segments(self, path: str, starts: list, ends: list, color: Rgba) -> None:
+        if starts:
+            self._meshcat.SetLineSegments(path, np.array(starts).T, np.array(ends).T, 4.0, color)
+        else:
+            self._meshcat.Delete(path)
+
     def _Draw(self, context) -> None:
         contacts = self._contacts_port.Eval(context)
-        if not contacts:
-            self._meshcat.Delete(self._path)
-            return
+        self._Segments("/field_forces", [c.p_WCa for c in contacts],
+                       [c.p_WCa + ARROW_LENGTH_PER_PENETRATION * c.penetration * c.nhat_BA_W
+                        for c in contacts], CONTACT_FORCE_COLOR)
         starts, ends = [], []
-        for c in contacts:
-            arrow = ARROW_LENGTH_PER_PENETRATION * c.penetration * c.nhat_BA_W
-            starts.append(c.p_WCa)
-            ends.append(c.p_WCa + arrow)
-        self._meshcat.SetLineSegments(self._path, np.array(starts).T, np.array(ends).T, 4.0,
-                                      CONTACT_FORCE_COLOR)
+        if self._forces_port.HasValue(context):
+            points = self._positions_port.Eval(context).reshape(-1, 3)
+            forces = self._forces_port.Eval(context).reshape(-1, 3)
+            for p, f in zip(points, forces):
+                if np.any(f != 0):
+                    starts.append(p)
+                    ends.append(p + MARKER_ARROW_LENGTH_PER_FORCE * f)
+        self._Segments("/marker_forces", starts, ends, MARKER_FORCE_COLOR)
 
 
 class TrailDrawer(LeafSystem):
@@ -134,8 +149,11 @@ def _AddAttractorRobot(builder: DiagramBuilder, scenario: Scenario, scene_graph:
 
 def AddViewer(builder: DiagramBuilder, *, scenario: Scenario, meshcat: Meshcat,
               plant: MultibodyPlant, scene_graph: SceneGraph, mobee: Mobee,
-              attractor: OutputPort) -> MeshcatVisualizer:
-    """Adds the Meshcat viewer of a scenario; returns the illustration visualizer."""
+              attractor: OutputPort, marker_forces: str | None = None) -> MeshcatVisualizer:
+    """Adds the Meshcat viewer of a scenario; returns the illustration visualizer.
+
+    ``marker_forces`` names the diagram input that carries the client's marker forces, if any.
+    """
     settings = scenario.visualization
     if settings.show_attractor:
         _AddAttractorRobot(builder, scenario, scene_graph, mobee, attractor)
@@ -147,9 +165,14 @@ def AddViewer(builder: DiagramBuilder, *, scenario: Scenario, meshcat: Meshcat,
         builder, scene_graph, meshcat,
         MeshcatVisualizerParams(role=Role.kProximity, prefix="collision",
                                 default_color=Rgba(0.2, 0.5, 0.9, 0.4), visible_by_default=False))
-    forces = builder.AddNamedSystem("field_force_drawer", ContactForceDrawer(
-        meshcat=meshcat, period=max(scenario.time_step, 1 / 30)))
-    builder.Connect(mobee.GetOutputPort("field_contacts"), forces.get_input_port())
+    forces = builder.AddNamedSystem("force_drawer", ForceDrawer(
+        meshcat=meshcat, num_markers=len(mobee.marker_names),
+        period=max(scenario.time_step, 1 / 30)))
+    builder.Connect(mobee.GetOutputPort("field_contacts"), forces.GetInputPort("field_contacts"))
+    builder.Connect(mobee.GetOutputPort("marker_positions"),
+                    forces.GetInputPort("marker_positions"))
+    if marker_forces is not None:
+        builder.ConnectInput(marker_forces, forces.GetInputPort("marker_forces"))
     if settings.trail_marker:
         trail = builder.AddNamedSystem("trail", TrailDrawer(
             meshcat=meshcat, marker_index=mobee.marker_index(settings.trail_marker),
