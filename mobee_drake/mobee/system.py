@@ -240,6 +240,16 @@ class Mobee(LeafSystem):
         """The plant's default positions of the controlled joints (the default attractor)."""
         return self._home.copy()
 
+    def CheckAttractor(self, q_star: np.ndarray) -> None:
+        """Raises ValueError naming the first joint whose attractor is outside its limits."""
+        outside = (q_star < self._q_min) | (q_star > self._q_max)
+        if outside.any():
+            i = np.flatnonzero(outside)[0]
+            raise ValueError(
+                f"MoBeE: attractor for joint '{self._joints[i]}' is {np.degrees(q_star[i]):.6g} "
+                f"deg, outside its limits [{np.degrees(self._q_min[i]):.6g}, "
+                f"{np.degrees(self._q_max[i]):.6g}] deg")
+
     @property
     def position_limits(self) -> tuple[np.ndarray, np.ndarray]:
         return self._q_min.copy(), self._q_max.copy()
@@ -273,13 +283,7 @@ class Mobee(LeafSystem):
             return
         q_star = self._attractor_port.Eval(context)
         self._CheckFinite("attractor", q_star, self._joints)
-        outside = (q_star < self._q_min) | (q_star > self._q_max)
-        if outside.any():
-            i = np.flatnonzero(outside)[0]
-            raise ValueError(
-                f"MoBeE: attractor for joint '{self._joints[i]}' is {np.degrees(q_star[i]):.6g} "
-                f"deg, outside its limits [{np.degrees(self._q_min[i]):.6g}, "
-                f"{np.degrees(self._q_max[i]):.6g}] deg")
+        self.CheckAttractor(q_star)
         value.set_value(q_star.copy())
 
     # ----------------------------------------------------------------------------------------

@@ -105,3 +105,18 @@ def FreezeJoints(plant: MultibodyPlant, instance: ModelInstanceIndex, *, keep: I
         plant.WeldFrames(frame_on_parent, frame_on_child, X_FM)
         frozen[name] = angle
     return frozen
+
+
+def JointStateSelector(plant: MultibodyPlant, joints: list[str]) -> np.ndarray:
+    """The matrix S with ``x_plant = S [q; v]`` for (q, v) of one-DOF ``joints`` in that order.
+
+    Its transpose selects those joints' (q, v) from the plant's state; its upper-left block maps
+    their positions into the plant's positions.
+    """
+    n = len(joints)
+    S = np.zeros((plant.num_multibody_states(), 2 * n))
+    for i, name in enumerate(joints):
+        joint = plant.GetJointByName(name)
+        S[joint.position_start(), i] = 1.0
+        S[plant.num_positions() + joint.velocity_start(), n + i] = 1.0
+    return S

@@ -43,6 +43,7 @@ from pydrake.systems.primitives import (
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
 from mobee_drake.mobee.system import Mobee
+from mobee_drake.robots.assembly import JointStateSelector
 from mobee_drake.robots.icub import AddIcub
 from mobee_drake.robots.overlay import RobotOverlay
 from mobee_drake.simulation.attractors import RandomAttractorSource, SliderAttractorSource
@@ -78,17 +79,6 @@ class Simulation:
     visualizer: MeshcatVisualizer | None = None
 
 
-def _StateToPlant(plant: MultibodyPlant, mobee: Mobee) -> np.ndarray:
-    """Maps (q, v) in MoBeE's joint order to the plant's state vector."""
-    n = len(mobee.joints)
-    S = np.zeros((plant.num_multibody_states(), 2 * n))
-    for i, name in enumerate(mobee.joints):
-        joint = plant.GetJointByName(name)
-        S[joint.position_start(), i] = 1.0
-        S[plant.num_positions() + joint.velocity_start(), n + i] = 1.0
-    return S
-
-
 def _AttractorSource(builder: DiagramBuilder, scenario: Scenario, mobee: Mobee,
                      plant: MultibodyPlant, meshcat: Meshcat | None) -> OutputPort:
     lower, upper = mobee.position_limits
@@ -103,12 +93,7 @@ def _AttractorSource(builder: DiagramBuilder, scenario: Scenario, mobee: Mobee,
         q_star = mobee.home
         for name, value in program.joints_deg.items():
             q_star[mobee.joint_index(name)] = np.radians(value)
-        outside = (q_star < lower) | (q_star > upper)
-        if outside.any():
-            i = np.flatnonzero(outside)[0]
-            raise ValueError(f"attractor for joint '{mobee.joints[i]}' is "
-                             f"{np.degrees(q_star[i]):.6g} deg, outside its limits "
-                             f"[{np.degrees(lower[i]):.6g}, {np.degrees(upper[i]):.6g}] deg")
+        mobee.CheckAttractor(q_star)
         return builder.AddNamedSystem("attractor", ConstantVectorSource(q_star)).get_output_port()
     babbling = np.ones(len(mobee.joints), dtype=bool)
     if program.joints:
@@ -154,7 +139,8 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simul
         initial_positions=mobee.home))
     builder.Connect(mobee.GetOutputPort("total"), virtual.GetInputPort("total"))
     builder.Connect(mobee.GetOutputPort("damping"), virtual.GetInputPort("damping"))
-    to_plant = builder.AddNamedSystem("to_plant_state", MatrixGain(_StateToPlant(plant, mobee)))
+    selector = JointStateSelector(plant, mobee.joints)
+    to_plant = builder.AddNamedSystem("to_plant_state", MatrixGain(selector))
     builder.Connect(virtual.get_output_port(), to_plant.get_input_port())
 
     if kinematic:
@@ -169,7 +155,7 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simul
         robot_state = virtual.get_output_port()
     else:
         from_plant = builder.AddNamedSystem(
-            "from_plant_state", MatrixGain(_StateToPlant(plant, mobee).T))
+            "from_plant_state", MatrixGain(selector.T))
         builder.Connect(plant.get_state_output_port(), from_plant.get_input_port())
         builder.Connect(from_plant.get_output_port(), mobee.GetInputPort("state"))
         robot_state = from_plant.get_output_port()
@@ -179,7 +165,7 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simul
                 "total_hold", ZeroOrderHold(scenario.time_step, len(joints)))
             builder.Connect(mobee.GetOutputPort("total"), held.get_input_port())
             # q'' = total / M in MoBeE's order, then to the plant's velocity order.
-            to_acceleration = _StateToPlant(plant, mobee)[plant.num_positions():, len(joints):]
+            to_acceleration = selector[plant.num_positions():, len(joints):]
             acceleration = builder.AddNamedSystem(
                 "acceleration", MatrixGain(to_acceleration @ np.diag(1.0 / mobee.mass)))
             builder.Connect(held.get_output_port(), acceleration.get_input_port())

@@ -21,7 +21,7 @@ from pydrake.systems.primitives import MatrixGain, SharedPointerSystem
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
 from mobee_drake.mobee.system import Mobee
-from mobee_drake.robots.assembly import FreezeJoints
+from mobee_drake.robots.assembly import FreezeJoints, JointStateSelector
 from mobee_drake.robots.model_cache import PreparedIcubModel
 from mobee_drake.simulation.scenario import Scenario
 
@@ -136,10 +136,8 @@ def _AddAttractorRobot(builder: DiagramBuilder, scenario: Scenario, scene_graph:
     FreezeJoints(ghost, instance, keep=mobee.joints, home=home, source="attractor robot")
     ghost.Finalize()
     builder.AddNamedSystem("attractor_robot_owner", SharedPointerSystem(ghost))
-    select = np.zeros((ghost.num_positions(), len(mobee.joints)))
-    for i, name in enumerate(mobee.joints):
-        select[ghost.GetJointByName(name).position_start(), i] = 1.0
-    to_ghost = builder.AddNamedSystem("attractor_to_robot", MatrixGain(select))
+    positions = JointStateSelector(ghost, mobee.joints)[:ghost.num_positions(), :len(mobee.joints)]
+    to_ghost = builder.AddNamedSystem("attractor_to_robot", MatrixGain(positions))
     to_pose = builder.AddNamedSystem("attractor_pose", MultibodyPositionToGeometryPose(ghost))
     builder.Connect(attractor, to_ghost.get_input_port())
     builder.Connect(to_ghost.get_output_port(), to_pose.get_input_port())
