@@ -5,18 +5,19 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import Frame, JacobianWrtVariable
 
 
-def ProjectPointForces(plant: MultibodyPlant, plant_context, frame_B: Frame, p_BP: np.ndarray,
-                       f_W: np.ndarray) -> np.ndarray:
-    """Returns ``sum_i J_i^T f_W[i]`` for forces at points ``p_BP[i]`` fixed in ``frame_B``.
+class PointForceProjector:
+    """``J^T f`` for a force ``f`` (world frame) at a point fixed in a frame of ``plant``.
 
-    ``J_i`` is the translational Jacobian of point i (world frame, with respect to all of the
-    plant's velocities). All points of one frame share one Jacobian computation.
-
-    Args:
-        p_BP: (k, 3) points in frame B.
-        f_W: (k, 3) forces in world.
+    ``J`` is the point's translational Jacobian in world with respect to all of the plant's
+    velocities; the result is a generalized force over the plant's velocities.
     """
-    world = plant.world_frame()
-    J = plant.CalcJacobianTranslationalVelocity(
-        plant_context, JacobianWrtVariable.kV, frame_B, p_BP.T, world, world)
-    return f_W.ravel() @ J
+
+    def __init__(self, plant: MultibodyPlant):
+        self._world = plant.world_frame()
+        self._jacobian = plant.CalcJacobianTranslationalVelocity
+
+    def __call__(self, plant_context, frame_F: Frame, p_FP: np.ndarray,
+                 f_W: np.ndarray) -> np.ndarray:
+        J = self._jacobian(plant_context, JacobianWrtVariable.kV, frame_F, p_FP, self._world,
+                           self._world)
+        return f_W @ J

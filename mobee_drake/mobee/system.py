@@ -17,7 +17,7 @@ from mobee_drake.mobee.fields import (
 )
 from mobee_drake.mobee.joint_limits import JointLimits
 from mobee_drake.mobee.params import MobeeParams
-from mobee_drake.mobee.projection import ProjectPointForces
+from mobee_drake.mobee.projection import PointForceProjector
 from mobee_drake.mobee.squash import Squash
 from mobee_drake.robots.overlay import RobotOverlay
 
@@ -118,6 +118,7 @@ class Mobee(LeafSystem):
         self._max_margin = max(self._margins.values(), default=0.0)
         self._geometry_names = dict(robot.geometry_names)
         self._geometry_frames = {g: plant.get_frame(f) for g, f in robot.geometry_frames.items()}
+        self._project = PointForceProjector(plant)
         self._markers = robot.markers
         self._marker_bodies = [plant.GetBodyByName(m.body_name, robot.instance)
                                for m in self._markers]
@@ -311,20 +312,13 @@ class Mobee(LeafSystem):
         """
         f_W = (self._params.collision_gain * (pairs.margin - pairs.distance))[:, None] \
             * pairs.nhat_BA_W
-        geometries = pairs.geometry_A
-        if pairs.b_is_robot.any():  # A self-collision pushes both bodies apart.
-            mine = np.flatnonzero(pairs.b_is_robot)
-            geometries = geometries + [pairs.geometry_B[i] for i in mine]
-            p_G = np.vstack((pairs.p_ACa, pairs.p_BCb[mine]))
-            f_W = np.vstack((f_W, -f_W[mine]))
-        else:
-            p_G = pairs.p_ACa
-        rows: dict = {}  # The points on each geometry share one Jacobian.
-        for i, g in enumerate(geometries):
-            rows.setdefault(g, []).append(i)
-        generalized = sum(
-            ProjectPointForces(self._plant, plant_context, self._geometry_frames[g], p_G[r], f_W[r])
-            for g, r in rows.items())
+        project, frames = self._project, self._geometry_frames
+        generalized = np.zeros(self._plant.num_velocities())
+        for g, p_GC, f in zip(pairs.geometry_A, pairs.p_ACa, f_W):
+            generalized += project(plant_context, frames[g], p_GC, f)
+        for i in np.flatnonzero(pairs.b_is_robot):  # A self-collision pushes both bodies apart.
+            generalized -= project(plant_context, frames[pairs.geometry_B[i]], pairs.p_BCb[i],
+                                   f_W[i])
         return generalized[self._v_index]
 
     def _CalcForces(self, context, value) -> None:
@@ -361,9 +355,9 @@ class Mobee(LeafSystem):
             loaded = np.flatnonzero(np.any(f_m != 0.0, axis=1))
             if loaded.size:
                 plant_context = self._plant_context_entry.Eval(context)
-                generalized = sum(ProjectPointForces(
-                    self._plant, plant_context, self._marker_bodies[i].body_frame(),
-                    self._markers[i].p_BM[None, :], f_m[i][None, :]) for i in loaded)
+                generalized = sum(self._project(plant_context,
+                                                self._marker_bodies[i].body_frame(),
+                                                self._markers[i].p_BM, f_m[i]) for i in loaded)
                 terms[6] = Squash(generalized[self._v_index], p.work_squash.m, p.work_squash.k)
 
     def _CalcMarkerPoses(self, context, value) -> None:
