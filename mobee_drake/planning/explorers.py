@@ -1,0 +1,81 @@
+"""Agents that explore a state-action space (dissertation Alg. 8, ch. 7.2.1).
+
+- ``curious`` (AC, Alg. 8): transition counts initialised optimistically (each action observed
+  once failing, leaving the agent where it was, and once succeeding; the 60-40 initialisation of
+  Table 7.1 observes one more success), intrinsic reward = the last observation's information gain
+  (Alg. 6), value iteration (Alg. 7) after every action, greedy on V(s, a).
+- ``random`` (RAND): a uniformly random action of the current state.
+- ``least_tried`` (LT): the action of the current state tried least often, random among ties.
+
+Every agent draws from its own seeded generator; ties of the greedy choice are broken at random
+too, so a run is reproducible from its seed.
+"""
+
+import dataclasses as dc
+
+import numpy as np
+
+from mobee_drake.planning.curiosity import TransitionCounts
+from mobee_drake.planning.state_space import StateActionSpace
+from mobee_drake.planning.value_iteration import ValueIteration
+
+STRATEGIES = ("curious", "random", "least_tried")
+INITIALIZATIONS = {"50-50": 1, "60-40": 2}  # successes observed after the one failure
+
+
+@dc.dataclass
+class ExplorerConfig:
+    strategy: str = "curious"
+    # "50-50" (Table 6.1) or "60-40" (Table 7.1).
+    initialization: str = "50-50"
+    gamma: float = 0.9
+    delta: float = 1e-3
+    seed: int = 0
+
+
+class Explorer:
+    """One agent exploring one state-action space."""
+
+    def __init__(self, space: StateActionSpace, config: ExplorerConfig | None = None):
+        config = config or ExplorerConfig()
+        if config.strategy not in STRATEGIES:
+            raise ValueError(f"unknown strategy '{config.strategy}'; strategies are "
+                             + ", ".join(STRATEGIES))
+        if config.initialization not in INITIALIZATIONS:
+            raise ValueError(f"unknown initialization '{config.initialization}'; use "
+                             + " or ".join(INITIALIZATIONS))
+        self.space, self.config = space, config
+        self.rng = np.random.default_rng(config.seed)
+        self.transitions = TransitionCounts(space.num_state_actions, space.num_states)
+        self.rewards = np.zeros(space.num_state_actions)
+        self.tries = np.zeros(space.num_state_actions, dtype=int)
+        for sa, (s, g) in enumerate(zip(space.action_state, space.action_goal)):
+            self.rewards[sa] = self.transitions.Observe(sa, s)
+            for _ in range(INITIALIZATIONS[config.initialization]):
+                self.rewards[sa] = self.transitions.Observe(sa, g)
+
+    def Values(self) -> tuple[np.ndarray, np.ndarray]:
+        """V(s, a) and V(s) by value iteration on the current model (Alg. 7)."""
+        return ValueIteration(self.transitions.Probabilities(), self.rewards,
+                              self.space.action_state, self.space.num_states,
+                              self.config.gamma, self.config.delta)
+
+    def ChooseAction(self, state: int) -> int:
+        """The state-action to try next from ``state``."""
+        actions = self.space.Actions(state)
+        if len(actions) == 0:
+            raise ValueError(f"state {state} has no actions")
+        if self.config.strategy == "random":
+            return int(self.rng.choice(actions))
+        if self.config.strategy == "least_tried":
+            scores = -self.tries[actions].astype(float)
+        else:
+            scores = self.Values()[0][actions]
+        best = actions[np.flatnonzero(scores >= scores.max() - 1e-12)]
+        return int(self.rng.choice(best))
+
+    def Observe(self, state_action: int, outcome: int) -> float:
+        """Records the outcome of a tried state-action; returns the intrinsic reward (Alg. 6)."""
+        self.tries[state_action] += 1
+        self.rewards[state_action] = self.transitions.Observe(state_action, outcome)
+        return self.rewards[state_action]

@@ -1,0 +1,163 @@
+"""The curious MDP planner's core against the dissertation's tables and closed forms."""
+
+import unittest
+
+import numpy as np
+
+from mobee_drake.planning.curiosity import KlDivergence, TransitionCounts
+from mobee_drake.planning.explorers import Explorer, ExplorerConfig
+from mobee_drake.planning.state_space import FromSamples, Lattice
+from mobee_drake.planning.value_iteration import ValueIteration
+
+
+class TestKlDivergence(unittest.TestCase):
+    def test_uniform_initialisation_examples(self):
+        # Eq. 6.6-6.9 (unnormalised counts, normalised before the divergence).
+        self.assertAlmostEqual(KlDivergence([1, 2, 1], [1, 1, 1]), 0.0589, places=4)
+        self.assertAlmostEqual(KlDivergence([2, 1, 1], [1, 1, 1]), 0.0589, places=4)
+        self.assertAlmostEqual(KlDivergence([1, 1, 2, 1, 1], [1] * 5), 0.0487, places=4)
+        self.assertAlmostEqual(KlDivergence([1, 1, 1, 2, 1, 1, 1], [1] * 7), 0.0398, places=4)
+
+
+class TestObserve(unittest.TestCase):
+    """Alg. 6 on one state-action with goal state g = 1, from state i = 0."""
+
+    def _Run(self, outcomes):
+        counts = TransitionCounts(1, 10)
+        return [round(counts.Observe(0, s), 4) for s in outcomes], counts
+
+    def test_table_6_1_initialisation(self):
+        rewards, counts = self._Run([0, 1])
+        self.assertEqual(rewards, [0.0, 0.0589])
+        np.testing.assert_array_equal(counts.counts[0, :2], [2, 2])
+
+    def test_table_7_1_sixty_forty(self):
+        rewards, counts = self._Run([0, 1, 1])
+        self.assertEqual(rewards, [0.0, 0.0589, 0.0201])
+        np.testing.assert_allclose(counts.Probabilities()[0, :2], [0.4, 0.6])
+
+    def test_table_6_2_predictable_success(self):
+        rewards, _ = self._Run([0, 1, 1, 1, 1])
+        self.assertEqual(rewards[1:], [0.0589, 0.0201, 0.0095, 0.0052])
+
+    def test_table_6_3_surprising_outcome(self):
+        rewards, _ = self._Run([0, 1, 5, 5, 5])
+        self.assertEqual(rewards[1:], [0.0589, 0.0487, 0.0196, 0.0103])
+
+    def test_table_6_4_unpredictable(self):
+        a, b, c, g = 5, 6, 7, 1
+        rewards, _ = self._Run([0, g, a, b, c, g, a, b])
+        # The first two rows follow Alg. 6, D(P || T), like every other table ...
+        self.assertEqual(rewards[1:3], [0.0589, 0.0487])
+        # ... the later rows were printed with the arguments swapped, D(T || P): each printed
+        # value is that of the swapped divergence of the printed T and P, to four decimals, and
+        # Alg. 6 gives what it says instead.
+        printed = [  # (T, P, R) of Table 6.4, rows 3-7
+            ([2, 2, 2, 1], [2, 2, 2, 2], 0.0345), ([2, 2, 2, 2, 1], [2, 2, 2, 2, 2], 0.0283),
+            ([2, 2, 2, 2, 2], [2, 3, 2, 2, 2], 0.0142), ([2, 3, 2, 2, 2], [2, 3, 3, 2, 2], 0.0133),
+            ([2, 3, 3, 2, 2], [2, 3, 3, 3, 2], 0.0125)]
+        for (t, p, r), ours in zip(printed, rewards[3:]):
+            self.assertAlmostEqual(KlDivergence(t, p), r, delta=1e-4)
+            self.assertEqual(ours, round(KlDivergence(p, t), 4))
+
+
+class TestStateActionSpaces(unittest.TestCase):
+    def test_sizes_of_the_dissertation_spaces(self):
+        cases = [
+            (Lattice([0.25, 0.75], 4), 16, 64),
+            (Lattice([0.25, 0.5, 0.75], 4), 81, 432),
+            (Lattice([0.25, 0.5, 0.75], 4, k=16), 81, 1296),
+            (Lattice([0.2, 0.4, 0.6, 0.8], 4), 256, 1536),
+            (Lattice([0.125, 0.375, 0.625, 0.875], 4), 256, 1536),
+            (Lattice([0.25, 0.5, 0.75], 3, k=8), 27, 216),
+        ]
+        for space, states, state_actions in cases:
+            self.assertEqual((space.num_states, space.num_state_actions),
+                             (states, state_actions))
+
+    def test_equidistant_neighbours_of_the_rank_3_lattice(self):
+        space = Lattice([0.25, 0.5, 0.75], 4)
+        counts = np.bincount(space.action_state)
+        self.assertEqual((counts.min(), counts.max()), (4, 8))  # corners 4, centre 8
+        centre = space.StateOf(np.full(4, 0.5))
+        goals = space.action_goal[space.Actions(centre)]
+        np.testing.assert_allclose(np.abs(space.centres[goals] - 0.5).sum(axis=1), 0.25)
+
+    def test_state_lookup_is_the_nearest_centre(self):
+        space = FromSamples(np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]]))
+        self.assertEqual(space.StateOf(np.array([0.6, 0.1])), 1)
+        self.assertEqual(space.StateOf(np.array([0.1, 0.4])), 0)
+        with self.assertRaisesRegex(ValueError, "samples must be"):
+            FromSamples(np.array([0.0, 1.0]))
+
+
+class TestValueIteration(unittest.TestCase):
+    def test_closed_form_of_a_deterministic_cycle(self):
+        # Two states, one action each, going to the other state; rewards 1 and 0.
+        # V0 = 1 + g V1, V1 = g V0  =>  V0 = 1 / (1 - g^2), V1 = g / (1 - g^2).
+        gamma = 0.9
+        T = np.array([[0.0, 1.0], [1.0, 0.0]])
+        q, v = ValueIteration(T, np.array([1.0, 0.0]), np.array([0, 1]), 2, gamma, delta=1e-12)
+        np.testing.assert_allclose(v, [1 / (1 - gamma**2), gamma / (1 - gamma**2)], rtol=1e-9)
+        np.testing.assert_allclose(q, v)
+
+    def test_max_over_actions_and_stochastic_outcomes(self):
+        # State 0 has two actions: a sure reward 1 staying put, or 50 % to reach the goal state 1
+        # (absorbing, reward 2). V1 = 2 / (1 - g); the second action is worth 0.5 g (V0 + V1).
+        gamma = 0.5
+        T = np.array([[1.0, 0.0], [0.5, 0.5], [0.0, 1.0]])
+        R = np.array([1.0, 0.0, 2.0])
+        q, v = ValueIteration(T, R, np.array([0, 0, 1]), 2, gamma, delta=1e-12)
+        v1 = 2 / (1 - gamma)
+        v0 = max(1 / (1 - gamma), 0.5 * gamma * v1 / (1 - 0.5 * gamma))
+        np.testing.assert_allclose(v, [v0, v1], rtol=1e-9)
+
+    def test_stops_at_delta(self):
+        T = np.array([[1.0]])
+        q, _ = ValueIteration(T, np.array([1.0]), np.array([0]), 1, 0.9, delta=1e-3)
+        # The geometric series to 10 stops once a sweep adds less than 1e-3.
+        self.assertLess(10 - q[0], 1e-3 / (1 - 0.9) + 1e-12)
+        self.assertGreater(10 - q[0], 0)
+
+
+class TestExplorers(unittest.TestCase):
+    def _Explore(self, strategy, steps, seed=0, fail=()):
+        """Explores the hypercube in a world where the state-actions in ``fail`` stay put."""
+        space = Lattice([0.25, 0.75], 4)
+        agent = Explorer(space, ExplorerConfig(strategy=strategy, seed=seed))
+        state, first_tried = 0, {}
+        for step in range(steps):
+            sa = agent.ChooseAction(state)
+            outcome = state if sa in fail else int(space.action_goal[sa])
+            agent.Observe(sa, outcome)
+            first_tried.setdefault(sa, step)
+            state = outcome
+        return agent, first_tried
+
+    def test_curious_agent_tries_everything_and_prefers_failing_actions(self):
+        agent, first = self._Explore("curious", 400, fail={5})
+        self.assertEqual(len(first), 64)
+        # A surprising state-action stays more interesting: it is tried more than the median.
+        self.assertGreater(agent.tries[5], np.median(agent.tries))
+
+    def test_same_seed_same_run(self):
+        a, _ = self._Explore("curious", 100, seed=3)
+        b, _ = self._Explore("curious", 100, seed=3)
+        np.testing.assert_array_equal(a.tries, b.tries)
+
+    def test_least_tried_breaks_ties_at_random_and_covers(self):
+        agent, first = self._Explore("least_tried", 300)
+        self.assertEqual(len(first), 64)
+        agent, _ = self._Explore("random", 50)
+        self.assertEqual(agent.tries.sum(), 50)
+
+    def test_bad_configuration(self):
+        space = Lattice([0.25, 0.75], 2)
+        with self.assertRaisesRegex(ValueError, "unknown strategy 'bold'"):
+            Explorer(space, ExplorerConfig(strategy="bold"))
+        with self.assertRaisesRegex(ValueError, "unknown initialization '70-30'"):
+            Explorer(space, ExplorerConfig(initialization="70-30"))
+
+
+if __name__ == "__main__":
+    unittest.main()
