@@ -159,5 +159,77 @@ class TestExplorers(unittest.TestCase):
             Explorer(space, ExplorerConfig(initialization="70-30"))
 
 
+class TestSupervisor(unittest.TestCase):
+    """The exploration loop as a Drake system, with the robot state fixed by the test."""
+
+    def _Dut(self, **timing):
+        from mobee_drake.planning.supervisor import ActionTiming, Agent, ExplorationSupervisor
+
+        space = Lattice([0.25, 0.75], 2)
+        agent = Agent(name="arm", joints=["b", "c"], space=space)
+        dut = ExplorationSupervisor(
+            agents=[agent], joints=["a", "b", "c"], lower=np.array([-1.0, 0.0, 0.0]),
+            upper=np.array([1.0, 2.0, 4.0]), home=np.array([0.5, 0.5, 1.0]),
+            timing=ActionTiming(**timing), period=0.2)
+        return dut, space
+
+    def test_an_action_runs_until_the_robot_settles(self):
+        dut, space = self._Dut(settle_time=0.5, min_duration=0.5, timeout=20.0)
+        context = dut.CreateDefaultContext()
+        # The robot at the centre of state 0: b = 0.5 (25 % of [0, 2]), c = 1 (25 % of [0, 4]).
+        q = np.array([0.3, 0.5, 1.0])
+        dut.GetInputPort("robot_state").FixValue(context, np.concatenate([q, np.zeros(3)]))
+        dut.ExecuteInitializationEvents(context)
+        (record,) = dut.Records(context)
+        self.assertEqual(record.state, 0)
+        goal = space.action_goal[record.state_action]
+        expected = np.array([0.5, *(np.array([0, 0]) + space.centres[goal] * [2, 4])])
+        np.testing.assert_allclose(dut.get_output_port().Eval(context), expected)
+        # Polling while the robot is still: the action ends 0.5 s after it started being still.
+        times = [0.2, 0.4, 0.6, 0.8]
+        done = []
+        for t in times:
+            context.SetTime(t)
+            state = context.get_mutable_state()
+            dut.CalcForcedUnrestrictedUpdate(context, state)
+            done.append(dut.Records(context)[0].actions_done)
+        self.assertEqual(done, [0, 0, 0, 1])  # slow since 0.2 s, settled at 0.7 s or later
+        # The robot never moved: the action failed, and the agent observed state 0 again.
+        counts = dut.Records(context)[0].explorer.transitions.counts[record.state_action]
+        self.assertEqual(counts[0], 3)  # the initialisation's failure, plus this one
+        self.assertEqual(dut.Records(context)[0].explorer.tries[record.state_action], 1)
+
+    def test_timeout_and_polling_copies_nothing(self):
+        import copy
+
+        dut, _ = self._Dut(timeout=1.0)
+        context = dut.CreateDefaultContext()
+        moving = np.concatenate([[0.3, 0.5, 1.0], [0.0, 1.0, 0.0]])
+        dut.GetInputPort("robot_state").FixValue(context, moving)
+        dut.ExecuteInitializationEvents(context)
+        record = dut.Records(context)[0]
+        self.assertIs(copy.deepcopy(record), record)
+        for t in (0.2, 0.4, 0.6, 0.8):
+            context.SetTime(t)
+            dut.CalcForcedUnrestrictedUpdate(context, context.get_mutable_state())
+            self.assertIs(dut.Records(context)[0], record)  # nothing changed, nothing built
+        context.SetTime(1.0)
+        dut.CalcForcedUnrestrictedUpdate(context, context.get_mutable_state())
+        self.assertEqual(dut.Records(context)[0].actions_done, 1)  # timed out while moving
+
+    def test_bad_agents(self):
+        from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
+
+        space = Lattice([0.25, 0.75], 2)
+        kwargs = dict(joints=["a", "b"], lower=np.zeros(2), upper=np.ones(2), home=np.zeros(2))
+        with self.assertRaisesRegex(ValueError, "agent 'x': unknown joints \\['z'\\]"):
+            ExplorationSupervisor(agents=[Agent("x", ["a", "z"], space)], **kwargs)
+        with self.assertRaisesRegex(ValueError, "share a joint"):
+            ExplorationSupervisor(agents=[Agent("x", ["a", "b"], space),
+                                          Agent("y", ["b", "a"], space)], **kwargs)
+        with self.assertRaisesRegex(ValueError, "2 dimensions for 1 joints"):
+            ExplorationSupervisor(agents=[Agent("x", ["a"], space)], **kwargs)
+
+
 if __name__ == "__main__":
     unittest.main()

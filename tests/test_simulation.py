@@ -337,6 +337,31 @@ class TestLiveWorld(unittest.TestCase):
         np.testing.assert_allclose(_Palm(simulation, simulator.get_context()), free[0], atol=1e-12)
 
 
+class TestExploration(unittest.TestCase):
+    def test_curious_agent_on_the_kinematic_robot(self):
+        scenario = LoadScenario(DIAGRAMS / "explore_hypercube.yaml", "{duration: 40}")
+        simulation = BuildSimulation(scenario)
+        simulator = Simulator(simulation.diagram)
+        simulator.Initialize()
+        simulator.AdvanceTo(scenario.duration)
+        context = simulator.get_context()
+        supervisor = simulation.diagram.GetSubsystemByName("attractor")
+        (record,) = supervisor.Records(supervisor.GetMyContextFromRoot(context))
+        explorer = record.explorer
+        self.assertGreaterEqual(record.actions_done, 4)
+        self.assertEqual(explorer.tries.sum(), record.actions_done)
+        # Without obstacles and inside the hypercube every action reaches its goal: each tried
+        # state-action's count of its goal grew by its tries (the initialisation put 1 there).
+        tried = np.flatnonzero(explorer.tries)
+        goals = explorer.space.action_goal[tried]
+        np.testing.assert_array_equal(explorer.transitions.counts[tried, goals],
+                                      2 + explorer.tries[tried])
+        # The attractor is the goal centre of the action in flight, inside the joint limits.
+        q_star = simulation.attractor.Eval(context)
+        lower, upper = simulation.mobee.position_limits
+        self.assertTrue(np.all((q_star >= lower) & (q_star <= upper)))
+
+
 class TestInteractive(unittest.TestCase):
     def test_sliders_move_the_attractor(self):
         from pydrake.geometry import Meshcat

@@ -11,6 +11,7 @@ Every agent draws from its own seeded generator; ties of the greedy choice are b
 too, so a run is reproducible from its seed.
 """
 
+import copy
 import dataclasses as dc
 
 import numpy as np
@@ -53,6 +54,14 @@ class Explorer:
             self.rewards[sa] = self.transitions.Observe(sa, s)
             for _ in range(INITIALIZATIONS[config.initialization]):
                 self.rewards[sa] = self.transitions.Observe(sa, g)
+
+    def Copy(self) -> "Explorer":
+        """An independent copy (model, tries and generator), sharing the space and config."""
+        twin = copy.copy(self)
+        twin.rng = copy.deepcopy(self.rng)
+        twin.transitions = copy.deepcopy(self.transitions)
+        twin.rewards, twin.tries = self.rewards.copy(), self.tries.copy()
+        return twin
 
     def Values(self) -> tuple[np.ndarray, np.ndarray]:
         """V(s, a) and V(s) by value iteration on the current model (Alg. 7)."""

@@ -43,12 +43,19 @@ from pydrake.systems.primitives import (
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
 from mobee_drake.mobee.system import Mobee
+from mobee_drake.planning.state_space import Lattice
+from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
 from mobee_drake.robots.assembly import JointStateSelector
 from mobee_drake.robots.icub import AddIcub
 from mobee_drake.robots.overlay import RobotOverlay
 from mobee_drake.simulation.attractors import RandomAttractorSource, SliderAttractorSource
 from mobee_drake.simulation.safety import SafetyMonitor
-from mobee_drake.simulation.scenario import FixedAttractor, Scenario, SliderAttractor
+from mobee_drake.simulation.scenario import (
+    ExploreAttractor,
+    FixedAttractor,
+    Scenario,
+    SliderAttractor,
+)
 from mobee_drake.simulation.virtual_dynamics import VirtualDynamics
 from mobee_drake.simulation.world import LiveWorld
 
@@ -80,9 +87,18 @@ class Simulation:
 
 
 def _AttractorSource(builder: DiagramBuilder, scenario: Scenario, mobee: Mobee,
-                     plant: MultibodyPlant, meshcat: Meshcat | None) -> OutputPort:
+                     robot_state: OutputPort, meshcat: Meshcat | None) -> OutputPort:
     lower, upper = mobee.position_limits
     program = scenario.attractor
+    if isinstance(program, ExploreAttractor):
+        agents = [Agent(name=a.name, joints=a.joints,
+                        space=Lattice(a.levels, len(a.joints), k=a.nearest or None),
+                        explorer=a.explorer) for a in program.agents]
+        supervisor = builder.AddNamedSystem("attractor", ExplorationSupervisor(
+            agents=agents, joints=mobee.joints, lower=lower, upper=upper, home=mobee.home,
+            timing=program.timing))
+        builder.Connect(robot_state, supervisor.GetInputPort("robot_state"))
+        return supervisor.get_output_port()
     if isinstance(program, SliderAttractor):
         if meshcat is None:
             raise ValueError("the slider attractor needs Meshcat (run with --meshcat)")
@@ -130,8 +146,6 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simul
     # unfixed, they are zero.
     builder.ExportInput(mobee.GetInputPort("config_force"), "config_force")
     builder.ExportInput(mobee.GetInputPort("marker_forces"), "marker_forces")
-    attractor = _AttractorSource(builder, scenario, mobee, plant, meshcat)
-    builder.Connect(attractor, mobee.GetInputPort("attractor"))
 
     _, damping, _ = scenario.mobee.PerJoint(joints)
     virtual = builder.AddNamedSystem("virtual_dynamics", VirtualDynamics(
@@ -183,6 +197,9 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simul
             builder.Connect(to_plant.get_output_port(), controller.get_input_port_desired_state())
         builder.Connect(controller.get_output_port_generalized_force(),
                         plant.get_applied_generalized_force_input_port())
+
+    attractor = _AttractorSource(builder, scenario, mobee, robot_state, meshcat)
+    builder.Connect(attractor, mobee.GetInputPort("attractor"))
 
     monitor = builder.AddNamedSystem("safety_monitor", SafetyMonitor(
         names=world.names, period=scenario.time_step))

@@ -10,6 +10,8 @@ import dataclasses as dc
 import pathlib
 
 from mobee_drake.mobee.params import MobeeParams
+from mobee_drake.planning.explorers import ExplorerConfig
+from mobee_drake.planning.supervisor import ActionTiming
 from mobee_drake.robots.icub import IcubConfig
 from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
 
@@ -77,6 +79,27 @@ class SliderAttractor:
 
 
 @dc.dataclass
+class ExploringAgent:
+    """A curious agent on some joints (dissertation ch. 6-7), its states a hyper-lattice."""
+
+    name: str = "agent"
+    joints: list[str] = dc.field(default_factory=list)
+    # The lattice's levels, in fractions of each joint's range (e.g. [0.25, 0.75]: a hypercube).
+    levels: list[float] = dc.field(default_factory=lambda: [0.25, 0.75])
+    # Actions to the k nearest states; 0: to the nearest equidistant ones.
+    nearest: int = 0
+    explorer: ExplorerConfig = dc.field(default_factory=ExplorerConfig)
+
+
+@dc.dataclass
+class ExploreAttractor:
+    """The attractor is set by exploring agents (Alg. 8), each on its own joints."""
+
+    agents: list[ExploringAgent] = dc.field(default_factory=list)
+    timing: ActionTiming = dc.field(default_factory=ActionTiming)
+
+
+@dc.dataclass
 class WorldEvent:
     """A scripted change of the world at a time: move an object or switch its role."""
 
@@ -117,7 +140,7 @@ class Scenario:
     # The dynamic robot's plant step (s).
     plant_time_step: float = 0.001
     duration: float = 10.0
-    attractor: FixedAttractor | RandomAttractors | SliderAttractor = dc.field(
+    attractor: FixedAttractor | RandomAttractors | SliderAttractor | ExploreAttractor = dc.field(
         default_factory=FixedAttractor)
     world_events: list[WorldEvent] = dc.field(default_factory=list)
     visualization: Visualization = dc.field(default_factory=Visualization)
