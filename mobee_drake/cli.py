@@ -21,6 +21,9 @@ def _Run(args: list[str]) -> None:
                         help="no viewer at all (fastest; implies --no-record)")
     parser.add_argument("--set", default=None,
                         help="YAML overrides of the scenario, e.g. '{robot_model: dynamic}'")
+    parser.add_argument("--checkpoint", default=None,
+                        help="a folder: resume from the checkpoint there, and save one after "
+                             "every completed action of the exploring agents")
     known = parser.parse_args(args)
 
     import pathlib
@@ -46,7 +49,8 @@ def _Run(args: list[str]) -> None:
         meshcat = StartMeshcat()
     try:
         summary = RunScenario(scenario, meshcat=meshcat, record=record,
-                              realtime_rate=1.0 if meshcat else 0.0, progress=True)
+                              realtime_rate=1.0 if meshcat else 0.0, progress=True,
+                              checkpoint=known.checkpoint)
     except ValueError as e:
         sys.exit(f"error: {known.scenario}: {e}")
     print(summary.Format())

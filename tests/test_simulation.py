@@ -5,12 +5,13 @@ import tempfile
 import unittest
 
 import numpy as np
-from pydrake.systems.analysis import Simulator
+from pydrake.systems.analysis import InitializeParams, Simulator
 
 from mobee_drake import cli
 from mobee_drake.mobee.fields import FieldPairs
 from mobee_drake.simulation.attractors import RandomAttractorSource
 from mobee_drake.simulation.builder import BuildSimulation
+from mobee_drake.simulation.checkpoint import LoadCheckpoint, SaveCheckpoint
 from mobee_drake.simulation.runner import Advance, RunScenario
 from mobee_drake.simulation.safety import SafetyMonitor
 from mobee_drake.simulation.scenario import LoadScenario, SceneObject, Sphere
@@ -360,6 +361,53 @@ class TestExploration(unittest.TestCase):
         q_star = simulation.attractor.Eval(context)
         lower, upper = simulation.mobee.position_limits
         self.assertTrue(np.all((q_star >= lower) & (q_star <= upper)))
+
+
+class TestCheckpoints(unittest.TestCase):
+    def test_resumed_run_equals_uninterrupted_run(self):
+        folder = pathlib.Path(tempfile.mkdtemp())
+        scenario = LoadScenario(DIAGRAMS / "explore_hypercube.yaml", "{duration: 30}")
+
+        def Final(simulation, simulator):
+            context = simulator.get_context()
+            supervisor = simulation.diagram.GetSubsystemByName("attractor")
+            (record,) = supervisor.Records(supervisor.GetMyContextFromRoot(context))
+            return (simulation.robot_state.Eval(context).copy(), record.explorer.tries.copy(),
+                    record.explorer.transitions.counts.copy(), record.state_action)
+
+        # Uninterrupted: 0 to 30 s.
+        simulation = BuildSimulation(scenario)
+        simulator = Simulator(simulation.diagram)
+        simulator.Initialize()
+        simulator.AdvanceTo(30.0)
+        expected = Final(simulation, simulator)
+
+        # Interrupted at 12.34 s (in the middle of an action), saved, resumed in a new diagram.
+        first = BuildSimulation(scenario)
+        simulator = Simulator(first.diagram)
+        simulator.Initialize()
+        simulator.AdvanceTo(12.34)
+        SaveCheckpoint(first, simulator.get_context(), folder / "run")
+        second = BuildSimulation(scenario)
+        simulator = Simulator(second.diagram)
+        LoadCheckpoint(second, simulator.get_mutable_context(), folder / "run")
+        simulator.Initialize(InitializeParams(suppress_initialization_events=True))
+        simulator.AdvanceTo(30.0)
+        for a, b in zip(expected, Final(second, simulator)):
+            np.testing.assert_array_equal(a, b)
+        self.assertTrue((folder / "run" / "right_arm.npz").is_file())
+
+    def test_runner_saves_after_actions_and_resumes(self):
+        folder = pathlib.Path(tempfile.mkdtemp()) / "run"
+        scenario = LoadScenario(DIAGRAMS / "explore_hypercube.yaml", "{duration: 20}")
+        first = RunScenario(scenario, checkpoint=str(folder))
+        self.assertAlmostEqual(first.simulated_time, 20.0)
+        scenario.duration = 30.0
+        second = RunScenario(scenario, checkpoint=str(folder))  # resumes at 20 s
+        self.assertAlmostEqual(second.simulated_time, 10.0)
+        other = BuildSimulation(LoadScenario(REACH, "{robot_model: dynamic}"))
+        with self.assertRaisesRegex(ValueError, "no saved state for 'plant'"):
+            LoadCheckpoint(other, other.diagram.CreateDefaultContext(), folder)
 
 
 class TestInteractive(unittest.TestCase):

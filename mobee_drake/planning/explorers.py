@@ -88,3 +88,26 @@ class Explorer:
         self.tries[state_action] += 1
         self.rewards[state_action] = self.transitions.Observe(state_action, outcome)
         return self.rewards[state_action]
+
+
+def ExplorerToArrays(explorer: Explorer) -> tuple[dict[str, np.ndarray], dict]:
+    """The learned model as arrays (counts, rewards, tries, the space) and the rest as JSON-able
+    data (configuration, generator state), for saving and exact resuming."""
+    space = explorer.space
+    arrays = dict(counts=explorer.transitions.counts, rewards=explorer.rewards,
+                  tries=explorer.tries, centres=space.centres, action_state=space.action_state,
+                  action_goal=space.action_goal)
+    return arrays, dict(config=dc.asdict(explorer.config),
+                        generator=explorer.rng.bit_generator.state)
+
+
+def ExplorerFromArrays(arrays, data: dict) -> Explorer:
+    """The inverse of :func:`ExplorerToArrays`."""
+    space = StateActionSpace(np.asarray(arrays["centres"]), np.asarray(arrays["action_state"]),
+                             np.asarray(arrays["action_goal"]))
+    explorer = Explorer(space, ExplorerConfig(**data["config"]))
+    explorer.transitions.counts[...] = arrays["counts"]
+    explorer.rewards[...] = arrays["rewards"]
+    explorer.tries[...] = arrays["tries"]
+    explorer.rng.bit_generator.state = data["generator"]
+    return explorer

@@ -167,3 +167,13 @@ class ExplorationSupervisor(LeafSystem):
     def Records(self, context) -> tuple[AgentRecord, ...]:
         """The agents' records in ``context`` (this system's context)."""
         return context.get_abstract_state(int(self._records)).get_value()
+
+    def SetRecords(self, context, records: tuple[AgentRecord, ...]) -> None:
+        """Replaces the agents' records in ``context`` (to resume a saved run)."""
+        if len(records) != len(self._agents):
+            raise ValueError(f"{len(records)} saved agents for {len(self._agents)} agents")
+        context.get_mutable_abstract_state(int(self._records)).set_value(tuple(records))
+
+    @property
+    def agent_names(self) -> list[str]:
+        return [agent.name for agent in self._agents]

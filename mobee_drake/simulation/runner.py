@@ -6,9 +6,11 @@ import pathlib
 import time
 
 from pydrake.geometry import Meshcat
-from pydrake.systems.analysis import Simulator
+from pydrake.systems.analysis import InitializeParams, Simulator
 
+from mobee_drake.planning.supervisor import ExplorationSupervisor
 from mobee_drake.simulation.builder import BuildSimulation, Simulation
+from mobee_drake.simulation.checkpoint import LoadCheckpoint, SaveCheckpoint
 from mobee_drake.simulation.safety import SafetyReport
 from mobee_drake.simulation.scenario import Scenario
 
@@ -45,8 +47,11 @@ def _WriteAtomically(path: pathlib.Path, text: str) -> None:
 
 
 def Advance(simulation: Simulation, simulator: Simulator, until: float, *,
-            progress: bool = False) -> None:
+            progress: bool = False, after_chunk=None) -> None:
     """Advances to ``until``, applying the scenario's world events whose time is in [now, until).
+
+    ``after_chunk(context)``, if given, is called after each of the (at most 500) chunks the run is
+    advanced in: the progress bar's and the checkpoints' occasions.
     """
     context = simulator.get_mutable_context()
     start = context.get_time()
@@ -71,23 +76,55 @@ def Advance(simulation: Simulation, simulator: Simulator, until: float, *,
         simulator.AdvanceTo(target)
         if bar is not None:
             bar.update(round(context.get_time() - before, 3))
+        if after_chunk is not None:
+            after_chunk(context)
     if bar is not None:
         bar.close()
 
 
+def _ActionsDone(simulation: Simulation, context) -> int:
+    """How many actions the exploring agents have completed (0 without agents)."""
+    supervisor = simulation.diagram.GetSubsystemByName("attractor")
+    if not isinstance(supervisor, ExplorationSupervisor):
+        return 0
+    return sum(r.actions_done for r in supervisor.Records(supervisor.GetMyContextFromRoot(context)))
+
+
 def RunScenario(scenario: Scenario, *, meshcat: Meshcat | None = None, record: str | None = None,
-                realtime_rate: float = 0.0, progress: bool = False) -> RunSummary:
-    """Runs ``scenario`` for its duration; with ``record`` saves a Meshcat recording (HTML)."""
+                realtime_rate: float = 0.0, progress: bool = False,
+                checkpoint: str | None = None) -> RunSummary:
+    """Runs ``scenario`` until its duration; with ``record`` saves a Meshcat recording (HTML).
+
+    With ``checkpoint`` (a folder), a run resumes from the checkpoint there if there is one, and
+    saves one whenever an exploring agent has completed an action (and at the end), so that an
+    interrupted run loses at most the actions in flight.
+    """
     if record and meshcat is None:
         meshcat = Meshcat()
     simulation = BuildSimulation(scenario, meshcat)
     simulator = Simulator(simulation.diagram)
     simulator.set_target_realtime_rate(realtime_rate)
-    simulator.Initialize()
+    context = simulator.get_mutable_context()
+    if checkpoint and (pathlib.Path(checkpoint) / "simulation.npz").is_file():
+        LoadCheckpoint(simulation, context, checkpoint)
+        simulator.Initialize(InitializeParams(suppress_initialization_events=True))
+    else:
+        simulator.Initialize()
     if record:
         simulation.visualizer.StartRecording()
+    saved = [_ActionsDone(simulation, context)]
+
+    def AfterChunk(context):
+        done = _ActionsDone(simulation, context)
+        if checkpoint and done > saved[0]:
+            SaveCheckpoint(simulation, context, checkpoint)
+            saved[0] = done
+
     start = time.perf_counter()
-    Advance(simulation, simulator, scenario.duration, progress=progress)
+    simulated_before = context.get_time()
+    Advance(simulation, simulator, scenario.duration, progress=progress, after_chunk=AfterChunk)
+    if checkpoint:
+        SaveCheckpoint(simulation, context, checkpoint)
     wall = time.perf_counter() - start
     context = simulator.get_context()
     recording = None
@@ -98,5 +135,5 @@ def RunScenario(scenario: Scenario, *, meshcat: Meshcat | None = None, record: s
         _WriteAtomically(path, meshcat.StaticHtml())
         recording = str(path.resolve())
     report = simulation.monitor.Report(simulation.monitor.GetMyContextFromRoot(context))
-    return RunSummary(simulated_time=context.get_time(), wall_time=wall, safety=report,
-                      recording=recording)
+    return RunSummary(simulated_time=context.get_time() - simulated_before, wall_time=wall,
+                      safety=report, recording=recording)
