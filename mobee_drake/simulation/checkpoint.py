@@ -6,7 +6,8 @@ run recorded with Meshcat can resume headless and back) and, when agents explore
 ``<agent>.npz`` (the learned model: counts, rewards, tries, the state-action space) with
 ``<agent>.json`` (its configuration, its generator's state and the action in flight). The
 folder is written next to its destination and renamed into place, so a crash never leaves a
-half-written checkpoint, and loading it into the same scenario continues the run exactly where it was saved.
+half-written checkpoint, and loading it into the same scenario continues the run exactly where
+it was saved.
 """
 
 import dataclasses as dc
