@@ -159,6 +159,31 @@ class TestExplorers(unittest.TestCase):
             Explorer(space, ExplorerConfig(initialization="70-30"))
 
 
+class TestPlanner(unittest.TestCase):
+    def test_plans_around_an_action_that_fails(self):
+        from mobee_drake.planning.planner import GreedyPlan
+
+        # A 3 x 3 lattice (states 0..8, row-major in the first coordinate); the direct step from
+        # the middle-left state 3 to the centre 4 was always seen to fail (e.g. an obstacle).
+        space = Lattice([0.0, 0.5, 1.0], 2)
+        agent = Explorer(space, ExplorerConfig(seed=0))
+        for sa, (s, g) in enumerate(zip(space.action_state, space.action_goal)):
+            blocked = (s, g) == (3, 4)
+            for _ in range(10):
+                agent.Observe(sa, s if blocked else g)
+        path = GreedyPlan(agent, start=3, goal=5)
+        self.assertEqual((path[0], path[-1]), (3, 5))
+        self.assertNotIn((3, 4), list(zip(path, path[1:])))
+        self.assertEqual(len(path), 5)  # a detour of four steps instead of two
+
+    def test_unknown_goal(self):
+        from mobee_drake.planning.planner import PlanValues
+
+        agent = Explorer(Lattice([0.0, 1.0], 1))
+        with self.assertRaisesRegex(ValueError, "goal state 7 is not a state"):
+            PlanValues(agent, {7: 1.0})
+
+
 class TestSupervisor(unittest.TestCase):
     """The exploration loop as a Drake system, with the robot state fixed by the test."""
 

@@ -363,6 +363,25 @@ class TestExploration(unittest.TestCase):
         self.assertTrue(np.all((q_star >= lower) & (q_star <= upper)))
 
 
+class TestSeveralAgents(unittest.TestCase):
+    def test_three_agents_explore_in_parallel(self):
+        scenario = LoadScenario(DIAGRAMS / "three_agents_table.yaml", "{duration: 20}")
+        simulation = BuildSimulation(scenario)
+        simulator = Simulator(simulation.diagram)
+        simulator.Initialize()
+        simulator.AdvanceTo(scenario.duration)
+        context = simulator.get_context()
+        supervisor = simulation.diagram.GetSubsystemByName("attractor")
+        records = supervisor.Records(supervisor.GetMyContextFromRoot(context))
+        self.assertEqual(supervisor.agent_names, ["right_arm", "left_arm", "torso"])
+        self.assertEqual([r.explorer.space.num_state_actions for r in records], [1296, 1296, 216])
+        self.assertTrue(all(r.actions_done >= 2 for r in records))
+        # Each agent sets the attractor of its own joints only: the neck stays at home.
+        q_star = simulation.attractor.Eval(context)
+        neck = [simulation.mobee.joint_index(j) for j in ("neck_pitch", "neck_roll", "neck_yaw")]
+        np.testing.assert_array_equal(q_star[neck], simulation.mobee.home[neck])
+
+
 class TestCheckpoints(unittest.TestCase):
     def test_resumed_run_equals_uninterrupted_run(self):
         folder = pathlib.Path(tempfile.mkdtemp())
