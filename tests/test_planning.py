@@ -256,5 +256,27 @@ class TestSupervisor(unittest.TestCase):
             ExplorationSupervisor(agents=[Agent("x", ["a"], space)], **kwargs)
 
 
+
+class TestExperimentsSmoke(unittest.TestCase):
+    """The ch. 7 experiment scripts on tiny budgets: they run the robot and write their files."""
+
+    def test_coverage_and_three_agents(self):
+        import pathlib
+        import tempfile
+
+        from mobee_drake.planning import experiments
+
+        output = pathlib.Path(tempfile.mkdtemp())
+        experiments.main(["--experiment", "7.2", "--output", str(output), "--runs", "1",
+                          "--transitions", "3"])
+        for strategy in ("curious", "random", "least_tried"):
+            self.assertTrue((output / f"7.2_{strategy}_run0.json").is_file())
+        self.assertTrue((output / "7.2_coverage.png").is_file())
+        experiments.main(["--experiment", "7.4", "--output", str(output), "--transitions", "6"])
+        report = (output / "report_7.4.md").read_text()
+        self.assertIn("correlation of the right and the left arm", report)
+        self.assertTrue((output / "7.4_three_agents.png").is_file())
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -1,0 +1,224 @@
+"""The model-learning experiments of dissertation ch. 7, on the kinematic iCub.
+
+- ``7.1``: the right arm's shoulder-elbow hypercube (16 states, 64 state-actions), no obstacles,
+  until every state-action was tried 5 times (320 actions); ``--runs`` runs for each gamma in
+  0.5, 0.9, 0.99; the tries and the value function of every state-action after 50 and 320
+  actions (Fig. 7.2-7.3).
+- ``7.2``: coverage of the rank-3 lattice's state-actions (81 states, 16 nearest: 1296
+  state-actions, the space ch. 7.2.1 used) against the number of transitions, for the curious
+  agent (AC), random choice (RAND) and least-tried (LT) (Fig. 7.5).
+- ``7.4``: three agents (both arms, the torso) in front of a table for ``--transitions``
+  transitions in all (18,000 in the source); the tries of every state-action of every agent
+  (Fig. 7.12).
+
+Each run writes its data as JSON (atomically, skipped when it exists, so an interrupted battery
+resumes), then the experiment writes PNG plots and a ``report.md``. Run:
+``python -m mobee_drake.planning.experiments --experiment 7.1 --output results/ch7``.
+"""
+
+import argparse
+import json
+import os
+import pathlib
+import sys
+import time
+
+import numpy as np
+from pydrake.systems.analysis import Simulator
+
+from mobee_drake.planning.explorers import ExplorerConfig
+from mobee_drake.simulation.builder import BuildSimulation
+from mobee_drake.simulation.scenario import Box as BoxShape
+from mobee_drake.simulation.scenario import (
+    ExploreAttractor,
+    ExploringAgent,
+    Scenario,
+    SceneObject,
+)
+
+RIGHT_ARM = ["r_shoulder_pitch", "r_shoulder_roll", "r_shoulder_yaw", "r_elbow"]
+LEFT_ARM = ["l_shoulder_pitch", "l_shoulder_roll", "l_shoulder_yaw", "l_elbow"]
+TORSO = ["torso_pitch", "torso_roll", "torso_yaw"]
+TABLE = SceneObject(name="table", shape=BoxShape(size=[0.6, 1.0, 0.04]),
+                    position=[-0.40, 0.0, -0.12])
+
+
+def _Scenario(agents: list[ExploringAgent], objects=()) -> Scenario:
+    scenario = Scenario()
+    scenario.objects = list(objects)
+    scenario.attractor = ExploreAttractor(agents=agents)
+    scenario.time_step = 0.02
+    scenario.visualization.meshcat = False
+    return scenario
+
+
+def _Explore(scenario: Scenario, stop, snapshots=(), chunk: float = 2.0) -> dict:
+    """Runs until ``stop(records)``; returns per-agent tries (and values at ``snapshots``)."""
+    simulation = BuildSimulation(scenario)
+    simulator = Simulator(simulation.diagram)
+    simulator.Initialize()
+    context = simulator.get_context()
+    supervisor = simulation.diagram.GetSubsystemByName("attractor")
+    supervisor_context = supervisor.GetMyContextFromRoot(context)
+    taken, coverage, start = {}, [], time.perf_counter()
+    while True:
+        simulator.AdvanceTo(context.get_time() + chunk)
+        records = supervisor.Records(supervisor_context)
+        done = sum(r.actions_done for r in records)
+        coverage.append([done] + [int((r.explorer.tries > 0).sum()) for r in records])
+        for count in snapshots:
+            if count not in taken and records[0].actions_done >= count:
+                taken[count] = dict(tries=records[0].explorer.tries.tolist(),
+                                    values=records[0].explorer.Values()[0].tolist())
+        if stop(records):
+            break
+    report = simulation.monitor.Report(simulation.monitor.GetMyContextFromRoot(context))
+    return dict(
+        agents=supervisor.agent_names,
+        tries=[r.explorer.tries.tolist() for r in records],
+        actions=[r.actions_done for r in records], snapshots=taken, coverage=coverage,
+        simulated_seconds=context.get_time(), wall_seconds=time.perf_counter() - start,
+        penetrating_steps=report.penetrating_steps)
+
+
+def _Save(path: pathlib.Path, data: dict) -> None:
+    temporary = path.with_suffix(".tmp")
+    temporary.write_text(json.dumps(data))
+    os.replace(temporary, path)
+
+
+def RunHypercube(output: pathlib.Path, runs: int, gammas=(0.5, 0.9, 0.99)) -> list[dict]:
+    results = []
+    for gamma in gammas:
+        for run in range(runs):
+            path = output / f"7.1_gamma{gamma}_run{run}.json"
+            if not path.exists():
+                agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=[0.25, 0.75],
+                                       explorer=ExplorerConfig(gamma=gamma, seed=run))
+                data = _Explore(_Scenario([agent]),
+                                stop=lambda records: records[0].explorer.tries.min() >= 5,
+                                snapshots=(50, 320))
+                _Save(path, dict(gamma=gamma, run=run, **data))
+            results.append(json.loads(path.read_text()))
+    return results
+
+
+def RunCoverage(output: pathlib.Path, transitions: int, runs: int) -> list[dict]:
+    results = []
+    for strategy in ("curious", "random", "least_tried"):
+        for run in range(runs):
+            path = output / f"7.2_{strategy}_run{run}.json"
+            if not path.exists():
+                agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM,
+                                       levels=[0.25, 0.5, 0.75], nearest=16,
+                                       explorer=ExplorerConfig(strategy=strategy, seed=run))
+                data = _Explore(_Scenario([agent]),
+                                stop=lambda records: records[0].actions_done >= transitions)
+                _Save(path, dict(strategy=strategy, run=run, **data))
+            results.append(json.loads(path.read_text()))
+    return results
+
+
+def RunThreeAgents(output: pathlib.Path, transitions: int) -> dict:
+    path = output / f"7.4_{transitions}.json"
+    if not path.exists():
+        agents = [ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=[0.25, 0.5, 0.75],
+                                 nearest=16, explorer=ExplorerConfig(seed=1)),
+                  ExploringAgent(name="left_arm", joints=LEFT_ARM, levels=[0.25, 0.5, 0.75],
+                                 nearest=16, explorer=ExplorerConfig(seed=2)),
+                  ExploringAgent(name="torso", joints=TORSO, levels=[0.25, 0.5, 0.75], nearest=8,
+                                 explorer=ExplorerConfig(seed=3))]
+        data = _Explore(_Scenario(agents, [TABLE]), chunk=5.0,
+                        stop=lambda records: sum(r.actions_done for r in records) >= transitions)
+        _Save(path, data)
+    return json.loads(path.read_text())
+
+
+def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    lines = []
+    if experiment == "7.1":
+        gammas = sorted({r["gamma"] for r in results})
+        figure, axes = plt.subplots(2, len(gammas), figsize=(5 * len(gammas), 6), squeeze=False)
+        for column, gamma in enumerate(gammas):
+            mine = [r for r in results if r["gamma"] == gamma]
+            for row, key in enumerate(("tries", "values")):
+                stack = np.array([r["snapshots"]["320"][key] for r in mine])
+                bottom = np.zeros(stack.shape[1])
+                for values in stack:
+                    axes[row, column].bar(np.arange(len(values)), values, bottom=bottom)
+                    bottom += values
+                axes[row, column].set_title(f"gamma {gamma}: {key} after 320 actions")
+            tries = np.array([r["snapshots"]["320"]["tries"] for r in mine])
+            values = np.array([r["snapshots"]["320"]["values"] for r in mine])
+            lines.append(f"| {gamma} | {len(mine)} | {tries.mean():.2f} | "
+                         f"{tries.std(axis=1).mean():.2f} | {values.mean():.4f} | "
+                         f"{np.mean([r['wall_seconds'] for r in mine]):.1f} |")
+        figure.tight_layout()
+        figure.savefig(output / "7.1_hypercube.png", dpi=80)
+        header = ["| gamma | runs | mean tries per state-action after 320 actions | "
+                  "spread of tries (std over state-actions, mean over runs) | mean V(s, a) | "
+                  "wall s per run |", "|---:|---:|---:|---:|---:|---:|"]
+        return header + lines
+    if experiment == "7.2":
+        figure, axis = plt.subplots(figsize=(7, 4))
+        for strategy in ("curious", "random", "least_tried"):
+            for r in [r for r in results if r["strategy"] == strategy]:
+                coverage = np.array(r["coverage"])
+                axis.plot(coverage[:, 0], coverage[:, 1], label=f"{strategy} run {r['run']}")
+                full = coverage[coverage[:, 1] >= 1296, 0]
+                lines.append(f"| {strategy} | {r['run']} | {coverage[-1, 0]} | "
+                             f"{coverage[-1, 1]} | {full[0] if len(full) else '-'} |")
+        axis.set_xlabel("transitions")
+        axis.set_ylabel("state-actions tried (of 1296)")
+        axis.legend()
+        figure.tight_layout()
+        figure.savefig(output / "7.2_coverage.png", dpi=80)
+        return (["| strategy | run | transitions | state-actions tried | transitions to try all |",
+                 "|---|---:|---:|---:|---:|"] + lines)
+    figure, axes = plt.subplots(3, 1, figsize=(12, 8))
+    for axis, name, tries in zip(axes, results["agents"], results["tries"]):
+        axis.bar(np.arange(len(tries)), tries)
+        axis.set_title(f"{name}: tries per state-action")
+    figure.tight_layout()
+    figure.savefig(output / "7.4_three_agents.png", dpi=80)
+    right, left = (np.array(t, dtype=float) for t in results["tries"][:2])
+    correlation = float(np.corrcoef(right, left)[0, 1])
+    return [f"- transitions: {sum(results['actions'])} ({results['actions']} per agent), "
+            f"{results['simulated_seconds']:.0f} s simulated in {results['wall_seconds']:.0f} s "
+            f"wall",
+            f"- correlation of the right and the left arm's tries per state-action: "
+            f"{correlation:.3f}",
+            f"- penetrating control periods: {results['penetrating_steps']}"]
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--experiment", choices=["7.1", "7.2", "7.4"], required=True)
+    parser.add_argument("--output", default="results/ch7")
+    parser.add_argument("--runs", type=int, default=10)
+    parser.add_argument("--transitions", type=int, default=18000)
+    argv = sys.argv[1:] if argv is None else argv
+    args = parser.parse_args(argv)
+    output = pathlib.Path(args.output)
+    output.mkdir(parents=True, exist_ok=True)
+    if args.experiment == "7.1":
+        results = RunHypercube(output, args.runs)
+    elif args.experiment == "7.2":
+        results = RunCoverage(output, args.transitions, args.runs)
+    else:
+        results = RunThreeAgents(output, args.transitions)
+    table = _Plots(output, args.experiment, results)
+    report = output / f"report_{args.experiment}.md"
+    report.write_text(f"# Experiment {args.experiment}\n\n`python -m mobee_drake.planning."
+                      f"experiments {' '.join(argv)}`\n\n" + "\n".join(table) + "\n")
+    print(report.read_text())
+
+
+if __name__ == "__main__":
+    main()
