@@ -9,6 +9,7 @@ from pydrake.systems.analysis import InitializeParams, Simulator
 
 from mobee_drake import cli
 from mobee_drake.mobee.fields import FieldPairs
+from mobee_drake.planning.state_space import Lattice
 from mobee_drake.simulation.attractors import RandomAttractorSource
 from mobee_drake.simulation.builder import BuildSimulation
 from mobee_drake.simulation.checkpoint import LoadCheckpoint, SaveCheckpoint
@@ -361,6 +362,37 @@ class TestExploration(unittest.TestCase):
         q_star = simulation.attractor.Eval(context)
         lower, upper = simulation.mobee.position_limits
         self.assertTrue(np.all((q_star >= lower) & (q_star <= upper)))
+
+
+class TestPlanningOnTheRobot(unittest.TestCase):
+    def test_planner_reuses_a_learned_model_to_reach_a_goal(self):
+        folder = pathlib.Path(tempfile.mkdtemp()) / "learned"
+        RunScenario(LoadScenario(DIAGRAMS / "explore_hypercube.yaml", "{duration: 30}"),
+                    checkpoint=str(folder))
+        # The goal: the corner of the hypercube opposite the start (4 steps away).
+        scenario = LoadScenario(DIAGRAMS / "explore_hypercube.yaml", "{duration: 60}")
+        simulation = BuildSimulation(scenario)
+        space = Lattice([0.25, 0.75], 4)
+        lower, upper = simulation.mobee.position_limits
+        columns = [simulation.mobee.joint_index(j) for j in scenario.attractor.agents[0].joints]
+        home = (simulation.mobee.home[columns] - lower[columns]) / (upper - lower)[columns]
+        first = space.StateOf(home)
+        goal = space.StateOf(1.0 - space.centres[first])
+        agent = scenario.attractor.agents[0]
+        agent.model = str(folder)
+        agent.explorer.strategy, agent.explorer.goal_state = "planner", goal
+        simulation = BuildSimulation(scenario)
+        simulator = Simulator(simulation.diagram)
+        simulator.Initialize()
+        simulator.AdvanceTo(scenario.duration)
+        supervisor = simulation.diagram.GetSubsystemByName("attractor")
+        (record,) = supervisor.Records(supervisor.GetMyContextFromRoot(simulator.get_context()))
+        self.assertTrue(record.arrived)
+        self.assertEqual(record.state, goal)
+        self.assertEqual(record.actions_done, 4)  # the shortest way through the hypercube
+        with self.assertRaisesRegex(ValueError, "no saved model of agent 'right_arm'"):
+            agent.model = str(folder.parent / "nothing")
+            BuildSimulation(scenario)
 
 
 class TestSeveralAgents(unittest.TestCase):

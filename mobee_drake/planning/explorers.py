@@ -6,6 +6,8 @@
   (Alg. 6), value iteration (Alg. 7) after every action, greedy on V(s, a).
 - ``random`` (RAND): a uniformly random action of the current state.
 - ``least_tried`` (LT): the action of the current state tried least often, random among ties.
+- ``planner``: exploits the learned model (ch. 6.5): greedy on the values of a reward for arriving
+  in ``goal_state`` (see :mod:`mobee_drake.planning.planner`); it keeps learning from outcomes.
 
 Every agent draws from its own seeded generator; ties of the greedy choice are broken at random
 too, so a run is reproducible from its seed.
@@ -13,6 +15,8 @@ too, so a run is reproducible from its seed.
 
 import copy
 import dataclasses as dc
+import json
+import pathlib
 
 import numpy as np
 
@@ -20,7 +24,7 @@ from mobee_drake.planning.curiosity import TransitionCounts
 from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.planning.value_iteration import ValueIteration
 
-STRATEGIES = ("curious", "random", "least_tried")
+STRATEGIES = ("curious", "random", "least_tried", "planner")
 INITIALIZATIONS = {"50-50": 1, "60-40": 2}  # successes observed after the one failure
 
 
@@ -32,6 +36,8 @@ class ExplorerConfig:
     gamma: float = 0.9
     delta: float = 1e-3
     seed: int = 0
+    # The state the "planner" strategy heads for.
+    goal_state: int = -1
 
 
 class Explorer:
@@ -42,6 +48,9 @@ class Explorer:
         if config.strategy not in STRATEGIES:
             raise ValueError(f"unknown strategy '{config.strategy}'; strategies are "
                              + ", ".join(STRATEGIES))
+        if config.strategy == "planner" and not 0 <= config.goal_state < space.num_states:
+            raise ValueError(f"the planner needs a goal_state in 0..{space.num_states - 1}, "
+                             f"got {config.goal_state}")
         if config.initialization not in INITIALIZATIONS:
             raise ValueError(f"unknown initialization '{config.initialization}'; use "
                              + " or ".join(INITIALIZATIONS))
@@ -78,6 +87,11 @@ class Explorer:
             return int(self.rng.choice(actions))
         if self.config.strategy == "least_tried":
             scores = -self.tries[actions].astype(float)
+        elif self.config.strategy == "planner":
+            from mobee_drake.planning.planner import PlanValues  # (planner imports this module)
+
+            scores = PlanValues(self, {self.config.goal_state: 1.0},
+                                gamma=self.config.gamma)[0][actions]
         else:
             scores = self.Values()[0][actions]
         best = actions[np.flatnonzero(scores >= scores.max() - 1e-12)]
@@ -101,13 +115,29 @@ def ExplorerToArrays(explorer: Explorer) -> tuple[dict[str, np.ndarray], dict]:
                         generator=explorer.rng.bit_generator.state)
 
 
-def ExplorerFromArrays(arrays, data: dict) -> Explorer:
-    """The inverse of :func:`ExplorerToArrays`."""
+def ExplorerFromArrays(arrays, data: dict, config: ExplorerConfig | None = None) -> Explorer:
+    """The inverse of :func:`ExplorerToArrays`; with ``config``, the saved model under another
+    configuration (e.g. a planner reusing what an explorer learned)."""
     space = StateActionSpace(np.asarray(arrays["centres"]), np.asarray(arrays["action_state"]),
                              np.asarray(arrays["action_goal"]))
-    explorer = Explorer(space, ExplorerConfig(**data["config"]))
+    explorer = Explorer(space, config or ExplorerConfig(**data["config"]))
     explorer.transitions.counts[...] = arrays["counts"]
     explorer.rewards[...] = arrays["rewards"]
     explorer.tries[...] = arrays["tries"]
-    explorer.rng.bit_generator.state = data["generator"]
+    if config is None:
+        explorer.rng.bit_generator.state = data["generator"]
     return explorer
+
+
+def LoadAgentModel(folder: str, name: str, config: ExplorerConfig) -> Explorer:
+    """Agent ``name``'s model from a checkpoint folder, under ``config``.
+
+    Raises:
+        ValueError: naming the file, when the folder has no model for that agent.
+    """
+    base = pathlib.Path(folder) / name
+    for suffix in (".npz", ".json"):
+        if not base.with_suffix(suffix).is_file():
+            raise ValueError(f"{base.with_suffix(suffix)}: no saved model of agent '{name}'")
+    return ExplorerFromArrays(np.load(base.with_suffix(".npz")),
+                              json.loads(base.with_suffix(".json").read_text()), config)

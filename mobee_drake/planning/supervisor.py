@@ -5,7 +5,8 @@ ends when the robot has settled (every joint of the agent slower than ``settle_s
 ``settle_time``, and at least ``min_duration`` after the start) or after ``timeout``. The outcome
 is the state holding the final configuration; the agent observes it (Alg. 6) and chooses the next
 action (Alg. 7-8). Several agents run at once, each on its own joints and blind to the others
-(ch. 7.4); joints of no agent are held at home.
+(ch. 7.4); joints of no agent are held at home. An agent with the "planner" strategy heads for
+its goal state and stops once an action has ended there.
 
 Where the learned model lives: the supervisor's state is one abstract value, a tuple of
 :class:`AgentRecord`, updated by a periodic unrestricted update (the polling period of the
@@ -45,6 +46,8 @@ class AgentRecord:
     started: float  # its start time (s)
     slow_since: float  # since when the agent's joints have been slow (inf: not slow)
     actions_done: int
+    # A planner that arrived in its goal state stops there (its attractor stays on the goal).
+    arrived: bool = False
 
     def __deepcopy__(self, memo) -> "AgentRecord":
         return self
@@ -58,6 +61,8 @@ class Agent:
     joints: list[str]
     space: StateActionSpace
     explorer: ExplorerConfig = dc.field(default_factory=ExplorerConfig)
+    # A model learned before (its space must be ``space``); None: start afresh.
+    model: Explorer | None = None
 
 
 class ExplorationSupervisor(LeafSystem):
@@ -88,6 +93,11 @@ class ExplorationSupervisor(LeafSystem):
             if unknown:
                 raise ValueError(f"agent '{agent.name}': unknown joints {unknown}; MoBeE's "
                                  "joints are: " + ", ".join(joints))
+            if agent.model is not None and agent.model.space.num_state_actions != \
+                    agent.space.num_state_actions:
+                raise ValueError(f"agent '{agent.name}': its model has "
+                                 f"{agent.model.space.num_state_actions} state-actions, its "
+                                 f"space {agent.space.num_state_actions}")
             if agent.space.centres.shape[1] != len(agent.joints):
                 raise ValueError(f"agent '{agent.name}': its space has "
                                  f"{agent.space.centres.shape[1]} dimensions for "
@@ -125,8 +135,10 @@ class ExplorationSupervisor(LeafSystem):
     def _Start(self, context, state) -> None:
         q = self._state_port.Eval(context)[:self._n]
         records = tuple(
-            self._Begin(agent, columns, Explorer(agent.space, agent.explorer), q,
-                        context.get_time(), 0)
+            self._Begin(agent, columns,
+                        agent.model.Copy() if agent.model else Explorer(agent.space,
+                                                                        agent.explorer),
+                        q, context.get_time(), 0)
             for agent, columns in zip(self._agents, self._columns))
         state.get_mutable_abstract_state(int(self._records)).set_value(records)
 
@@ -138,6 +150,8 @@ class ExplorationSupervisor(LeafSystem):
         changed = False
         for i, (agent, columns) in enumerate(zip(self._agents, self._columns)):
             record = records[i]
+            if record.arrived:
+                continue
             slow = np.max(np.abs(v[columns])) < timing.settle_speed
             slow_since = min(record.slow_since, now) if slow else np.inf
             elapsed = now - record.started
@@ -147,8 +161,13 @@ class ExplorationSupervisor(LeafSystem):
                 explorer = record.explorer.Copy()
                 outcome = agent.space.StateOf(self._Fractions(q, columns))
                 explorer.Observe(record.state_action, outcome)
-                records[i] = self._Begin(agent, columns, explorer, q, now,
-                                         record.actions_done + 1)
+                if (explorer.config.strategy == "planner"
+                        and outcome == explorer.config.goal_state):
+                    records[i] = dc.replace(record, explorer=explorer, state=outcome,
+                                            actions_done=record.actions_done + 1, arrived=True)
+                else:
+                    records[i] = self._Begin(agent, columns, explorer, q, now,
+                                             record.actions_done + 1)
                 changed = True
             elif slow_since != record.slow_since:
                 records[i] = dc.replace(record, slow_since=slow_since)

@@ -43,6 +43,7 @@ from pydrake.systems.primitives import (
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
 from mobee_drake.mobee.system import Mobee
+from mobee_drake.planning.explorers import LoadAgentModel
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
 from mobee_drake.robots.assembly import JointStateSelector
@@ -93,7 +94,9 @@ def _AttractorSource(builder: DiagramBuilder, scenario: Scenario, mobee: Mobee,
     if isinstance(program, ExploreAttractor):
         agents = [Agent(name=a.name, joints=a.joints,
                         space=Lattice(a.levels, len(a.joints), k=a.nearest or None),
-                        explorer=a.explorer) for a in program.agents]
+                        explorer=a.explorer,
+                        model=LoadAgentModel(a.model, a.name, a.explorer) if a.model else None)
+                  for a in program.agents]
         supervisor = builder.AddNamedSystem("attractor", ExplorationSupervisor(
             agents=agents, joints=mobee.joints, lower=lower, upper=upper, home=mobee.home,
             timing=program.timing))

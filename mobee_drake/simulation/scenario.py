@@ -89,6 +89,8 @@ class ExploringAgent:
     # Actions to the k nearest states; 0: to the nearest equidistant ones.
     nearest: int = 0
     explorer: ExplorerConfig = dc.field(default_factory=ExplorerConfig)
+    # Start from a model learned before: a checkpoint folder holding ``<name>.npz/json``.
+    model: str = ""
 
 
 @dc.dataclass
