@@ -67,6 +67,17 @@ def _Bench(args: list[str]) -> None:
     main(rest)
 
 
+def _Experiment(args: list[str]) -> None:
+    """Runs a battery of experiments that write data, plots and a report."""
+    parser = argparse.ArgumentParser(prog="mobee-drake experiment")
+    parser.add_argument("which", choices=["ch7"],
+                        help="ch7: the model-learning experiments of the dissertation's ch. 7")
+    known, rest = parser.parse_known_args(args)
+    from mobee_drake.planning.experiments import main
+
+    main(rest)
+
+
 def _Info(args: list[str]) -> None:
     """Prints the iCub model, its controlled joints, overlay geometry, markers and clauses."""
     parser = argparse.ArgumentParser(prog="mobee-drake info")
@@ -100,7 +111,7 @@ def _Info(args: list[str]) -> None:
     print("constraint clauses: " + ", ".join(mobee.clauses.names))
 
 
-COMMANDS = {"bench": _Bench, "info": _Info, "run": _Run}
+COMMANDS = {"bench": _Bench, "experiment": _Experiment, "info": _Info, "run": _Run}
 
 
 def main(argv: list[str] | None = None) -> None:
