@@ -70,11 +70,14 @@ def _Bench(args: list[str]) -> None:
 def _Experiment(args: list[str]) -> None:
     """Runs a battery of experiments that write data, plots and a report."""
     parser = argparse.ArgumentParser(prog="mobee-drake experiment")
-    parser.add_argument("which", choices=["ch7"],
-                        help="ch7: the model-learning experiments of the dissertation's ch. 7")
+    parser.add_argument("which", choices=["ch7", "saggriac"],
+                        help="ch7: the model-learning experiments of the dissertation's ch. 7; "
+                             "saggriac: the SAGG-RIAC comparison on the 15-joint arm")
     known, rest = parser.parse_known_args(args)
-    from mobee_drake.planning.experiments import main
-
+    if known.which == "ch7":
+        from mobee_drake.planning.experiments import main
+    else:
+        from mobee_drake.goal_babbling.experiments import main
     main(rest)
 
 

@@ -1,0 +1,256 @@
+"""Typed, serialisable configuration of SAGG-RIAC and its baselines on the planar arm.
+
+Defaults are the values of Baranes & Oudeyer (IROS 2010), Sec. III-IV, where the paper gives one.
+Where the paper is silent the value is our choice; every such field says "(our choice)" in its
+comment and is listed in docs/saggriac.md.
+"""
+
+import dataclasses
+import json
+import math
+import typing
+
+
+@dataclasses.dataclass
+class ArmConfig:
+    """The planar arm of Sec. III-C and IV-A.
+
+    Attributes:
+        num_joints: n, revolute joints in a plane (paper: 15).
+        total_length: Sum of the link lengths (paper: 50 units); all links have the same length (our
+            choice).
+        joint_limit: Each relative joint angle is clipped to [-joint_limit, joint_limit] rad (our
+            choice: pi).
+        sensor_noise_std: Standard deviation of Gaussian noise added to each observed end-effector
+            coordinate (paper: none; 0 disables it).
+    """
+
+    num_joints: int = 15
+    total_length: float = 50.0
+    joint_limit: float = math.pi
+    sensor_noise_std: float = 0.0
+
+
+@dataclasses.dataclass
+class LowLevelConfig:
+    """The SSA-like low level of Sec. III-D and the local models of Sec. III-B.
+
+    Attributes:
+        velocity: v, desired end-effector displacement per reaching micro-action (paper: 0.5
+            units/movement).
+        exploration_actions: q, random micro-actions in one exploration phase (paper: 20 in exp. 1,
+            100 in exp. 2).
+        exploration_joint_step: Exploration micro-actions draw each joint step uniformly in
+            [-exploration_joint_step, exploration_joint_step] rad (our choice: 0.01 rad, which moves
+            the tip of the straight arm by about v). ACTUATOR-Random and ACTUATOR-RIAC use the same
+            box.
+        max_joint_step: A reaching micro-action J^+ dx is scaled down so that no joint moves more
+            than this (our choice: 0.05 rad), which keeps micro-actions small near singular Jacobian
+            estimates.
+        error_threshold: eps_max; an exploration phase follows a reaching micro-action whose
+            performed displacement differs from the desired one by more than this (our choice: 0.1
+            units = v / 5, from a pilot on seed 100, see docs/saggriac.md).
+        num_neighbours: Size of the neighbourhood in theta-space used to estimate J (our choice: 30
+            = 2n, the dimension of (theta, dtheta), from the same pilot).
+        neighbour_search_eps: Approximate nearest neighbours, as the paper's ANN [18]: the k-d tree
+            search may return neighbours up to (1 + eps) times farther than the exact ones (our
+            choice: 1.0, for speed in 15 dimensions; 0 is exact).
+        timeout_per_unit: The timeout of a (sub)goal attempt is ceil(timeout_per_unit * D(x_start,
+            x_g) / v) + timeout_explorations * q micro-actions, exploration included (our choice:
+            2).
+        timeout_explorations: See timeout_per_unit (our choice: 1).
+    """
+
+    velocity: float = 0.5
+    exploration_actions: int = 20
+    exploration_joint_step: float = 0.01
+    max_joint_step: float = 0.05
+    error_threshold: float = 0.1
+    num_neighbours: int = 30
+    neighbour_search_eps: float = 1.0
+    timeout_per_unit: float = 2.0
+    timeout_explorations: int = 1
+
+
+@dataclasses.dataclass
+class InterestConfig:
+    """Competence, interest and region splitting of Sec. II-D.
+
+    Attributes:
+        max_region_goals: g_max; a region holding more goals is split (paper: 50).
+        window: zeta, the sliding window of eq. 2 (our choice: 20).
+        min_child_goals: Each half of a split holds at least this many goals (our choice: 10 = zeta
+            / 2).
+        mode_probabilities: p_1, p_2, p_3 of the three goal-selection modes (paper: 0.7, 0.2, 0.1).
+        competence_tolerance: eps_C < 0; a goal counts as reached when C > eps_C (our choice: -0.05,
+            i.e. within 5 % of the starting distance).
+        min_competence: min_C, the lowest competence (our choice: -1, no better than not moving).
+    """
+
+    max_region_goals: int = 50
+    window: int = 20
+    min_child_goals: int = 10
+    mode_probabilities: tuple[float, float, float] = (0.7, 0.2, 0.1)
+    competence_tolerance: float = -0.05
+    min_competence: float = -1.0
+
+
+@dataclasses.dataclass
+class EvaluationConfig:
+    """The evaluation of Sec. IV-B (Fig. 4-5).
+
+    Attributes:
+        num_test_goals: Test goals uniform in the reachable half-disc x >= 0, |x| <= total length
+            (paper: 100); even-numbered ones start from rest, odd-numbered ones from where the
+            previous test reach ended.
+        num_test_configurations: Test joint configurations for the forward-model error (paper: 100).
+        test_joint_range: Test configurations draw each relative joint angle uniformly in
+            [-test_joint_range, test_joint_range] rad (our choice: 0.3).
+        num_checkpoints: Evaluations at equally spaced time steps after step 0 (our choice: 20).
+        tolerance: A test reach stops once the tip is this close to the goal (our choice: 0.05
+            units).
+        test_set_seed: Seed of the test set, shared by all learners and seeds (our choice: 12345).
+    """
+
+    num_test_goals: int = 100
+    num_test_configurations: int = 100
+    test_joint_range: float = 0.3
+    num_checkpoints: int = 20
+    tolerance: float = 0.05
+    test_set_seed: int = 12345
+
+
+@dataclasses.dataclass
+class GoalBabblingConfig:
+    """Everything one learning run needs.
+
+    Attributes:
+        goal_space_low: Lower corner of S' (paper, exp. 1: (0, -50); exp. 2: (0, -150)).
+        goal_space_high: Upper corner of S' (paper, exp. 1: (50, 50); exp. 2: (150, 150)).
+        num_subgoals: l, subgoals on the way to each goal, the last one being the goal (paper: 5).
+        reset_every_attempts: r, the arm returns to rest every r goal attempts (paper: 2).
+        budget: Micro-actions (time steps) of the run (paper: 50,000 in exp. 1, 200,000 in exp. 2).
+        seed: Seed of the learner's own numpy Generator.
+        arm: Arm parameters.
+        low_level: Low-level parameters.
+        interest: High-level parameters.
+        evaluation: Evaluation parameters.
+    """
+
+    goal_space_low: tuple[float, float] = (0.0, -50.0)
+    goal_space_high: tuple[float, float] = (50.0, 50.0)
+    num_subgoals: int = 5
+    reset_every_attempts: int = 2
+    budget: int = 50_000
+    seed: int = 0
+    arm: ArmConfig = dataclasses.field(default_factory=ArmConfig)
+    low_level: LowLevelConfig = dataclasses.field(default_factory=LowLevelConfig)
+    interest: InterestConfig = dataclasses.field(default_factory=InterestConfig)
+    evaluation: EvaluationConfig = dataclasses.field(default_factory=EvaluationConfig)
+
+    def ActuatorResetPeriod(self) -> int:
+        """Time steps between resets of the actuator-space baselines (Sec. IV-B-1).
+
+        The paper resets them every "max" steps, the steps needed to reach consecutively the two
+        most distant reachable positions. We read this as: from rest (L, 0) to (0, L) (distance L
+        sqrt 2), then to (0, -L) (distance 2 L), at v per step.
+
+        Returns:
+            ceil((sqrt(2) + 2) L / v).
+        """
+        length = self.arm.total_length
+        return math.ceil((math.sqrt(2.0) + 2.0) * length / self.low_level.velocity)
+
+
+def Experiment1Config(seed: int = 0, budget: int = 50_000) -> GoalBabblingConfig:
+    """Sec. IV-B-1: S' = [0, 50] x [-50, 50], q = 20, 50,000 movements.
+
+    Args:
+        seed: Learner seed.
+        budget: Micro-actions.
+
+    Returns:
+        The configuration.
+    """
+    return GoalBabblingConfig(
+        goal_space_low=(0.0, -50.0),
+        goal_space_high=(50.0, 50.0),
+        budget=budget,
+        seed=seed,
+        low_level=LowLevelConfig(exploration_actions=20),
+    )
+
+
+def Experiment2Config(seed: int = 0, budget: int = 200_000) -> GoalBabblingConfig:
+    """Sec. IV-B-2: S' = [0, 150] x [-150, 150], q = 100, 200,000 time steps.
+
+    Args:
+        seed: Learner seed.
+        budget: Micro-actions.
+
+    Returns:
+        The configuration.
+    """
+    return GoalBabblingConfig(
+        goal_space_low=(0.0, -150.0),
+        goal_space_high=(150.0, 150.0),
+        budget=budget,
+        seed=seed,
+        low_level=LowLevelConfig(exploration_actions=100),
+    )
+
+
+def ConfigToDict(config: GoalBabblingConfig) -> dict:
+    """Plain JSON-compatible dict of a configuration.
+
+    Args:
+        config: The configuration.
+
+    Returns:
+        Nested dict (tuples become lists).
+    """
+    return dataclasses.asdict(config)
+
+
+def _Build(cls: type, data: dict):
+    hints = typing.get_type_hints(cls)
+    kwargs = {}
+    for field in dataclasses.fields(cls):
+        if field.name not in data:
+            continue
+        value = data[field.name]
+        hint = hints[field.name]
+        if dataclasses.is_dataclass(hint):
+            value = _Build(hint, value)
+        elif typing.get_origin(hint) is tuple:
+            value = tuple(value)
+        kwargs[field.name] = value
+    unknown = set(data) - {field.name for field in dataclasses.fields(cls)}
+    if unknown:
+        raise ValueError(f"unknown {cls.__name__} fields: {sorted(unknown)}")
+    return cls(**kwargs)
+
+
+def ConfigFromDict(data: dict) -> GoalBabblingConfig:
+    """Inverse of ConfigToDict; missing fields take their defaults.
+
+    Args:
+        data: Nested dict as written by ConfigToDict (or a subset of it).
+
+    Returns:
+        The configuration.
+
+    Raises:
+        ValueError: On a field name the configuration does not have.
+    """
+    return _Build(GoalBabblingConfig, data)
+
+
+def ConfigToJson(config: GoalBabblingConfig) -> str:
+    """JSON text of a configuration."""
+    return json.dumps(ConfigToDict(config), indent=2, sort_keys=True)
+
+
+def ConfigFromJson(text: str) -> GoalBabblingConfig:
+    """Configuration from JSON text written by ConfigToJson."""
+    return ConfigFromDict(json.loads(text))
