@@ -26,7 +26,7 @@ import time
 import numpy as np
 from pydrake.systems.analysis import Simulator
 
-from mobee_drake.planning.explorers import ExplorerConfig
+from mobee_drake.planning.explorers import INITIALIZATIONS, ExplorerConfig
 from mobee_drake.simulation.builder import BuildSimulation
 from mobee_drake.simulation.scenario import Box as BoxShape
 from mobee_drake.simulation.scenario import (
@@ -73,9 +73,19 @@ def _Explore(scenario: Scenario, stop, snapshots=(), chunk: float = 2.0) -> dict
         if stop(records):
             break
     report = simulation.monitor.Report(simulation.monitor.GetMyContextFromRoot(context))
+    def Misses(explorer):
+        """Per state-action, the share of its tries that did not end in its goal state."""
+        space, counts = explorer.space, explorer.transitions.counts
+        initial = 1 + INITIALIZATIONS[explorer.config.initialization]  # goal counts before tries
+        hits = counts[np.arange(space.num_state_actions), space.action_goal] - initial
+        return np.where(explorer.tries > 0,
+                        1 - hits / np.maximum(explorer.tries, 1), 0.0).tolist()
+
     return dict(
         agents=supervisor.agent_names,
         tries=[r.explorer.tries.tolist() for r in records],
+        misses=[Misses(r.explorer) for r in records],
+        goals=[r.explorer.space.centres[r.explorer.space.action_goal].tolist() for r in records],
         actions=[r.actions_done for r in records], snapshots=taken, coverage=coverage,
         simulated_seconds=context.get_time(), wall_seconds=time.perf_counter() - start,
         penetrating_steps=report.penetrating_steps)
@@ -188,12 +198,26 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
     figure.savefig(output / "7.4_three_agents.png", dpi=80)
     right, left = (np.array(t, dtype=float) for t in results["tries"][:2])
     correlation = float(np.corrcoef(right, left)[0, 1])
-    return [f"- transitions: {sum(results['actions'])} ({results['actions']} per agent), "
-            f"{results['simulated_seconds']:.0f} s simulated in {results['wall_seconds']:.0f} s "
-            f"wall",
-            f"- correlation of the right and the left arm's tries per state-action: "
-            f"{correlation:.3f}",
-            f"- penetrating control periods: {results['penetrating_steps']}"]
+    lines = [f"- transitions: {sum(results['actions'])} ({results['actions']} per agent), "
+             f"{results['simulated_seconds']:.0f} s simulated in {results['wall_seconds']:.0f} s "
+             f"wall",
+             f"- correlation of the right and the left arm's tries per state-action: "
+             f"{correlation:.3f}",
+             f"- penetrating control periods: {results['penetrating_steps']}"]
+    for name, tries, misses, goals in zip(results["agents"], results["tries"],
+                                          results["misses"], results["goals"]):
+        tries, misses, goals = np.array(tries), np.array(misses), np.array(goals)
+        top = np.argsort(tries)[::-1][:20]
+        surprising = misses > 0.1
+        tried_surprising = tries[surprising].mean() if surprising.any() else 0.0
+        lines.append(
+            f"- {name}: the 20 most-tried state-actions (mean {tries[top].mean():.0f} tries, "
+            f"median of all {np.median(tries):.0f}) miss their goal in "
+            f"{100 * misses[top].mean():.0f} % of their tries (all: "
+            f"{100 * misses.mean():.0f} %); state-actions missing their goal more than 10 % of "
+            f"the time: {surprising.sum()}, tried {tried_surprising:.0f} times on average against {tries[~surprising].mean():.0f}; mean goal of the 20 "
+            f"most-tried, in fractions of range: {np.round(goals[top].mean(axis=0), 2).tolist()}")
+    return lines
 
 
 def main(argv=None) -> None:
