@@ -215,7 +215,8 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
             f"median of all {np.median(tries):.0f}) miss their goal in "
             f"{100 * misses[top].mean():.0f} % of their tries (all: "
             f"{100 * misses.mean():.0f} %); state-actions missing their goal more than 10 % of "
-            f"the time: {surprising.sum()}, tried {tried_surprising:.0f} times on average against {tries[~surprising].mean():.0f}; mean goal of the 20 "
+            f"the time: {surprising.sum()}, tried {tried_surprising:.0f} times on average "
+            f"against {tries[~surprising].mean():.0f}; mean goal of the 20 "
             f"most-tried, in fractions of range: {np.round(goals[top].mean(axis=0), 2).tolist()}")
     return lines
 
