@@ -5,7 +5,9 @@ import tempfile
 import unittest
 
 import numpy as np
+from pydrake.common.value import AbstractValue
 from pydrake.systems.analysis import InitializeParams, Simulator
+from pydrake.systems.framework import LeafSystem
 
 from mobee_drake import cli
 from mobee_drake.mobee.fields import FieldPairs
@@ -15,7 +17,7 @@ from mobee_drake.simulation.builder import BuildSimulation
 from mobee_drake.simulation.checkpoint import LoadCheckpoint, SaveCheckpoint
 from mobee_drake.simulation.runner import Advance, RunScenario
 from mobee_drake.simulation.safety import SafetyMonitor
-from mobee_drake.simulation.scenario import LoadScenario, SceneObject, Sphere
+from mobee_drake.simulation.scenario import LoadScenario, SceneObject, Sphere, WorldEvent
 from mobee_drake.simulation.virtual_dynamics import VirtualDynamics
 from mobee_drake.yaml_io import YamlFileError
 
@@ -491,6 +493,50 @@ class TestInteractive(unittest.TestCase):
         simulation.world.Remove(simulator.get_mutable_context(), "table")
         simulation.diagram.ForcedPublish(context)
         self.assertFalse(meshcat.HasPath("/field_forces"))
+
+
+class BallSwitcher(LeafSystem):
+    """A toy supervisor: once the palm is within 10 cm of the ball, it asks for the ball to become
+    a ghost (a world event in its abstract state, listed on ``world_events``)."""
+
+    def __init__(self, mobee, ball_position):
+        super().__init__()
+        self._ball = np.asarray(ball_position)
+        self._palm = 3 * mobee.marker_index("r_palm")
+        self._positions = self.DeclareVectorInputPort("marker_positions",
+                                                      3 * len(mobee.marker_names))
+        self._issued = self.DeclareAbstractState(AbstractValue.Make([]))
+        self.DeclarePeriodicUnrestrictedUpdateEvent(0.1, 0.0, self._Update)
+        self.DeclareAbstractOutputPort(
+            "world_events", lambda: AbstractValue.Make([]),
+            lambda context, output: output.set_value(
+                context.get_abstract_state(int(self._issued)).get_value()),
+            prerequisites_of_calc={self.abstract_state_ticket(self._issued)})
+
+    def _Update(self, context, state):
+        issued = context.get_abstract_state(int(self._issued)).get_value()
+        palm = self._positions.Eval(context)[self._palm:self._palm + 3]
+        if not issued and np.linalg.norm(palm - self._ball) < 0.10:
+            event = WorldEvent(time=context.get_time(), object="ball", role="ghost")
+            state.get_mutable_abstract_state(int(self._issued)).set_value([event])
+
+
+class TestSupervisorWorldEvents(unittest.TestCase):
+    def test_a_supervisor_switches_the_ball_to_a_ghost(self):
+        scenario = LoadScenario(REACH, "{duration: 4}")
+        ball = next(o for o in scenario.objects if o.name == "ball").position
+
+        def Prebuild(parts):
+            switcher = parts.builder.AddNamedSystem("switcher", BallSwitcher(parts.mobee, ball))
+            parts.builder.Connect(parts.mobee.GetOutputPort("marker_positions"),
+                                  switcher.get_input_port())
+
+        simulation = BuildSimulation(scenario, prebuild=Prebuild)
+        simulator = Simulator(simulation.diagram)
+        simulator.Initialize()
+        Advance(simulation, simulator, 4.0)
+        self.assertEqual(simulation.world.role("ball"), "ghost")
+        self.assertEqual(simulation.applied_requests, {"switcher": 1})
 
 
 class TestRunner(unittest.TestCase):

@@ -85,6 +85,9 @@ class Simulation:
     robot_state: OutputPort
     attractor: OutputPort
     visualizer: MeshcatVisualizer | None = None
+    # How many of each supervisor's world events the runner has applied (runner bookkeeping:
+    # the events themselves are in the supervisors' state, the world in SceneGraph's Context).
+    applied_requests: dict = dc.field(default_factory=dict)
 
 
 def _AttractorSource(builder: DiagramBuilder, scenario: Scenario, mobee: Mobee,
@@ -125,8 +128,28 @@ def _AttractorSource(builder: DiagramBuilder, scenario: Scenario, mobee: Mobee,
         seed=scenario.random_seed)).get_output_port()
 
 
-def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simulation:
-    """Builds the scenario's diagram; with ``meshcat``, also the viewer."""
+@dc.dataclass
+class Parts:
+    """What a prebuild callback may connect to: the systems and ports of the simulation."""
+
+    builder: DiagramBuilder
+    plant: MultibodyPlant
+    scene_graph: SceneGraph
+    mobee: Mobee
+    world: LiveWorld
+    # (q, v) of MoBeE's joints, and MoBeE's attractor.
+    robot_state: OutputPort
+    attractor: OutputPort
+
+
+def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None, *,
+                    prebuild=None) -> Simulation:
+    """Builds the scenario's diagram; with ``meshcat``, also the viewer.
+
+    ``prebuild(parts: Parts)``, if given, is called before the diagram is built, to add a user's
+    own systems (a supervisor, a logger). A system with an abstract output port named
+    ``world_events`` edits the live world (see :mod:`mobee_drake.simulation.world`).
+    """
     builder = DiagramBuilder()
     kinematic = scenario.robot_model == "kinematic"
     if kinematic:
@@ -217,6 +240,9 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None) -> Simul
                                scene_graph=scene_graph, mobee=mobee, attractor=attractor,
                                marker_forces="marker_forces")
 
+    if prebuild is not None:
+        prebuild(Parts(builder=builder, plant=plant, scene_graph=scene_graph, mobee=mobee,
+                       world=world, robot_state=robot_state, attractor=attractor))
     builder.ExportOutput(robot_state, "robot_state")
     builder.ExportOutput(attractor, "attractor")
     diagram = builder.Build()

@@ -13,6 +13,7 @@ from mobee_drake.simulation.builder import BuildSimulation, Simulation
 from mobee_drake.simulation.checkpoint import LoadCheckpoint, SaveCheckpoint
 from mobee_drake.simulation.safety import SafetyReport
 from mobee_drake.simulation.scenario import Scenario
+from mobee_drake.simulation.world import SupervisorEventPorts
 
 
 @dc.dataclass
@@ -66,6 +67,17 @@ def Advance(simulation: Simulation, simulator: Simulator, until: float, *,
         bar = tqdm(total=round(until - start, 3), leave=False,
                    bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} s simulated "
                               "[{elapsed}<{remaining}]")
+    requests = SupervisorEventPorts(simulation.diagram)
+
+    def ApplyRequests():
+        for port in requests:  # Supervisors' requests, applied once each, in order.
+            name = port.get_system().get_name()
+            issued = port.Eval(port.get_system().GetMyContextFromRoot(context))
+            for event in issued[simulation.applied_requests.get(name, 0):]:
+                simulation.world.Apply(context, event)
+            simulation.applied_requests[name] = len(issued)
+
+    ApplyRequests()
     for k in range(1, chunks + 1):
         target = start + (until - start) * k / chunks
         while events and events[0].time <= target:
@@ -74,6 +86,7 @@ def Advance(simulation: Simulation, simulator: Simulator, until: float, *,
             simulation.world.Apply(context, event)
         before = context.get_time()
         simulator.AdvanceTo(target)
+        ApplyRequests()
         if bar is not None:
             bar.update(round(context.get_time() - before, 3))
         if after_chunk is not None:
@@ -108,6 +121,10 @@ def RunScenario(scenario: Scenario, *, meshcat: Meshcat | None = None, record: s
     if checkpoint and (pathlib.Path(checkpoint) / "simulation.npz").is_file():
         LoadCheckpoint(simulation, context, checkpoint)
         simulator.Initialize(InitializeParams(suppress_initialization_events=True))
+        # The world's changes live in SceneGraph's Context, not in the checkpoint: replay them.
+        for event in sorted(scenario.world_events, key=lambda e: e.time):
+            if event.time < context.get_time():
+                simulation.world.Apply(context, event)
     else:
         simulator.Initialize()
     if record:

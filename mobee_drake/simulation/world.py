@@ -12,8 +12,11 @@ be registered and removed and its roles assigned and removed. We use exactly tha
   and a **ghost** have no proximity role (MoBeE ignores them, the palm may touch a target), the
   target drawn green, the ghost translucent;
 - :class:`LiveWorld` changes them through the diagram's Context, between simulation steps, from a
-  script or from scenario events: roles are assigned and removed, objects registered and removed;
-  a move re-registers the object at its new pose (SceneGraph does not update the pose of a
+  script, from scenario events, or on a supervisor's request (an abstract output port named
+  ``world_events`` listing every :class:`~mobee_drake.simulation.scenario.WorldEvent` the
+  supervisor has issued, in order; the runner applies the new ones after each step it takes):
+  roles are assigned and removed, objects registered and removed; a move re-registers the object
+  at its new pose (SceneGraph does not update the pose of a
   world-fixed geometry whose shape is changed in a Context). Changes made in the Context are not
   in the SceneGraph model, so a Meshcat *recording* shows the objects as they were at the start
   (the live view is updated).
@@ -167,3 +170,12 @@ class LiveWorld:
             self.Move(root_context, event.object, event.position)
         if event.role:
             self.SetRole(root_context, event.object, event.role)
+
+
+WORLD_EVENTS_PORT = "world_events"
+
+
+def SupervisorEventPorts(diagram) -> list:
+    """The ``world_events`` output ports of the diagram's systems (see the module)."""
+    return [system.GetOutputPort(WORLD_EVENTS_PORT) for system in diagram.GetSystems()
+            if system.HasOutputPort(WORLD_EVENTS_PORT)]
