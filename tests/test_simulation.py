@@ -32,6 +32,17 @@ def _Palm(simulation, context):
         mobee.GetMyContextFromRoot(context))[3 * i:3 * i + 3].copy()
 
 
+def _RunAgents(scenario):
+    """Runs an exploring scenario for its duration; returns it and its agents' records."""
+    simulation = BuildSimulation(scenario)
+    simulator = Simulator(simulation.diagram)
+    simulator.Initialize()
+    simulator.AdvanceTo(scenario.duration)
+    supervisor = simulation.diagram.GetSubsystemByName("attractor")
+    records = supervisor.Records(supervisor.GetMyContextFromRoot(simulator.get_context()))
+    return simulation, simulator, supervisor, records
+
+
 def _Trajectory(scenario, times):
     simulation = BuildSimulation(scenario)
     simulator = Simulator(simulation.diagram)
@@ -344,13 +355,8 @@ class TestLiveWorld(unittest.TestCase):
 class TestExploration(unittest.TestCase):
     def test_curious_agent_on_the_kinematic_robot(self):
         scenario = LoadScenario(DIAGRAMS / "explore_hypercube.yaml", "{duration: 40}")
-        simulation = BuildSimulation(scenario)
-        simulator = Simulator(simulation.diagram)
-        simulator.Initialize()
-        simulator.AdvanceTo(scenario.duration)
+        simulation, simulator, _, (record,) = _RunAgents(scenario)
         context = simulator.get_context()
-        supervisor = simulation.diagram.GetSubsystemByName("attractor")
-        (record,) = supervisor.Records(supervisor.GetMyContextFromRoot(context))
         explorer = record.explorer
         self.assertGreaterEqual(record.actions_done, 4)
         self.assertEqual(explorer.tries.sum(), record.actions_done)
@@ -383,12 +389,7 @@ class TestPlanningOnTheRobot(unittest.TestCase):
         agent = scenario.attractor.agents[0]
         agent.model = str(folder)
         agent.explorer.strategy, agent.explorer.goal_state = "planner", goal
-        simulation = BuildSimulation(scenario)
-        simulator = Simulator(simulation.diagram)
-        simulator.Initialize()
-        simulator.AdvanceTo(scenario.duration)
-        supervisor = simulation.diagram.GetSubsystemByName("attractor")
-        (record,) = supervisor.Records(supervisor.GetMyContextFromRoot(simulator.get_context()))
+        _, _, _, (record,) = _RunAgents(scenario)
         self.assertTrue(record.arrived)
         self.assertEqual(record.state, goal)
         self.assertEqual(record.actions_done, 4)  # the shortest way through the hypercube
@@ -400,13 +401,8 @@ class TestPlanningOnTheRobot(unittest.TestCase):
 class TestSeveralAgents(unittest.TestCase):
     def test_three_agents_explore_in_parallel(self):
         scenario = LoadScenario(DIAGRAMS / "three_agents_table.yaml", "{duration: 20}")
-        simulation = BuildSimulation(scenario)
-        simulator = Simulator(simulation.diagram)
-        simulator.Initialize()
-        simulator.AdvanceTo(scenario.duration)
+        simulation, simulator, supervisor, records = _RunAgents(scenario)
         context = simulator.get_context()
-        supervisor = simulation.diagram.GetSubsystemByName("attractor")
-        records = supervisor.Records(supervisor.GetMyContextFromRoot(context))
         self.assertEqual(supervisor.agent_names, ["right_arm", "left_arm", "torso"])
         self.assertEqual([r.explorer.space.num_state_actions for r in records], [1296, 1296, 216])
         self.assertTrue(all(r.actions_done >= 2 for r in records))
