@@ -3,7 +3,6 @@
 import pathlib
 
 import numpy as np
-from pydrake.math import RigidTransform
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import DiagramBuilder
@@ -11,7 +10,8 @@ from pydrake.systems.framework import DiagramBuilder
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.assembly import AddRobotWithOverlay
-from mobee_drake.scene.objects import AddBox
+from mobee_drake.simulation.scenario import Box, SceneObject
+from mobee_drake.simulation.world import LiveWorld
 
 MODELS = pathlib.Path(__file__).parent / "models"
 JOINTS = ["joint1", "joint2", "joint3"]
@@ -26,8 +26,10 @@ class ArmDiagram:
         self.robot = AddRobotWithOverlay(
             self.plant, scene_graph, model_file=MODELS / "three_link_arm.urdf",
             overlay_file=MODELS / "three_link_arm_overlay.yaml", controlled_joints=JOINTS)
+        world = LiveWorld(self.plant, scene_graph)
         for i, (size, center) in enumerate(boxes):
-            AddBox(self.plant, f"box{i}", size, RigidTransform(center))
+            world.Register(SceneObject(name=f"box{i}", shape=Box(size=list(size)),
+                                       position=list(center)))
         self.plant.Finalize()
         self.params = params or MobeeParams()
         self.dut = Mobee.AddToBuilder(builder, plant=self.plant, scene_graph=scene_graph,

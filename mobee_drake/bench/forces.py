@@ -13,13 +13,13 @@ import dataclasses as dc
 import time
 
 import numpy as np
-from pydrake.math import RigidTransform
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.icub import AddIcub, IcubConfig
-from mobee_drake.scene.objects import AddBox
+from mobee_drake.simulation.scenario import Box, SceneObject
+from mobee_drake.simulation.world import LiveWorld
 
 # The region in front of the iCub (root frame: x backwards, y right, z up) where boxes are placed.
 # It spans 60 cm in front of the chest, 1.2 m across and 1 m high; the arms reach about half of it.
@@ -41,9 +41,11 @@ def _BuildIcubAmongBoxes(num_boxes: int, rng: np.random.Generator):
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
     config = IcubConfig()
     robot = AddIcub(plant, scene_graph, config)
+    world = LiveWorld(plant, scene_graph)
     for i in range(num_boxes):
-        size = rng.uniform(0.02, 0.05, size=3)
-        AddBox(plant, f"box{i}", size, RigidTransform(rng.uniform(BOX_REGION_LOW, BOX_REGION_HIGH)))
+        world.Register(SceneObject(
+            name=f"box{i}", shape=Box(size=rng.uniform(0.02, 0.05, size=3).tolist()),
+            position=rng.uniform(BOX_REGION_LOW, BOX_REGION_HIGH).tolist()))
     plant.Finalize()
     mobee = Mobee.AddToBuilder(builder, plant=plant, scene_graph=scene_graph, robot=robot,
                                joints=config.controlled_joints)
