@@ -7,6 +7,9 @@
 - ``7.2``: coverage of the rank-3 lattice's state-actions (81 states, 16 nearest: 1296
   state-actions, the space ch. 7.2.1 used) against the number of transitions, for the curious
   agent (AC), random choice (RAND) and least-tried (LT) (Fig. 7.5).
+- ``7.2i``: the rank-3 lattice with equidistant neighbours (81 states, 432 state-actions,
+  Fig. 7.4), the 50-50 and the 60-40 initialisations, until every state-action was tried 5 times
+  (Fig. 7.6-7.7); the tries and values, and the state-actions that do not reliably reach their goal.
 - ``7.4``: three agents (both arms, the torso) in front of a table for ``--transitions``
   transitions in all (18,000 in the source); the tries of every state-action of every agent
   (Fig. 7.12).
@@ -27,6 +30,7 @@ import numpy as np
 from pydrake.systems.analysis import Simulator
 
 from mobee_drake.planning.explorers import INITIALIZATIONS, ExplorerConfig
+from mobee_drake.planning.state_space import Lattice
 from mobee_drake.simulation.builder import BuildSimulation
 from mobee_drake.simulation.scenario import Box as BoxShape
 from mobee_drake.simulation.scenario import (
@@ -129,6 +133,23 @@ def RunCoverage(output: pathlib.Path, transitions: int, runs: int) -> list[dict]
     return results
 
 
+def RunInitializations(output: pathlib.Path, runs: int, gamma: float = 0.9) -> list[dict]:
+    results = []
+    for initialization in ("50-50", "60-40"):
+        for run in range(runs):
+            path = output / f"7.2i_{initialization}_run{run}.json"
+            if not path.exists():
+                agent = ExploringAgent(
+                    name="right_arm", joints=RIGHT_ARM, levels=[0.25, 0.5, 0.75],
+                    explorer=ExplorerConfig(initialization=initialization, gamma=gamma,
+                                            seed=run))
+                data = _Explore(_Scenario([agent]),
+                                stop=lambda records: records[0].explorer.tries.min() >= 5)
+                _Save(path, dict(initialization=initialization, run=run, **data))
+            results.append(json.loads(path.read_text()))
+    return results
+
+
 def RunThreeAgents(output: pathlib.Path, transitions: int) -> dict:
     path = output / f"7.4_{transitions}.json"
     if not path.exists():
@@ -190,6 +211,26 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
         figure.savefig(output / "7.2_coverage.png", dpi=80)
         return (["| strategy | run | transitions | state-actions tried | transitions to try all |",
                  "|---|---:|---:|---:|---:|"] + lines)
+    if experiment == "7.2i":
+        figure, axes = plt.subplots(2, 1, figsize=(12, 6))
+        space = Lattice([0.25, 0.5, 0.75], 4)
+        header = ["| initialisation | run | actions | state-actions missing their goal in more "
+                  "than 10 % of >= 3 tries (state -> goal: misses/tries) |", "|---|---:|---:|---|"]
+        for r in results:
+            tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
+            axes[0 if r["initialization"] == "50-50" else 1].bar(
+                np.arange(len(tries)), tries, alpha=0.6, label=f"run {r['run']}")
+            unreliable = np.flatnonzero((misses > 0.1) & (tries >= 3))
+            listed = ", ".join(
+                f"{space.action_state[i]}->{space.action_goal[i]}: "
+                f"{round(misses[i] * tries[i])}/{tries[i]}" for i in unreliable)
+            lines.append(f"| {r['initialization']} | {r['run']} | {r['actions'][0]} | "
+                         f"{listed or '-'} |")
+        for axis, name in zip(axes, ("50-50", "60-40")):
+            axis.set_title(f"{name}: tries per state-action")
+        figure.tight_layout()
+        figure.savefig(output / "7.2i_initializations.png", dpi=80)
+        return header + lines
     figure, axes = plt.subplots(3, 1, figsize=(12, 8))
     for axis, name, tries in zip(axes, results["agents"], results["tries"]):
         axis.bar(np.arange(len(tries)), tries)
@@ -224,7 +265,7 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--experiment", choices=["7.1", "7.2", "7.4"], required=True)
+    parser.add_argument("--experiment", choices=["7.1", "7.2", "7.2i", "7.4"], required=True)
     parser.add_argument("--output", default="results/ch7")
     parser.add_argument("--runs", type=int, default=10)
     parser.add_argument("--transitions", type=int, default=18000)
@@ -236,6 +277,8 @@ def main(argv=None) -> None:
         results = RunHypercube(output, args.runs)
     elif args.experiment == "7.2":
         results = RunCoverage(output, args.transitions, args.runs)
+    elif args.experiment == "7.2i":
+        results = RunInitializations(output, args.runs)
     else:
         results = RunThreeAgents(output, args.transitions)
     table = _Plots(output, args.experiment, results)
