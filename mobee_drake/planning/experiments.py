@@ -32,6 +32,7 @@ from pydrake.systems.analysis import Simulator
 from mobee_drake.planning.explorers import INITIALIZATIONS, ExplorerConfig
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.simulation.builder import BuildSimulation
+from mobee_drake.simulation.runner import Advance
 from mobee_drake.simulation.scenario import Box as BoxShape
 from mobee_drake.simulation.scenario import (
     ExploreAttractor,
@@ -66,7 +67,7 @@ def _Explore(scenario: Scenario, stop, snapshots=(), chunk: float = 2.0) -> dict
     supervisor_context = supervisor.GetMyContextFromRoot(context)
     taken, coverage, start = {}, [], time.perf_counter()
     while True:
-        simulator.AdvanceTo(context.get_time() + chunk)
+        Advance(simulation, simulator, context.get_time() + chunk)  # world events included
         records = supervisor.Records(supervisor_context)
         done = sum(r.actions_done for r in records)
         coverage.append([done] + [int((r.explorer.tries > 0).sum()) for r in records])
