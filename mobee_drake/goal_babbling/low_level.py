@@ -10,6 +10,7 @@ ANN) plus exact brute force over the newest samples; the tree is rebuilt only wh
 past about 3 sqrt(size) samples, so no step rebuilds it from scratch.
 """
 
+import abc
 import math
 
 import numpy as np
@@ -218,7 +219,7 @@ class BudgetExhausted(Exception):
     """Raised by Learner.Act once the run's budget of micro-actions is spent."""
 
 
-class Learner:
+class Learner(abc.ABC):
     """Owns the arm, the memory and a seeded Generator; acts, and evaluates at checkpoints.
 
     Subclasses implement _Loop, which acts forever; Run stops it when the budget is spent.
@@ -339,8 +340,9 @@ class Learner:
         cost = ReachingCost(goal, self.arm.position, start, interest.min_competence)
         return Competence(cost, interest.competence_tolerance, interest.min_competence)
 
+    @abc.abstractmethod
     def _Loop(self) -> None:
-        raise NotImplementedError
+        """The learner's own loop of micro-actions; it ends when the budget is spent."""
 
     def Run(self) -> "Learner":
         """Learns until the budget of micro-actions is spent.
