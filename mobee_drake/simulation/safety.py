@@ -53,22 +53,21 @@ class SafetyMonitor(LeafSystem):
                                                 update=self._Update)
 
     def _Update(self, context, discrete_state) -> None:
+        pairs = self._pairs_port.Eval(context)
+        if not len(pairs):
+            return  # Nothing inside a field: the state (which Drake passes in) stays as it is.
         x = context.get_discrete_state(self._state).value().copy()
         n = len(self._names)
-        pairs = self._pairs_port.Eval(context)
-        if len(pairs):
-            inspector = self._query_port.Eval(context).inspector()
-            for geometry_id, distance, robot in zip(pairs.geometry_B, pairs.distance,
-                                                    pairs.b_is_robot):
-                if robot:
-                    i = self._self_index
-                else:
-                    i = self._index.get(inspector.GetName(geometry_id), self._others_index)
-                x[i] = min(x[i], distance)
-            deepest_now = -pairs.distance.min()
-            if deepest_now > 0:
-                x[n] += 1
-                x[n + 1] = max(x[n + 1], deepest_now)
+        inspector = self._query_port.Eval(context).inspector()
+        for geometry_id, distance, robot in zip(pairs.geometry_B, pairs.distance,
+                                                pairs.b_is_robot):
+            i = self._self_index if robot else self._index.get(inspector.GetName(geometry_id),
+                                                               self._others_index)
+            x[i] = min(x[i], distance)
+        deepest_now = -pairs.distance.min()
+        if deepest_now > 0:
+            x[n] += 1
+            x[n + 1] = max(x[n + 1], deepest_now)
         discrete_state.get_mutable_vector(self._state).SetFromVector(x)
 
     def Report(self, context) -> SafetyReport:
