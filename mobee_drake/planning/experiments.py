@@ -10,6 +10,9 @@
 - ``7.2i``: the rank-3 lattice with equidistant neighbours (81 states, 432 state-actions,
   Fig. 7.4), the 50-50 and the 60-40 initialisations, until every state-action was tried 5 times
   (Fig. 7.6-7.7); the tries and values, and the state-actions that do not reliably reach their goal.
+- ``7.3``: both rank-4 lattices (256 states, 1536 state-actions; levels 20-80 % and 12.5-87.5 %)
+  for ``--transitions`` actions each: the states never entered and why (their centres' shoulder
+  cable clearance), and the state-actions with several outcomes (Fig. 7.8-7.9).
 - ``7.4``: three agents (both arms, the torso) in front of a table for ``--transitions``
   transitions in all (18,000 in the source); the tries of every state-action of every agent
   (Fig. 7.12).
@@ -27,10 +30,14 @@ import sys
 import time
 
 import numpy as np
+from pydrake.geometry import SceneGraph
+from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.analysis import Simulator
 
+from mobee_drake.mobee.constraints import ClauseSet
 from mobee_drake.planning.explorers import INITIALIZATIONS, ExplorerConfig
 from mobee_drake.planning.state_space import Lattice
+from mobee_drake.robots.icub import AddIcub, IcubConfig
 from mobee_drake.simulation.builder import BuildSimulation
 from mobee_drake.simulation.runner import Advance
 from mobee_drake.simulation.scenario import Box as BoxShape
@@ -151,6 +158,23 @@ def RunInitializations(output: pathlib.Path, runs: int, gamma: float = 0.9) -> l
     return results
 
 
+RANK_4_LATTICES = {"20-80": [0.2, 0.4, 0.6, 0.8], "12.5-87.5": [0.125, 0.375, 0.625, 0.875]}
+
+
+def RunRank4(output: pathlib.Path, transitions: int) -> list[dict]:
+    results = []
+    for name, levels in RANK_4_LATTICES.items():
+        path = output / f"7.3_{name}_{transitions}.json"
+        if not path.exists():
+            agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=levels,
+                                   explorer=ExplorerConfig(seed=0))
+            data = _Explore(_Scenario([agent]), chunk=5.0,
+                            stop=lambda records: records[0].actions_done >= transitions)
+            _Save(path, dict(lattice=name, levels=levels, **data))
+        results.append(json.loads(path.read_text()))
+    return results
+
+
 def RunThreeAgents(output: pathlib.Path, transitions: int) -> dict:
     path = output / f"7.4_{transitions}.json"
     if not path.exists():
@@ -164,6 +188,20 @@ def RunThreeAgents(output: pathlib.Path, transitions: int) -> dict:
                         stop=lambda records: sum(r.actions_done for r in records) >= transitions)
         _Save(path, data)
     return json.loads(path.read_text())
+
+
+def _ConstraintClearances(centres: np.ndarray) -> np.ndarray:
+    """The smallest clearance (deg) of the right arm's constraint clauses at each state centre
+    (fractions of the shoulder-elbow joints' ranges), from the iCub model and its overlay."""
+    plant, scene_graph = MultibodyPlant(0.0), SceneGraph()
+    plant.RegisterAsSourceForSceneGraph(scene_graph)
+    robot = AddIcub(plant, scene_graph, IcubConfig(controlled_joints=RIGHT_ARM))
+    plant.Finalize()
+    lower = np.array([plant.GetJointByName(j).position_lower_limits()[0] for j in RIGHT_ARM])
+    upper = np.array([plant.GetJointByName(j).position_upper_limits()[0] for j in RIGHT_ARM])
+    clauses = ClauseSet(robot.overlay.clauses, RIGHT_ARM, robot.frozen_joints)
+    return np.array([np.degrees(clauses.Clearances(lower + c * (upper - lower)).min())
+                     for c in centres])
 
 
 def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
@@ -212,6 +250,27 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
         figure.savefig(output / "7.2_coverage.png", dpi=80)
         return (["| strategy | run | transitions | state-actions tried | transitions to try all |",
                  "|---|---:|---:|---:|---:|"] + lines)
+    if experiment == "7.3":
+        header = ["| lattice | actions | states never entered (clearance of the tightest "
+                  "constraint clause at their centres, deg of joint space) | state-actions with "
+                  "several outcomes (tried >= 3 times) | most-tried state-action: tries, share "
+                  "ending in its goal |",
+                  "|---|---:|---|---:|---|"]
+        for r in results:
+            space = Lattice(r["levels"], 4)
+            tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
+            entered = np.zeros(space.num_states, dtype=bool)
+            entered[space.action_state[tries > 0]] = True  # an action was tried from it
+            never = np.flatnonzero(~entered)
+            clearance = _ConstraintClearances(space.centres[never])
+            clearances = [f"{s_}: {c:.0f}" for s_, c in zip(never, clearance)]
+            several = int(np.sum((misses > 0) & (misses < 1) & (tries >= 3)))
+            top = int(np.argmax(tries))
+            lines.append(f"| {r['lattice']} | {r['actions'][0]} | {len(never)}: "
+                         f"{', '.join(clearances) or '-'} | {several} | "
+                         f"{space.action_state[top]}->{space.action_goal[top]}: {tries[top]}, "
+                         f"{100 * (1 - misses[top]):.0f} % |")
+        return header + lines
     if experiment == "7.2i":
         figure, axes = plt.subplots(2, 1, figsize=(12, 6))
         space = Lattice([0.25, 0.5, 0.75], 4)
@@ -266,7 +325,8 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--experiment", choices=["7.1", "7.2", "7.2i", "7.4"], required=True)
+    parser.add_argument("--experiment", choices=["7.1", "7.2", "7.2i", "7.3", "7.4"],
+                        required=True)
     parser.add_argument("--output", default="results/ch7")
     parser.add_argument("--runs", type=int, default=10)
     parser.add_argument("--transitions", type=int, default=18000)
@@ -280,6 +340,8 @@ def main(argv=None) -> None:
         results = RunCoverage(output, args.transitions, args.runs)
     elif args.experiment == "7.2i":
         results = RunInitializations(output, args.runs)
+    elif args.experiment == "7.3":
+        results = RunRank4(output, args.transitions)
     else:
         results = RunThreeAgents(output, args.transitions)
     table = _Plots(output, args.experiment, results)
