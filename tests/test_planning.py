@@ -260,7 +260,7 @@ class TestSupervisor(unittest.TestCase):
 class TestExperimentsSmoke(unittest.TestCase):
     """The ch. 7 experiment scripts on tiny budgets: they run the robot and write their files."""
 
-    def test_coverage_and_three_agents(self):
+    def test_coverage_rank_4_and_three_agents(self):
         import pathlib
         import tempfile
 
@@ -272,6 +272,10 @@ class TestExperimentsSmoke(unittest.TestCase):
         for strategy in ("curious", "random", "least_tried"):
             self.assertTrue((output / f"7.2_{strategy}_run0.json").is_file())
         self.assertTrue((output / "7.2_coverage.png").is_file())
+        experiments.main(["--experiment", "7.3", "--output", str(output), "--transitions", "2"])
+        report = (output / "report_7.3.md").read_text()
+        self.assertIn("| 20-80 |", report)
+        self.assertIn("| 12.5-87.5 |", report)
         experiments.main(["--experiment", "7.4", "--output", str(output), "--transitions", "6"])
         report = (output / "report_7.4.md").read_text()
         self.assertIn("correlation of the right and the left arm", report)
