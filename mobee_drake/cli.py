@@ -1,6 +1,7 @@
 """The ``mobee-drake`` command: one subcommand per job a user runs."""
 
 import argparse
+import importlib
 import sys
 
 
@@ -56,29 +57,26 @@ def _Run(args: list[str]) -> None:
     print(summary.Format())
 
 
+def _Dispatch(prog: str, args: list[str], modules: dict[str, str]) -> None:
+    """Runs ``main(rest)`` of the module named by the first argument (its own --help included)."""
+    if not args or args[0] not in modules:
+        parser = argparse.ArgumentParser(prog=prog)
+        parser.add_argument("which", choices=sorted(modules))
+        parser.parse_args(args[:1])
+    importlib.import_module(modules[args[0]]).main(args[1:])
+
+
 def _Bench(args: list[str]) -> None:
-    parser = argparse.ArgumentParser(prog="mobee-drake bench")
-    parser.add_argument("what", choices=["forces", "simulation"], help="which benchmark to run")
-    known, rest = parser.parse_known_args(args)
-    if known.what == "forces":
-        from mobee_drake.bench.forces import main
-    else:
-        from mobee_drake.bench.simulation import main
-    main(rest)
+    """Benchmarks that print their figures."""
+    _Dispatch("mobee-drake bench", args, {"forces": "mobee_drake.bench.forces",
+                                          "simulation": "mobee_drake.bench.simulation"})
 
 
 def _Experiment(args: list[str]) -> None:
-    """Runs a battery of experiments that write data, plots and a report."""
-    parser = argparse.ArgumentParser(prog="mobee-drake experiment")
-    parser.add_argument("which", choices=["ch7", "saggriac"],
-                        help="ch7: the model-learning experiments of the dissertation's ch. 7; "
-                             "saggriac: the SAGG-RIAC comparison on the 15-joint arm")
-    known, rest = parser.parse_known_args(args)
-    if known.which == "ch7":
-        from mobee_drake.planning.experiments import main
-    else:
-        from mobee_drake.goal_babbling.experiments import main
-    main(rest)
+    """Batteries of experiments that write data, plots and a report: ch7 (the model-learning
+    experiments of the dissertation's ch. 7), saggriac (SAGG-RIAC on the 15-joint arm)."""
+    _Dispatch("mobee-drake experiment", args, {"ch7": "mobee_drake.planning.experiments",
+                                               "saggriac": "mobee_drake.goal_babbling.experiments"})
 
 
 def _Info(args: list[str]) -> None:
