@@ -242,6 +242,33 @@ class TestSupervisor(unittest.TestCase):
         dut.CalcForcedUnrestrictedUpdate(context, context.get_mutable_state())
         self.assertEqual(dut.Records(context)[0].actions_done, 1)  # timed out while moving
 
+    def test_planner_takes_new_goals(self):
+        from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
+
+        # A 2 x 2 lattice over joints b, c; the planner starts in state 0 heading for state 3.
+        space = Lattice([0.25, 0.75], 2)
+        agent = Agent(name="arm", joints=["b", "c"], space=space,
+                      explorer=ExplorerConfig(strategy="planner", goal_state=3))
+        dut = ExplorationSupervisor(agents=[agent], joints=["b", "c"], lower=np.zeros(2),
+                                    upper=np.ones(2), home=np.zeros(2))
+        context = dut.CreateDefaultContext()
+        dut.GetInputPort("robot_state").FixValue(context, [0.25, 0.25, 0.0, 0.0])
+        dut.ExecuteInitializationEvents(context)
+        # A goal one step away: the first action goes straight there.
+        dut.SetPlannerGoal(context, "arm", 2)
+        (record,) = dut.Records(context)
+        self.assertEqual((record.state, record.explorer.config.goal_state), (0, 2))
+        self.assertEqual(space.action_goal[record.state_action], 2)
+        np.testing.assert_allclose(dut.get_output_port().Eval(context), space.centres[2])
+        self.assertFalse(record.arrived)
+        # The goal it is in already: it has arrived and stays.
+        dut.SetPlannerGoal(context, "arm", 0)
+        self.assertTrue(dut.Records(context)[0].arrived)
+        with self.assertRaisesRegex(ValueError, "goal state 4 is not a state"):
+            dut.SetPlannerGoal(context, "arm", 4)
+        with self.assertRaisesRegex(ValueError, "unknown agent 'leg'"):
+            dut.SetPlannerGoal(context, "leg", 1)
+
     def test_bad_agents(self):
         from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
 

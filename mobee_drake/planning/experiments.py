@@ -16,6 +16,12 @@
 - ``7.4``: three agents (both arms, the torso) in front of a table for ``--transitions``
   transitions in all (18,000 in the source); the tries of every state-action of every agent
   (Fig. 7.12).
+- ``7.4.1``: planning among a moving obstacle, on the right arm's hypercube: a box jumps at
+  random times into the arm's way and out of it; a curious agent learns for
+  ``--transitions`` actions among it (1000 by default), another without it; each becomes a
+  planner (a reward on a goal state) and solves, ``--runs`` times among the moving box, every
+  problem with two shortest routes of which one has a step the first agent found unreliable: the
+  plans, and the actions and failed transitions per problem.
 
 Each run writes its data as JSON (atomically, skipped when it exists, so an interrupted battery
 resumes), then the experiment writes PNG plots and a ``report.md``. Run:
@@ -35,10 +41,12 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.analysis import Simulator
 
 from mobee_drake.mobee.constraints import ClauseSet
-from mobee_drake.planning.explorers import INITIALIZATIONS, ExplorerConfig
+from mobee_drake.planning.explorers import INITIALIZATIONS, ExplorerConfig, LoadAgentModel
+from mobee_drake.planning.planner import GreedyPlan
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.robots.icub import AddIcub, IcubConfig
 from mobee_drake.simulation.builder import BuildSimulation
+from mobee_drake.simulation.checkpoint import SaveCheckpoint
 from mobee_drake.simulation.runner import Advance
 from mobee_drake.simulation.scenario import Box as BoxShape
 from mobee_drake.simulation.scenario import (
@@ -46,6 +54,7 @@ from mobee_drake.simulation.scenario import (
     ExploringAgent,
     Scenario,
     SceneObject,
+    WorldEvent,
 )
 
 RIGHT_ARM = ["r_shoulder_pitch", "r_shoulder_roll", "r_shoulder_yaw", "r_elbow"]
@@ -64,8 +73,10 @@ def _Scenario(agents: list[ExploringAgent], objects=()) -> Scenario:
     return scenario
 
 
-def _Explore(scenario: Scenario, stop, snapshots=(), chunk: float = 2.0) -> dict:
-    """Runs until ``stop(records)``; returns per-agent tries (and values at ``snapshots``)."""
+def _Explore(scenario: Scenario, stop, snapshots=(), chunk: float = 2.0,
+             keep: pathlib.Path | None = None) -> dict:
+    """Runs until ``stop(records)``; returns per-agent tries (and values at ``snapshots``); with
+    ``keep``, saves the final checkpoint there (the learned models, for a planner to reuse)."""
     simulation = BuildSimulation(scenario)
     simulator = Simulator(simulation.diagram)
     simulator.Initialize()
@@ -84,23 +95,26 @@ def _Explore(scenario: Scenario, stop, snapshots=(), chunk: float = 2.0) -> dict
                                     values=records[0].explorer.Values()[0].tolist())
         if stop(records):
             break
+    if keep is not None:
+        SaveCheckpoint(simulation, context, keep)
     report = simulation.monitor.Report(simulation.monitor.GetMyContextFromRoot(context))
-    def Misses(explorer):
-        """Per state-action, the share of its tries that did not end in its goal state."""
-        space, counts = explorer.space, explorer.transitions.counts
-        initial = 1 + INITIALIZATIONS[explorer.config.initialization]  # goal counts before tries
-        hits = counts[np.arange(space.num_state_actions), space.action_goal] - initial
-        return np.where(explorer.tries > 0,
-                        1 - hits / np.maximum(explorer.tries, 1), 0.0).tolist()
-
     return dict(
         agents=supervisor.agent_names,
         tries=[r.explorer.tries.tolist() for r in records],
-        misses=[Misses(r.explorer) for r in records],
+        values=[r.explorer.Values()[0].tolist() for r in records],
+        misses=[_Misses(r.explorer).tolist() for r in records],
         goals=[r.explorer.space.centres[r.explorer.space.action_goal].tolist() for r in records],
         actions=[r.actions_done for r in records], snapshots=taken, coverage=coverage,
         simulated_seconds=context.get_time(), wall_seconds=time.perf_counter() - start,
         penetrating_steps=report.penetrating_steps)
+
+
+def _Misses(explorer) -> np.ndarray:
+    """Per state-action, the share of its tries that did not end in its goal state (0 untried)."""
+    space, counts = explorer.space, explorer.transitions.counts
+    initial = 1 + INITIALIZATIONS[explorer.config.initialization]  # goal counts before tries
+    hits = counts[np.arange(space.num_state_actions), space.action_goal] - initial
+    return np.where(explorer.tries > 0, 1 - hits / np.maximum(explorer.tries, 1), 0.0)
 
 
 def _Save(path: pathlib.Path, data: dict) -> None:
@@ -141,35 +155,42 @@ def RunCoverage(output: pathlib.Path, transitions: int, runs: int) -> list[dict]
     return results
 
 
-def RunInitializations(output: pathlib.Path, runs: int, gamma: float = 0.9) -> list[dict]:
+def RunInitializations(output: pathlib.Path, runs: int,
+                       gammas=(0.5, 0.9, 0.99)) -> list[dict]:
     results = []
     for initialization in ("50-50", "60-40"):
-        for run in range(runs):
-            path = output / f"7.2i_{initialization}_run{run}.json"
-            if not path.exists():
-                agent = ExploringAgent(
-                    name="right_arm", joints=RIGHT_ARM, levels=[0.25, 0.5, 0.75],
-                    explorer=ExplorerConfig(initialization=initialization, gamma=gamma,
-                                            seed=run))
-                data = _Explore(_Scenario([agent]),
-                                stop=lambda records: records[0].explorer.tries.min() >= 5)
-                _Save(path, dict(initialization=initialization, run=run, **data))
-            results.append(json.loads(path.read_text()))
+        for gamma in gammas:
+            for run in range(runs):
+                path = output / f"7.2i_{initialization}_gamma{gamma}_run{run}.json"
+                if not path.exists():
+                    agent = ExploringAgent(
+                        name="right_arm", joints=RIGHT_ARM, levels=[0.25, 0.5, 0.75],
+                        explorer=ExplorerConfig(initialization=initialization, gamma=gamma,
+                                                seed=run))
+                    data = _Explore(_Scenario([agent]),
+                                    stop=lambda records: records[0].explorer.tries.min() >= 5)
+                    _Save(path, dict(initialization=initialization, gamma=gamma, run=run,
+                                     **data))
+                results.append(json.loads(path.read_text()))
     return results
 
 
 RANK_4_LATTICES = {"20-80": [0.2, 0.4, 0.6, 0.8], "12.5-87.5": [0.125, 0.375, 0.625, 0.875]}
+# The actions the source took on each (Fig. 7.8-7.9).
+RANK_4_SOURCE_ACTIONS = {"20-80": 14597, "12.5-87.5": 26963}
 
 
-def RunRank4(output: pathlib.Path, transitions: int) -> list[dict]:
+def RunRank4(output: pathlib.Path, transitions: int | None) -> list[dict]:
+    """Each rank-4 lattice for ``transitions`` actions (None: the source's number)."""
     results = []
     for name, levels in RANK_4_LATTICES.items():
-        path = output / f"7.3_{name}_{transitions}.json"
+        budget = RANK_4_SOURCE_ACTIONS[name] if transitions is None else transitions
+        path = output / f"7.3_{name}_{budget}.json"
         if not path.exists():
             agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=levels,
                                    explorer=ExplorerConfig(seed=0))
             data = _Explore(_Scenario([agent]), chunk=5.0,
-                            stop=lambda records: records[0].actions_done >= transitions)
+                            stop=lambda records, budget=budget: records[0].actions_done >= budget)
             _Save(path, dict(lattice=name, levels=levels, **data))
         results.append(json.loads(path.read_text()))
     return results
@@ -190,6 +211,126 @@ def RunThreeAgents(output: pathlib.Path, transitions: int) -> dict:
     return json.loads(path.read_text())
 
 
+# Ch. 7.4.1 on the right arm's hypercube: a 20 cm box that jumps, at random times, into the arm's
+# way (centred on the right hand's pose in state 1: shoulder pitch, roll and yaw at 25 %, elbow at
+# 75 %) or out of it (metres, the iCub's root frame). MoBeE lets the arm slip around the box on
+# some edges (a hypercube's regions are large); where it does not, the transition fails while the
+# box is there (a static box there fails 9 of the 64 state-actions in 25-75 % of their tries).
+MOVING_BOX = "moving_box"
+BOX_PLACES = {"in the way": [-0.209, 0.217, 0.273], "away": [0.3, -0.6, -0.3]}
+# A state-action is unreliable when it reached its goal in fewer than this share of >= 5 tries.
+UNRELIABLE = 0.8
+
+
+def _MovingBox(seed: int, horizon: float) -> tuple[SceneObject, list[WorldEvent]]:
+    """The box and its jumps until ``horizon`` (every 4-12 s, to a random place)."""
+    rng, time_, events, places = np.random.default_rng(seed), 0.0, [], list(BOX_PLACES.values())
+    while time_ < horizon:
+        time_ += rng.uniform(4.0, 12.0)
+        events.append(WorldEvent(time=round(time_, 2), object=MOVING_BOX,
+                                 position=places[rng.integers(len(places))]))
+    return (SceneObject(name=MOVING_BOX, shape=BoxShape(size=[0.2, 0.2, 0.2]),
+                        position=BOX_PLACES["away"]), events)
+
+
+def _Reliability(explorer) -> np.ndarray:
+    """Per state-action, the share of its tries that reached its goal (1 when tried < 5 times)."""
+    return np.where(explorer.tries >= 5, 1 - _Misses(explorer), 1.0)
+
+
+def _DetourProblems(space, unreliable: np.ndarray) -> list[tuple[int, int]]:
+    """(start, goal) two steps apart with exactly two shortest routes, one of them over an
+    unreliable state-action and the other not."""
+    action = {(int(s), int(g)): sa for sa, (s, g) in
+              enumerate(zip(space.action_state, space.action_goal))}
+    problems = []
+    for start in range(space.num_states):
+        for goal in range(space.num_states):
+            routes = [(action[start, m], action[m, goal]) for m in range(space.num_states)
+                      if (start, m) in action and (m, goal) in action and m != goal
+                      and (start, goal) not in action and start != goal]
+            risky = [bool(unreliable[list(route)].any()) for route in routes]
+            if len(routes) == 2 and sum(risky) == 1:
+                problems.append((start, goal))
+    return problems
+
+
+def _Plan(model: pathlib.Path, problems, repeats: int, seed: int) -> dict:
+    """The learned model in ``model`` as a planner among the moving box: for each problem, go to
+    its start, then plan to its goal and execute; counts actions and failed transitions."""
+    box, events = _MovingBox(seed, horizon=40.0 * repeats * len(problems) * 6)
+    agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=[0.25, 0.75],
+                           model=str(model), explorer=ExplorerConfig(
+                               strategy="planner", goal_state=problems[0][0], seed=seed))
+    scenario = _Scenario([agent], [box])
+    scenario.world_events = events
+    simulation = BuildSimulation(scenario)
+    simulator = Simulator(simulation.diagram)
+    simulator.Initialize()
+    context = simulator.get_context()
+    supervisor = simulation.diagram.GetSubsystemByName("attractor")
+    supervisor_context = supervisor.GetMyContextFromRoot(context)
+
+    def Go(goal: int, max_actions: int = 12) -> tuple[int, np.ndarray]:
+        """Heads for ``goal``; returns the actions taken and the transitions observed."""
+        supervisor.SetPlannerGoal(supervisor_context, "right_arm", goal)
+        before = supervisor.Records(supervisor_context)[0]
+        record = before
+        while not record.arrived and record.actions_done - before.actions_done < max_actions:
+            Advance(simulation, simulator, context.get_time() + 1.0)
+            record = supervisor.Records(supervisor_context)[0]
+        observed = record.explorer.transitions.counts - before.explorer.transitions.counts
+        return record.actions_done - before.actions_done, observed
+
+    space = supervisor.Records(supervisor_context)[0].explorer.space
+    rows = np.arange(space.num_state_actions)
+    episodes = []
+    for _ in range(repeats):
+        for start, goal in problems:
+            Go(start)
+            actions, observed = Go(goal)
+            failed = observed.sum() - observed[rows, space.action_goal].sum()
+            episodes.append(dict(start=start, goal=goal, actions=actions, failed=int(failed),
+                                 tried=np.flatnonzero(observed.sum(axis=1)).tolist()))
+    report = simulation.monitor.Report(simulation.monitor.GetMyContextFromRoot(context))
+    return dict(episodes=episodes, simulated_seconds=context.get_time(),
+                penetrating_steps=report.penetrating_steps)
+
+
+def RunDynamicPlanning(output: pathlib.Path, transitions: int, repeats: int) -> dict:
+    """Ch. 7.4.1: a curious agent trained among the moving box and one trained without it, each
+    turned into a planner (reward on a goal) and run among the moving box on the problems with a
+    risky and a safe shortest route (risky as the first agent learned it)."""
+    models = {}
+    for trained in ("moving_box", "no_box"):
+        models[trained] = output / f"7.4.1_model_{trained}_{transitions}"
+        if not models[trained].exists():
+            agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=[0.25, 0.75],
+                                   explorer=ExplorerConfig(seed=0))
+            box, events = _MovingBox(seed=0, horizon=12.0 * transitions)
+            scenario = _Scenario([agent], [box] if trained == "moving_box" else [])
+            scenario.world_events = events if trained == "moving_box" else []
+            _Explore(scenario, chunk=5.0, keep=models[trained],
+                     stop=lambda records: records[0].actions_done >= transitions)
+    learned = {trained: LoadAgentModel(str(model), "right_arm", ExplorerConfig())
+               for trained, model in models.items()}
+    space = learned["moving_box"].space
+    unreliable = _Reliability(learned["moving_box"]) < UNRELIABLE
+    problems = _DetourProblems(space, unreliable)
+    results = dict(unreliable=np.flatnonzero(unreliable).tolist(), problems=problems,
+                   action_state=space.action_state.tolist(),
+                   action_goal=space.action_goal.tolist())
+    for trained, explorer in learned.items():
+        path = output / f"7.4.1_plans_{trained}_{transitions}_{repeats}.json"
+        if not path.exists():
+            plans = [GreedyPlan(explorer, start, goal) for start, goal in problems]
+            _Save(path, dict(reliability=_Reliability(explorer).tolist(), plans=plans,
+                             **(_Plan(models[trained], problems, repeats, seed=1)
+                                if problems else dict(episodes=[]))))
+        results[trained] = json.loads(path.read_text())
+    return results
+
+
 def _ConstraintClearances(centres: np.ndarray) -> np.ndarray:
     """The smallest clearance (deg) of the right arm's constraint clauses at each state centre
     (fractions of the shoulder-elbow joints' ranges), from the iCub model and its overlay."""
@@ -202,6 +343,15 @@ def _ConstraintClearances(centres: np.ndarray) -> np.ndarray:
     clauses = ClauseSet(robot.overlay.clauses, RIGHT_ARM, robot.frozen_joints)
     return np.array([np.degrees(clauses.Clearances(lower + c * (upper - lower)).min())
                      for c in centres])
+
+
+def _StackedBars(axis, stack: np.ndarray, title: str) -> None:
+    """One bar per state-action, the runs (rows of ``stack``) stacked in colours (Fig. 7.2-7.7)."""
+    bottom = np.zeros(stack.shape[1])
+    for values in stack:
+        axis.bar(np.arange(len(values)), values, bottom=bottom, width=1.0)
+        bottom += values
+    axis.set_title(title)
 
 
 def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
@@ -217,12 +367,9 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
         for column, gamma in enumerate(gammas):
             mine = [r for r in results if r["gamma"] == gamma]
             for row, key in enumerate(("tries", "values")):
-                stack = np.array([r["snapshots"]["320"][key] for r in mine])
-                bottom = np.zeros(stack.shape[1])
-                for values in stack:
-                    axes[row, column].bar(np.arange(len(values)), values, bottom=bottom)
-                    bottom += values
-                axes[row, column].set_title(f"gamma {gamma}: {key} after 320 actions")
+                _StackedBars(axes[row, column],
+                             np.array([r["snapshots"]["320"][key] for r in mine]),
+                             f"gamma {gamma}: {key} after 320 actions")
             tries = np.array([r["snapshots"]["320"]["tries"] for r in mine])
             values = np.array([r["snapshots"]["320"]["values"] for r in mine])
             lines.append(f"| {gamma} | {len(mine)} | {tries.mean():.2f} | "
@@ -272,24 +419,66 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
                          f"{100 * (1 - misses[top]):.0f} % |")
         return header + lines
     if experiment == "7.2i":
-        figure, axes = plt.subplots(2, 1, figsize=(12, 6))
         space = Lattice([0.25, 0.5, 0.75], 4)
-        header = ["| initialisation | run | actions | state-actions missing their goal in more "
-                  "than 10 % of >= 3 tries (state -> goal: misses/tries) |", "|---|---:|---:|---|"]
-        for r in results:
-            tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
-            axes[0 if r["initialization"] == "50-50" else 1].bar(
-                np.arange(len(tries)), tries, alpha=0.6, label=f"run {r['run']}")
-            unreliable = np.flatnonzero((misses > 0.1) & (tries >= 3))
-            listed = ", ".join(
-                f"{space.action_state[i]}->{space.action_goal[i]}: "
-                f"{round(misses[i] * tries[i])}/{tries[i]}" for i in unreliable)
-            lines.append(f"| {r['initialization']} | {r['run']} | {r['actions'][0]} | "
-                         f"{listed or '-'} |")
-        for axis, name in zip(axes, ("50-50", "60-40")):
-            axis.set_title(f"{name}: tries per state-action")
+        gammas = sorted({r["gamma"] for r in results})
+        header = ["| initialisation | gamma | run | actions | state-actions missing their goal "
+                  "in more than 10 % of >= 3 tries (state -> goal: misses/tries) |",
+                  "|---|---:|---:|---:|---|"]
+        for initialization in ("50-50", "60-40"):
+            figure, axes = plt.subplots(2 * len(gammas), 1, figsize=(12, 3 * len(gammas)),
+                                        squeeze=False)
+            for row, gamma in enumerate(gammas):
+                mine = [r for r in results
+                        if r["initialization"] == initialization and r["gamma"] == gamma]
+                for offset, key in enumerate(("tries", "values")):
+                    _StackedBars(axes[2 * row + offset, 0],
+                                 np.array([r[key][0] for r in mine]),
+                                 f"{initialization}, gamma {gamma}: {key} per state-action, "
+                                 f"{len(mine)} runs stacked")
+                for r in mine:
+                    tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
+                    unreliable = np.flatnonzero((misses > 0.1) & (tries >= 3))
+                    listed = ", ".join(
+                        f"{space.action_state[i]}->{space.action_goal[i]}: "
+                        f"{round(misses[i] * tries[i])}/{tries[i]}" for i in unreliable)
+                    lines.append(f"| {initialization} | {gamma} | {r['run']} | "
+                                 f"{r['actions'][0]} | {listed or '-'} |")
+            figure.tight_layout()
+            figure.savefig(output / f"7.2i_{initialization}.png", dpi=80)
+        return header + lines
+    if experiment == "7.4.1":
+        unreliable = np.array(results["unreliable"], dtype=int)
+        risky = {(results["action_state"][sa], results["action_goal"][sa]) for sa in unreliable}
+        figure, axis = plt.subplots(figsize=(12, 4))
+        header = [f"- unreliable state-actions learned among the moving box (reached their goal "
+                  f"in < {UNRELIABLE:.0%} of >= 5 tries), state -> goal: "
+                  + (", ".join(f"{s_}->{g}" for s_, g in sorted(risky)) or "none"),
+                  f"- problems with one risky and one safe shortest route: "
+                  f"{len(results['problems'])}", "",
+                  "| trained | greedy plans over a risky step | executed problems | actions per "
+                  "problem | failed transitions per problem | problems that tried a risky "
+                  "state-action | penetrating control periods |",
+                  "|---|---:|---:|---:|---:|---:|---:|"]
+        for offset, trained in enumerate(("moving_box", "no_box")):
+            r = results[trained]
+            axis.bar(np.arange(len(r["reliability"])) + 0.4 * offset, r["reliability"],
+                     width=0.4, label=f"trained: {trained}")
+            crossing = sum(any(step in risky for step in zip(path, path[1:]))
+                           for path in r["plans"])
+            episodes = r["episodes"] or [dict(actions=0, failed=0, tried=[])]
+            lines.append(
+                f"| {trained} | {crossing} of {len(r['plans'])} | {len(r['episodes'])} | "
+                f"{np.mean([e['actions'] for e in episodes]):.2f} | "
+                f"{np.mean([e['failed'] for e in episodes]):.2f} | "
+                f"{np.mean([bool(set(e['tried']) & set(unreliable)) for e in episodes]):.0%} | "
+                f"{r.get('penetrating_steps', 0)} |")
+        for sa in unreliable:
+            axis.axvspan(sa - 0.3, sa + 0.7, color="red", alpha=0.15)
+        axis.set_xlabel("state-action (unreliable ones shaded)")
+        axis.set_ylabel("share of tries reaching the goal")
+        axis.legend()
         figure.tight_layout()
-        figure.savefig(output / "7.2i_initializations.png", dpi=80)
+        figure.savefig(output / "7.4.1_moving_box.png", dpi=80)
         return header + lines
     figure, axes = plt.subplots(3, 1, figsize=(12, 8))
     for axis, name, tries in zip(axes, results["agents"], results["tries"]):
@@ -325,11 +514,13 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--experiment", choices=["7.1", "7.2", "7.2i", "7.3", "7.4"],
+    parser.add_argument("--experiment", choices=["7.1", "7.2", "7.2i", "7.3", "7.4", "7.4.1"],
                         required=True)
     parser.add_argument("--output", default="results/ch7")
-    parser.add_argument("--runs", type=int, default=10)
-    parser.add_argument("--transitions", type=int, default=18000)
+    parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--transitions", type=int, default=None,
+                        help="7.2: per run (default 2500); 7.3: per lattice (default: the "
+                        "source's 14,597 and 26,963); 7.4: in all (default 18,000)")
     argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(argv)
     output = pathlib.Path(args.output)
@@ -337,13 +528,15 @@ def main(argv=None) -> None:
     if args.experiment == "7.1":
         results = RunHypercube(output, args.runs)
     elif args.experiment == "7.2":
-        results = RunCoverage(output, args.transitions, args.runs)
+        results = RunCoverage(output, args.transitions or 2500, args.runs)
     elif args.experiment == "7.2i":
         results = RunInitializations(output, args.runs)
     elif args.experiment == "7.3":
         results = RunRank4(output, args.transitions)
+    elif args.experiment == "7.4":
+        results = RunThreeAgents(output, args.transitions or 18000)
     else:
-        results = RunThreeAgents(output, args.transitions)
+        results = RunDynamicPlanning(output, args.transitions or 1000, args.runs)
     table = _Plots(output, args.experiment, results)
     report = output / f"report_{args.experiment}.md"
     report.write_text(f"# Experiment {args.experiment}\n\n`python -m mobee_drake.planning."

@@ -193,6 +193,32 @@ class ExplorationSupervisor(LeafSystem):
             raise ValueError(f"{len(records)} saved agents for {len(self._agents)} agents")
         context.get_mutable_abstract_state(int(self._records)).set_value(tuple(records))
 
+    def SetPlannerGoal(self, context, agent: str, goal: int) -> None:
+        """Gives the "planner" agent ``agent`` a new goal state (ch. 6.5, 7.4.1): from the state
+        the robot is in now it plans for the new goal and starts its first action (or, already
+        there, stays). ``context`` is this system's context."""
+        if agent not in self.agent_names:
+            raise ValueError(f"unknown agent '{agent}'; agents: " + ", ".join(self.agent_names))
+        i = self.agent_names.index(agent)
+        config, columns = self._agents[i], self._columns[i]
+        records = list(self.Records(context))
+        explorer = records[i].explorer.Copy()
+        if explorer.config.strategy != "planner":
+            raise ValueError(f"agent '{agent}' explores ('{explorer.config.strategy}'); only a "
+                             "'planner' agent takes goals")
+        if not 0 <= goal < config.space.num_states:
+            raise ValueError(f"agent '{agent}': goal state {goal} is not a state "
+                             f"(0..{config.space.num_states - 1})")
+        explorer.config = dc.replace(explorer.config, goal_state=goal)
+        q = self._state_port.Eval(context)[:self._n]
+        state = config.space.StateOf(self._Fractions(q, columns))
+        if state == goal:
+            records[i] = dc.replace(records[i], explorer=explorer, state=state, arrived=True)
+        else:
+            records[i] = self._Begin(config, columns, explorer, q, context.get_time(),
+                                     records[i].actions_done)
+        self.SetRecords(context, tuple(records))
+
     @property
     def agent_names(self) -> list[str]:
         return [agent.name for agent in self._agents]
