@@ -1,6 +1,6 @@
 """Adds a robot for MoBeE to a plant: root welded, uncontrolled joints welded, overlay applied."""
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 import pathlib
 
 import numpy as np
@@ -14,6 +14,7 @@ from pydrake.multibody.tree import ModelInstanceIndex, RevoluteJoint
 from mobee_drake.robots.overlay import (
     ApplyOverlay,
     LoadOverlay,
+    Overlay,
     RobotOverlay,
     ZeroConfigurationPoses,
 )
@@ -34,22 +35,33 @@ def AddRobotWithOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, *,
         ValueError: naming the file and the element, for unknown joints or links, home angles
             outside their limits, or a malformed overlay.
     """
-    model_file, overlay_file = str(model_file), str(overlay_file)
-    overlay = LoadOverlay(overlay_file)
-    (instance,) = Parser(plant, model_name).AddModels(model_file)
+    model_file = str(model_file)
+    return AddModelWithOverlay(
+        plant, scene_graph, add_model=lambda p: Parser(p, model_name).AddModels(model_file)[0],
+        overlay=LoadOverlay(overlay_file), controlled_joints=controlled_joints, home=home,
+        X_WRoot=X_WRoot, model_source=model_file, overlay_source=str(overlay_file))
+
+
+def AddModelWithOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, *,
+                        add_model: Callable[[MultibodyPlant], ModelInstanceIndex],
+                        overlay: Overlay, controlled_joints: Iterable[str],
+                        home: Mapping[str, float] | None, X_WRoot: RigidTransform | None,
+                        model_source: str, overlay_source: str) -> RobotOverlay:
+    """:func:`AddRobotWithOverlay` for a model that ``add_model(plant)`` adds (to the plant and to
+    the scratch plant that finds the links' poses at zero) and an overlay already loaded."""
+    instance = add_model(plant)
     if not plant.HasBodyNamed(overlay.reference_link, instance):
-        raise ValueError(f"{overlay_file}: reference_link '{overlay.reference_link}' is not a link "
-                         f"of {model_file}")
+        raise ValueError(f"{overlay_source}: reference_link '{overlay.reference_link}' is not a "
+                         f"link of {model_source}")
     root = plant.GetBodyByName(overlay.reference_link, instance)
     if not any(plant.get_joint(j).child_body().index() == root.index()
                for j in plant.GetJointIndices(instance)):
         plant.WeldFrames(plant.world_frame(), root.body_frame(), X_WRoot or RigidTransform())
-    reference = ZeroConfigurationPoses(
-        lambda scratch: Parser(scratch).AddModels(model_file)[0], overlay.reference_link)
+    reference = ZeroConfigurationPoses(add_model, overlay.reference_link)
     frozen = FreezeJoints(plant, instance, keep=controlled_joints, home=home or {},
-                          source=model_file)
+                          source=model_source)
     return ApplyOverlay(plant, scene_graph, instance, overlay, reference, frozen_joints=frozen,
-                        source=overlay_file)
+                        source=overlay_source)
 
 
 def FreezeJoints(plant: MultibodyPlant, instance: ModelInstanceIndex, *, keep: Iterable[str],
