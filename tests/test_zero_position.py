@@ -173,5 +173,23 @@ class TestErrors(unittest.TestCase):
                     "field volumes are supported for spheres only")
 
 
+
+
+class TestKatanaScenario(unittest.TestCase):
+    def test_babbles_among_obstacles_without_touching_them(self):
+        from mobee_drake.simulation.runner import RunScenario
+        from mobee_drake.simulation.scenario import LoadScenario
+
+        scenario = LoadScenario(MODELS.parent / "diagrams" / "katana.yaml",
+                                "{duration: 30.0, visualization: {meshcat: false}}")
+        summary = RunScenario(scenario)
+        self.assertEqual(summary.safety.penetrating_steps, 0)
+        # The arm came inside the field of at least one obstacle, and MoBeE kept it out.
+        approaches = [d for name, d in summary.safety.closest_approach.items()
+                      if name in ("post", "ball", "shelf") and d is not None]
+        self.assertTrue(approaches)
+        self.assertGreater(min(approaches), 0.0)
+
+
 if __name__ == "__main__":
     unittest.main()

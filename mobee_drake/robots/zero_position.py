@@ -48,6 +48,7 @@ import numpy as np
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 
 from mobee_drake.robots.overlay import (
+    MODELS_DIR,
     Box,
     Capsule,
     Clause,
@@ -459,6 +460,32 @@ class _Reader:
         self.primitives.append(Primitive(name=name, link=body, shape=shape, field=margin))
 
 
+VISUAL_COLOR = "1.0 0.55 0.1 1"
+
+
+def _Visual(primitive: Primitive, body_origin: np.ndarray) -> str:
+    """An SDFormat <visual> of a primitive, on a body whose frame sits at ``body_origin`` and is
+    parallel to the root's at zero."""
+    shape = primitive.shape
+    if isinstance(shape, Sphere):
+        X = RigidTransform(np.asarray(shape.center) - body_origin)
+        geometry = f"<sphere><radius>{shape.radius!r}</radius></sphere>"
+    elif isinstance(shape, Capsule):
+        start, end = np.asarray(shape.start), np.asarray(shape.end)
+        X = RigidTransform(RotationMatrix.MakeFromOneVector(end - start, 2),
+                           (start + end) / 2 - body_origin)
+        geometry = (f"<capsule><radius>{shape.radius!r}</radius>"
+                    f"<length>{float(np.linalg.norm(end - start))!r}</length></capsule>")
+    else:
+        X = RigidTransform(RollPitchYaw(np.radians(shape.rpy_deg)),
+                           np.asarray(shape.center) - body_origin)
+        geometry = f"<box><size>{_Xyz(np.asarray(shape.size))}</size></box>"
+    rpy = RollPitchYaw(X.rotation()).vector()
+    return (f'<visual name="{primitive.name}"><pose>{_Xyz(X.translation())} {_Xyz(rpy)}</pose>'
+            f"<geometry>{geometry}</geometry><material><diffuse>{VISUAL_COLOR}</diffuse>"
+            "</material></visual>")
+
+
 def _Xyz(v: np.ndarray) -> str:
     return " ".join(repr(float(c)) for c in v)
 
@@ -499,6 +526,11 @@ def LoadZeroPositionTree(filename: str | pathlib.Path) -> ZeroPositionRobot:
     sdf = (f'<?xml version="1.0"?><sdf version="1.9"><model name="{name}">'
            f'<link name="{ROOT_BODY}"/>' + "".join(reader.links_sdf)
            + "".join(reader.joints_sdf) + "</model></sdf>")
+    for body in reader.joint_points:  # each body's primitives, drawn
+        visuals = "".join(_Visual(p, reader.joint_points[body]) for p in reader.primitives
+                          if p.link == body)
+        sdf = sdf.replace(f'<link name="{body}"/>', f'<link name="{body}">{visuals}</link>', 1)
+        sdf = sdf.replace(f'<link name="{body}"><pose', f'<link name="{body}">{visuals}<pose', 1)
     return ZeroPositionRobot(name=name, source=source, sdf=sdf, overlay=overlay,
                              motors=tuple(reader.motors), joints=tuple(reader.joints))
 
@@ -520,3 +552,23 @@ def AddZeroPositionRobot(plant, scene_graph, robot: ZeroPositionRobot, *,
         controlled_joints=robot.joints if controlled_joints is None else controlled_joints,
         home=robot.home, X_WRoot=X_WRoot, model_source=robot.source,
         overlay_source=robot.source)
+
+
+@dc.dataclass
+class ZeroPositionConfig:
+    """A robot of a scenario read from a MoBeE XML file (e.g. ``katana.xml``)."""
+
+    # The file; a relative path is taken from the package's models/ folder.
+    file: str = "katana.xml"
+    # The controlled joints; empty: every joint of a motor that drives one joint. (Motors that
+    # drive several joints, like the Katana's gripper, are held at home: MoBeE 2.0 here controls
+    # joints, not motors.)
+    controlled_joints: list[str] = dc.field(default_factory=list)
+
+    def Load(self) -> ZeroPositionRobot:
+        path = pathlib.Path(self.file)
+        return LoadZeroPositionTree(path if path.is_absolute() else MODELS_DIR / path)
+
+    def Joints(self, robot: ZeroPositionRobot) -> list[str]:
+        return list(self.controlled_joints) or [m.joints[0] for m in robot.motors
+                                                if len(m.joints) == 1]

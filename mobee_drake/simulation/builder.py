@@ -1,4 +1,5 @@
-"""Builds the Diagram of a scenario: the iCub, its world, MoBeE, the robot model and the viewer.
+"""Builds the Diagram of a scenario: the robot (the iCub or a MoBeE XML robot), its world,
+MoBeE, the robot model and the viewer.
 
 Two robots, chosen by ``Scenario.robot_model``:
 
@@ -47,8 +48,8 @@ from mobee_drake.planning.explorers import LoadAgentModel
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
 from mobee_drake.robots.assembly import JointStateSelector
-from mobee_drake.robots.icub import AddIcub
 from mobee_drake.robots.overlay import RobotOverlay
+from mobee_drake.robots.scenario_robot import AddScenarioRobot
 from mobee_drake.simulation.attractors import RandomAttractorSource, SliderAttractorSource
 from mobee_drake.simulation.safety import SafetyMonitor
 from mobee_drake.simulation.scenario import (
@@ -158,13 +159,12 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None, *,
         plant.RegisterAsSourceForSceneGraph(scene_graph)
     else:
         plant, scene_graph = AddMultibodyPlantSceneGraph(builder, scenario.plant_time_step)
-    robot = AddIcub(plant, scene_graph, scenario.robot)
+    robot, joints = AddScenarioRobot(plant, scene_graph, scenario.robot)
     world = LiveWorld(plant, scene_graph)
     for obj in scenario.objects:
         world.Register(obj)
     plant.Finalize()
 
-    joints = scenario.robot.controlled_joints
     mobee = builder.AddNamedSystem("mobee", Mobee(plant, robot, joints=joints,
                                                   params=scenario.mobee))
     builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))

@@ -13,6 +13,7 @@ from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.planning.explorers import ExplorerConfig
 from mobee_drake.planning.supervisor import ActionTiming
 from mobee_drake.robots.icub import IcubConfig
+from mobee_drake.robots.zero_position import ZeroPositionConfig
 from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
 
 ROBOT_MODELS = ("kinematic", "dynamic")
@@ -129,7 +130,8 @@ class Visualization:
 class Scenario:
     """Everything a run needs (see ``diagrams/`` for examples)."""
 
-    robot: IcubConfig = dc.field(default_factory=IcubConfig)
+    # The iCub, or ``!ZeroPositionConfig {file: katana.xml}`` for a robot from a MoBeE XML file.
+    robot: IcubConfig | ZeroPositionConfig = dc.field(default_factory=IcubConfig)
     objects: list[SceneObject] = dc.field(default_factory=list)
     mobee: MobeeParams = dc.field(default_factory=MobeeParams)
     # "kinematic": MoBeE's virtual dynamics (eq. 5.7) move the robot, no plant dynamics;

@@ -1,8 +1,6 @@
 """Meshcat: the robot and its world, the attractor as a translucent robot, the trail of a marker,
 and MoBeE's workspace forces: field forces at witness points, client forces at markers."""
 
-import re
-
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.geometry import (
@@ -22,7 +20,7 @@ from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.assembly import FreezeJoints, JointStateSelector
-from mobee_drake.robots.model_cache import PreparedIcubModel
+from mobee_drake.robots.scenario_robot import RobotModelText
 from mobee_drake.simulation.scenario import Scenario
 
 ATTRACTOR_ALPHA = 0.25
@@ -119,20 +117,15 @@ class TrailDrawer(LeafSystem):
 
 def _AddAttractorRobot(builder: DiagramBuilder, scenario: Scenario, scene_graph: SceneGraph,
                        mobee: Mobee, attractor: OutputPort) -> None:
-    """A second, translucent iCub (illustration only) posed at the attractor."""
-    urdf = PreparedIcubModel(scenario.robot.model).read_text()
-    translucent = re.sub(r'rgba="([\d.]+) ([\d.]+) ([\d.]+) [\d.]+"',
-                         rf'rgba="\1 \2 \3 {ATTRACTOR_ALPHA}"', urdf)
-    # A model parsed from a string must name its meshes by URI.
-    translucent = translucent.replace('filename="/', 'filename="file:///')
+    """A second, translucent robot (illustration only) posed at the attractor."""
+    text, extension, root, home = RobotModelText(scenario.robot, ATTRACTOR_ALPHA)
     ghost = MultibodyPlant(0.0)
     ghost.RegisterAsSourceForSceneGraph(scene_graph)
     parser = Parser(ghost, "attractor")
-    (instance,) = parser.AddModelsFromString(translucent, "urdf")
+    (instance,) = parser.AddModelsFromString(text, extension)
     ghost.RenameModelInstance(instance, "attractor")
-    ghost.WeldFrames(ghost.world_frame(), ghost.GetFrameByName("root_link", instance),
+    ghost.WeldFrames(ghost.world_frame(), ghost.GetFrameByName(root, instance),
                      RigidTransform())
-    home = {name: np.radians(v) for name, v in scenario.robot.home_deg.items()}
     FreezeJoints(ghost, instance, keep=mobee.joints, home=home, source="attractor robot")
     ghost.Finalize()
     builder.AddNamedSystem("attractor_robot_owner", SharedPointerSystem(ghost))
