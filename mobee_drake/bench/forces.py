@@ -1,11 +1,16 @@
-"""Benchmark: MoBeE total-force evaluations per second for the iCub upper body among boxes.
+"""Benchmark: MoBeE total-force evaluations per second for a robot among boxes (Fig. 2.4).
 
-Like the scalability experiment of dissertation Fig. 2.4: every controlled joint is driven through
+Like the scalability experiment of dissertation ch. 2.4: every controlled joint is driven through
 its range by its own oscillator, and for each new pose the whole MoBeE evaluation runs (forward
 kinematics, SceneGraph's signed-distance query, every force term and their total), against 0 to
-several hundred fixed boxes in front of the robot. One process, one core.
+several hundred boxes in the robot's workspace: the iCub upper body (20 joints, 14 primitives) or
+the Katana of App. B (5 joints, 10 primitives). With ``--churn``, as in Alg. 1, objects are removed
+and inserted while the robot moves: before every evaluation one box is removed and a new one
+inserted (our single-threaded stand-in for the source's sensory thread flooding the model).
+One process, one core.
 
-Run: ``mobee-drake bench forces`` (or ``python -m mobee_drake.bench.forces``).
+Run: ``mobee-drake bench forces [--robot katana] [--churn] [--plot FILE.png]`` (or
+``python -m mobee_drake.bench.forces``).
 """
 
 import argparse
@@ -17,14 +22,18 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake.mobee.system import Mobee
-from mobee_drake.robots.icub import AddIcub, IcubConfig
+from mobee_drake.robots.icub import IcubConfig
+from mobee_drake.robots.scenario_robot import AddScenarioRobot
+from mobee_drake.robots.zero_position import ZeroPositionConfig
 from mobee_drake.simulation.scenario import Box, SceneObject
 from mobee_drake.simulation.world import LiveWorld
 
-# The region in front of the iCub (root frame: x backwards, y right, z up) where boxes are placed.
-# It spans 60 cm in front of the chest, 1.2 m across and 1 m high; the arms reach about half of it.
-BOX_REGION_LOW = np.array([-0.80, -0.60, -0.40])
-BOX_REGION_HIGH = np.array([-0.20, 0.60, 0.60])
+# Where boxes are placed, per robot (root frame, metres). In front of the iCub (x backwards, y
+# right, z up): 60 cm in front of the chest, 1.2 m across and 1 m high; the arms reach about half
+# of it. Around the Katana: its reach (about 0.5 m around the shoulder at (0, 0, -0.01)).
+BOX_REGIONS = {"icub": (np.array([-0.80, -0.60, -0.40]), np.array([-0.20, 0.60, 0.60])),
+               "katana": (np.array([-0.50, -0.50, -0.20]), np.array([0.50, 0.50, 0.55]))}
+ROBOTS = {"icub": IcubConfig, "katana": ZeroPositionConfig}
 
 
 @dc.dataclass
@@ -36,21 +45,24 @@ class ForceBenchmarkResult:
     mean_pairs_in_fields: float
 
 
-def _BuildIcubAmongBoxes(num_boxes: int, rng: np.random.Generator):
+def _RandomBox(name: str, robot: str, rng: np.random.Generator) -> SceneObject:
+    low, high = BOX_REGIONS[robot]
+    return SceneObject(name=name, shape=Box(size=rng.uniform(0.02, 0.05, size=3).tolist()),
+                       position=rng.uniform(low, high).tolist())
+
+
+def _BuildRobotAmongBoxes(robot: str, num_boxes: int, rng: np.random.Generator):
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
-    config = IcubConfig()
-    robot = AddIcub(plant, scene_graph, config)
+    overlay, joints = AddScenarioRobot(plant, scene_graph, ROBOTS[robot]())
     world = LiveWorld(plant, scene_graph)
     for i in range(num_boxes):
-        world.Register(SceneObject(
-            name=f"box{i}", shape=Box(size=rng.uniform(0.02, 0.05, size=3).tolist()),
-            position=rng.uniform(BOX_REGION_LOW, BOX_REGION_HIGH).tolist()))
+        world.Register(_RandomBox(f"box{i}", robot, rng))
     plant.Finalize()
-    mobee = Mobee.AddToBuilder(builder, plant=plant, scene_graph=scene_graph, robot=robot,
-                               joints=config.controlled_joints)
+    mobee = Mobee.AddToBuilder(builder, plant=plant, scene_graph=scene_graph, robot=overlay,
+                               joints=joints)
     diagram = builder.Build()
-    return diagram, plant, mobee
+    return diagram, plant, mobee, world
 
 
 def _OscillatorPoses(mobee: Mobee, num_poses: int, rng: np.random.Generator,
@@ -69,23 +81,33 @@ def _OscillatorPoses(mobee: Mobee, num_poses: int, rng: np.random.Generator,
     return np.clip(q, q_min, q_max)
 
 
-def MeasureForceEvaluations(num_obstacles: int, *, num_poses: int = 2000, repeats: int = 5,
-                            amplitude: float = 1.0, seed: int = 0) -> ForceBenchmarkResult:
-    """Times ``repeats`` sweeps of ``num_poses`` total-force evaluations among boxes."""
+def MeasureForceEvaluations(num_obstacles: int, *, robot: str = "icub", num_poses: int = 2000,
+                            repeats: int = 5, amplitude: float = 1.0, churn: bool = False,
+                            seed: int = 0) -> ForceBenchmarkResult:
+    """Times ``repeats`` sweeps of ``num_poses`` total-force evaluations among boxes; with
+    ``churn``, each evaluation follows the removal of one box and the insertion of another."""
     rng = np.random.default_rng(seed)
-    diagram, plant, mobee = _BuildIcubAmongBoxes(num_obstacles, rng)
+    diagram, plant, mobee, world = _BuildRobotAmongBoxes(robot, num_obstacles, rng)
     context = diagram.CreateDefaultContext()
     plant_context = plant.GetMyMutableContextFromRoot(context)
     mobee_context = mobee.GetMyContextFromRoot(context)
+    boxes = [f"box{i}" for i in range(num_obstacles)]
+    replacements = [_RandomBox(f"new{k}", robot, rng)
+                    for k in range(num_poses * repeats if churn and boxes else 0)]
     total, contacts = mobee.GetOutputPort("total"), mobee.GetOutputPort("field_contacts")
     # The plant's positions are the controlled joints, possibly in another order.
     order = [plant.GetJointByName(j).position_start() for j in mobee.joints]
     poses = _OscillatorPoses(mobee, num_poses, rng, amplitude)
     x = plant.GetPositions(plant_context)
     rates = []
-    for _ in range(repeats):
+    for repeat in range(repeats):
         start = time.perf_counter()
-        for q in poses:
+        for k, q in enumerate(poses):
+            if replacements:
+                new = replacements[repeat * num_poses + k]
+                world.Remove(context, boxes[k % len(boxes)])
+                world.Add(context, new)
+                boxes[k % len(boxes)] = new.name
             x[order] = q
             plant.SetPositions(plant_context, x)
             total.Eval(mobee_context)
@@ -102,21 +124,48 @@ def MeasureForceEvaluations(num_obstacles: int, *, num_poses: int = 2000, repeat
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--robot", choices=sorted(ROBOTS), nargs="+", default=["icub"])
     parser.add_argument("--obstacles", type=int, nargs="+", default=[0, 10, 30, 100, 300])
     parser.add_argument("--poses", type=int, default=2000, help="evaluations per sweep")
     parser.add_argument("--repeats", type=int, default=5, help="sweeps per row")
     parser.add_argument("--amplitude", type=float, default=1.0,
                         help="fraction of each joint's range swept (1: the whole range, Fig. 2.4)")
+    parser.add_argument("--churn", action="store_true",
+                        help="remove one box and insert another before every evaluation (Alg. 1)")
+    parser.add_argument("--plot", default="", help="save the curves (like Fig. 2.4) to this PNG")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
-    print("| boxes | evaluations/s (best) | evaluations/s (median) | us/evaluation (best) "
+    print("| robot | boxes | evaluations/s (best) | evaluations/s (median) | us/evaluation (best) "
           "| pairs inside fields (mean) |")
-    print("|---:|---:|---:|---:|---:|")
-    for n in args.obstacles:
-        r = MeasureForceEvaluations(n, num_poses=args.poses, repeats=args.repeats,
-                                    amplitude=args.amplitude, seed=args.seed)
-        print(f"| {n} | {r.best_per_second:,.0f} | {r.median_per_second:,.0f} | "
-              f"{1e6 / r.best_per_second:.0f} | {r.mean_pairs_in_fields:.2f} |", flush=True)
+    print("|---|---:|---:|---:|---:|---:|")
+    curves = {}
+    for robot in args.robot:
+        for n in args.obstacles:
+            r = MeasureForceEvaluations(n, robot=robot, num_poses=args.poses,
+                                        repeats=args.repeats, amplitude=args.amplitude,
+                                        churn=args.churn, seed=args.seed)
+            curves.setdefault(robot, []).append((n, r.best_per_second, r.median_per_second))
+            print(f"| {robot} | {n} | {r.best_per_second:,.0f} | {r.median_per_second:,.0f} | "
+                  f"{1e6 / r.best_per_second:.0f} | {r.mean_pairs_in_fields:.2f} |", flush=True)
+    if args.plot:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        figure, axis = plt.subplots(figsize=(6, 4))
+        for robot, points in curves.items():
+            n, best, median = np.array(points).T
+            axis.plot(n, best, "o-", label=f"{robot} (best)")
+            axis.plot(n, median, "x--", label=f"{robot} (median)")
+        axis.set_yscale("log")
+        axis.set_xlabel("boxes in the workspace" + (" (churning)" if args.churn else ""))
+        axis.set_ylabel("MoBeE evaluations per second")
+        axis.grid(True, which="both", alpha=0.3)
+        axis.legend()
+        figure.tight_layout()
+        figure.savefig(args.plot, dpi=90)
+        print(f"plot: {args.plot}")
 
 
 if __name__ == "__main__":
