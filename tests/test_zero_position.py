@@ -191,5 +191,48 @@ class TestKatanaScenario(unittest.TestCase):
         self.assertGreater(min(approaches), 0.0)
 
 
+
+class TestTwoRobots(unittest.TestCase):
+    """The iCub and the Katana in one world, each with its own MoBeE (ch. 4.1.2)."""
+
+    def test_each_mobee_keeps_its_robot_off_the_other(self):
+        from pydrake.systems.analysis import Simulator
+
+        from mobee_drake.simulation.builder import BuildSimulation
+        from mobee_drake.simulation.scenario import LoadScenario
+
+        scenario = LoadScenario(MODELS.parent / "diagrams" / "icub_and_katana.yaml",
+                                "{visualization: {meshcat: false}}")
+        simulation = BuildSimulation(scenario)
+        simulator = Simulator(simulation.diagram)
+        simulator.Initialize()
+        context = simulator.get_context()
+        katana = simulation.diagram.GetSubsystemByName("katana_mobee")
+        inspector = simulation.scene_graph.model_inspector()
+        icub = simulation.robot.instance
+        samples_with_icub_in_katana_fields = 0
+        for t in np.arange(1.0, 61.0, 1.0):
+            simulator.AdvanceTo(t)
+            pairs = katana.GetOutputPort("field_pairs").Eval(katana.GetMyContextFromRoot(context))
+            bodies = [simulation.plant.GetBodyFromFrameId(inspector.GetFrameId(b))
+                      for b in pairs.geometry_B]
+            samples_with_icub_in_katana_fields += any(
+                b is not None and b.model_instance() == icub for b in bodies)
+        self.assertGreater(samples_with_icub_in_katana_fields, 0)
+        report = simulation.monitor.Report(simulation.monitor.GetMyContextFromRoot(context))
+        self.assertEqual(report.penetrating_steps, 0)
+        # The iCub's MoBeE saw the Katana (an "other object" to it) inside its fields too.
+        self.assertGreater(report.closest_approach["(other objects)"], 0.0)
+
+    def test_companions_need_the_kinematic_robot(self):
+        from mobee_drake.simulation.scenario import LoadScenario
+        from mobee_drake.yaml_io import YamlFileError
+
+        with self.assertRaisesRegex(YamlFileError, "companion 'katana': other robots run in "
+                                    "kinematic scenarios only"):
+            LoadScenario(MODELS.parent / "diagrams" / "icub_and_katana.yaml",
+                         "{robot_model: dynamic}")
+
+
 if __name__ == "__main__":
     unittest.main()

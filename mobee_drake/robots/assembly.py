@@ -119,8 +119,10 @@ def FreezeJoints(plant: MultibodyPlant, instance: ModelInstanceIndex, *, keep: I
     return frozen
 
 
-def JointStateSelector(plant: MultibodyPlant, joints: list[str]) -> np.ndarray:
-    """The matrix S with ``x_plant = S [q; v]`` for (q, v) of one-DOF ``joints`` in that order.
+def JointStateSelector(plant: MultibodyPlant, joints: list[str],
+                       instance: ModelInstanceIndex | None = None) -> np.ndarray:
+    """The matrix S with ``x_plant = S [q; v]`` for (q, v) of one-DOF ``joints`` (of model
+    ``instance``, if given) in that order.
 
     Its transpose selects those joints' (q, v) from the plant's state; its upper-left block maps
     their positions into the plant's positions.
@@ -128,7 +130,8 @@ def JointStateSelector(plant: MultibodyPlant, joints: list[str]) -> np.ndarray:
     n = len(joints)
     S = np.zeros((plant.num_multibody_states(), 2 * n))
     for i, name in enumerate(joints):
-        joint = plant.GetJointByName(name)
+        joint = (plant.GetJointByName(name) if instance is None
+                 else plant.GetJointByName(name, instance))
         S[joint.position_start(), i] = 1.0
         S[plant.num_positions() + joint.velocity_start(), n + i] = 1.0
     return S

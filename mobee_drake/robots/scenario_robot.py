@@ -4,6 +4,7 @@ import math
 import re
 
 from pydrake.geometry import SceneGraph
+from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 
 from mobee_drake.robots.icub import AddIcub, IcubConfig
@@ -14,15 +15,17 @@ from mobee_drake.robots.zero_position import AddZeroPositionRobot, ZeroPositionC
 RobotConfig = IcubConfig | ZeroPositionConfig
 
 
-def AddScenarioRobot(plant: MultibodyPlant, scene_graph: SceneGraph,
-                     config: RobotConfig) -> tuple[RobotOverlay, list[str]]:
-    """Adds the configured robot to an unfinalized plant; returns its overlay and the joints
-    MoBeE controls."""
+def AddScenarioRobot(plant: MultibodyPlant, scene_graph: SceneGraph, config: RobotConfig, *,
+                     X_WRoot: RigidTransform | None = None,
+                     model_name: str | None = None) -> tuple[RobotOverlay, list[str]]:
+    """Adds the configured robot, its root at ``X_WRoot``, to an unfinalized plant; returns its
+    overlay and the joints MoBeE controls."""
     if isinstance(config, IcubConfig):
-        return AddIcub(plant, scene_graph, config), list(config.controlled_joints)
+        return AddIcub(plant, scene_graph, config, X_WRoot), list(config.controlled_joints)
     robot = config.Load()
     joints = config.Joints(robot)
-    return AddZeroPositionRobot(plant, scene_graph, robot, controlled_joints=joints), joints
+    return AddZeroPositionRobot(plant, scene_graph, robot, controlled_joints=joints,
+                                X_WRoot=X_WRoot, model_name=model_name), joints
 
 
 def RobotModelText(config: RobotConfig, alpha: float) -> tuple[str, str, str, dict[str, float]]:

@@ -36,6 +36,7 @@ from pydrake.systems.controllers import (
 )
 from pydrake.systems.framework import Diagram, DiagramBuilder, OutputPort
 from pydrake.systems.primitives import (
+    Adder,
     ConstantVectorSource,
     MatrixGain,
     SharedPointerSystem,
@@ -59,7 +60,7 @@ from mobee_drake.simulation.scenario import (
     SliderAttractor,
 )
 from mobee_drake.simulation.virtual_dynamics import VirtualDynamics
-from mobee_drake.simulation.world import LiveWorld
+from mobee_drake.simulation.world import LiveWorld, ObjectPose
 
 # Gains of the dynamic robot's joint controller, per unit of (mass-normalised) acceleration:
 # critically damped at 20 rad/s, which tracks MoBeE's virtual trajectory (time constants around
@@ -91,17 +92,18 @@ class Simulation:
     applied_requests: dict = dc.field(default_factory=dict)
 
 
-def _AttractorSource(builder: DiagramBuilder, scenario: Scenario, mobee: Mobee,
-                     robot_state: OutputPort, meshcat: Meshcat | None) -> OutputPort:
+def _AttractorSource(builder: DiagramBuilder, program, seed: int, mobee: Mobee,
+                     robot_state: OutputPort, meshcat: Meshcat | None,
+                     name: str = "attractor") -> OutputPort:
+    """The system that sets ``mobee``'s attractor according to ``program``."""
     lower, upper = mobee.position_limits
-    program = scenario.attractor
     if isinstance(program, ExploreAttractor):
         agents = [Agent(name=a.name, joints=a.joints,
                         space=Lattice(a.levels, len(a.joints), k=a.nearest or None),
                         explorer=a.explorer,
                         model=LoadAgentModel(a.model, a.name, a.explorer) if a.model else None)
                   for a in program.agents]
-        supervisor = builder.AddNamedSystem("attractor", ExplorationSupervisor(
+        supervisor = builder.AddNamedSystem(name, ExplorationSupervisor(
             agents=agents, joints=mobee.joints, lower=lower, upper=upper, home=mobee.home,
             timing=program.timing))
         builder.Connect(robot_state, supervisor.GetInputPort("robot_state"))
@@ -109,24 +111,43 @@ def _AttractorSource(builder: DiagramBuilder, scenario: Scenario, mobee: Mobee,
     if isinstance(program, SliderAttractor):
         if meshcat is None:
             raise ValueError("the slider attractor needs Meshcat (run with --meshcat)")
-        return builder.AddNamedSystem("attractor", SliderAttractorSource(
+        return builder.AddNamedSystem(name, SliderAttractorSource(
             meshcat=meshcat, joints=mobee.joints, lower=lower, upper=upper, home=mobee.home,
             period=SLIDER_PERIOD)).get_output_port()
     if isinstance(program, FixedAttractor):
         q_star = mobee.home
-        for name, value in program.joints_deg.items():
-            q_star[mobee.joint_index(name)] = np.radians(value)
+        for joint, value in program.joints_deg.items():
+            q_star[mobee.joint_index(joint)] = np.radians(value)
         mobee.CheckAttractor(q_star)
-        return builder.AddNamedSystem("attractor", ConstantVectorSource(q_star)).get_output_port()
+        return builder.AddNamedSystem(name, ConstantVectorSource(q_star)).get_output_port()
     babbling = np.ones(len(mobee.joints), dtype=bool)
     if program.joints:
         babbling[:] = False
-        for name in program.joints:
-            babbling[mobee.joint_index(name)] = True
-    return builder.AddNamedSystem("attractor", RandomAttractorSource(
+        for joint in program.joints:
+            babbling[mobee.joint_index(joint)] = True
+    return builder.AddNamedSystem(name, RandomAttractorSource(
         lower=lower, upper=upper, home=mobee.home, babbling=babbling,
         range_fraction=program.range_fraction, period=program.period,
-        seed=scenario.random_seed)).get_output_port()
+        seed=seed)).get_output_port()
+
+
+def _AddMobee(builder: DiagramBuilder, plant: MultibodyPlant, scene_graph: SceneGraph,
+              robot: RobotOverlay, joints: list[str], params, time_step: float, prefix: str = ""):
+    """One robot's MoBeE, its virtual dynamics (eq. 5.7) and the map of their state into the
+    plant's; returns the three systems and the selector matrix."""
+    mobee = builder.AddNamedSystem(f"{prefix}mobee", Mobee(plant, robot, joints=joints,
+                                                           params=params))
+    builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
+    _, damping, _ = params.PerJoint(joints)
+    virtual = builder.AddNamedSystem(f"{prefix}virtual_dynamics", VirtualDynamics(
+        mass=mobee.mass, damping=np.array(damping), period=time_step,
+        initial_positions=mobee.home))
+    builder.Connect(mobee.GetOutputPort("total"), virtual.GetInputPort("total"))
+    builder.Connect(mobee.GetOutputPort("damping"), virtual.GetInputPort("damping"))
+    selector = JointStateSelector(plant, mobee.joints, robot.instance)
+    to_plant = builder.AddNamedSystem(f"{prefix}to_plant_state", MatrixGain(selector))
+    builder.Connect(virtual.get_output_port(), to_plant.get_input_port())
+    return mobee, virtual, selector, to_plant
 
 
 @dc.dataclass
@@ -160,35 +181,45 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None, *,
     else:
         plant, scene_graph = AddMultibodyPlantSceneGraph(builder, scenario.plant_time_step)
     robot, joints = AddScenarioRobot(plant, scene_graph, scenario.robot)
+    companions = [AddScenarioRobot(plant, scene_graph, c.robot, model_name=c.name,
+                                   X_WRoot=ObjectPose(c.position, c.rpy_deg))
+                  for c in scenario.companions]
     world = LiveWorld(plant, scene_graph)
     for obj in scenario.objects:
         world.Register(obj)
     plant.Finalize()
 
-    mobee = builder.AddNamedSystem("mobee", Mobee(plant, robot, joints=joints,
-                                                  params=scenario.mobee))
-    builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
+    mobee, virtual, selector, to_plant = _AddMobee(builder, plant, scene_graph, robot, joints,
+                                                   scenario.mobee, scenario.time_step)
     # The client's forces (eq. 5.9-5.10) are inputs of the diagram, for scripts and supervisors;
     # unfixed, they are zero.
     builder.ExportInput(mobee.GetInputPort("config_force"), "config_force")
     builder.ExportInput(mobee.GetInputPort("marker_forces"), "marker_forces")
-
-    _, damping, _ = scenario.mobee.PerJoint(joints)
-    virtual = builder.AddNamedSystem("virtual_dynamics", VirtualDynamics(
-        mass=mobee.mass, damping=np.array(damping), period=scenario.time_step,
-        initial_positions=mobee.home))
-    builder.Connect(mobee.GetOutputPort("total"), virtual.GetInputPort("total"))
-    builder.Connect(mobee.GetOutputPort("damping"), virtual.GetInputPort("damping"))
-    selector = JointStateSelector(plant, mobee.joints)
-    to_plant = builder.AddNamedSystem("to_plant_state", MatrixGain(selector))
-    builder.Connect(virtual.get_output_port(), to_plant.get_input_port())
+    companion_positions = []
+    for companion, (overlay, companion_joints) in zip(scenario.companions, companions):
+        other, other_virtual, _, other_to_plant = _AddMobee(
+            builder, plant, scene_graph, overlay, companion_joints, companion.mobee,
+            scenario.time_step, prefix=f"{companion.name}_")
+        builder.Connect(other_virtual.get_output_port(), other.GetInputPort("state"))
+        builder.Connect(_AttractorSource(builder, companion.attractor, scenario.random_seed,
+                                         other, other_virtual.get_output_port(), None,
+                                         name=f"{companion.name}_attractor"),
+                        other.GetInputPort("attractor"))
+        companion_positions.append(other_to_plant.get_output_port())
 
     if kinematic:
         # The plant lives as long as the diagram; it is not a system of it.
         builder.AddNamedSystem("plant_owner", SharedPointerSystem(plant))
         to_pose = builder.AddNamedSystem(
             "to_geometry_pose", MultibodyPositionToGeometryPose(plant, input_multibody_state=True))
-        builder.Connect(to_plant.get_output_port(), to_pose.get_input_port())
+        plant_state = to_plant.get_output_port()
+        if companion_positions:  # Each robot's joints fill their own entries of the state.
+            adder = builder.AddNamedSystem("all_robots_state", Adder(
+                1 + len(companion_positions), plant.num_multibody_states()))
+            for i, port in enumerate([plant_state] + companion_positions):
+                builder.Connect(port, adder.get_input_port(i))
+            plant_state = adder.get_output_port()
+        builder.Connect(plant_state, to_pose.get_input_port())
         builder.Connect(to_pose.get_output_port(),
                         scene_graph.get_source_pose_port(plant.get_source_id()))
         builder.Connect(virtual.get_output_port(), mobee.GetInputPort("state"))
@@ -224,7 +255,8 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None, *,
         builder.Connect(controller.get_output_port_generalized_force(),
                         plant.get_applied_generalized_force_input_port())
 
-    attractor = _AttractorSource(builder, scenario, mobee, robot_state, meshcat)
+    attractor = _AttractorSource(builder, scenario.attractor, scenario.random_seed, mobee,
+                                 robot_state, meshcat)
     builder.Connect(attractor, mobee.GetInputPort("attractor"))
 
     monitor = builder.AddNamedSystem("safety_monitor", SafetyMonitor(

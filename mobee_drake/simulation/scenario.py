@@ -103,6 +103,23 @@ class ExploreAttractor:
 
 
 @dc.dataclass
+class Companion:
+    """Another robot in the same world with its own MoBeE (dissertation ch. 4.1.2, Fig. 4.5).
+
+    Kinematic runs only. Each robot's MoBeE keeps its own body out of the other's way: to it, the
+    other robot is an obstacle.
+    """
+
+    name: str = "katana"
+    robot: ZeroPositionConfig | IcubConfig = dc.field(default_factory=ZeroPositionConfig)
+    # Pose of the companion's root in world: metres, degrees.
+    position: list[float] = dc.field(default_factory=_Zeros3)
+    rpy_deg: list[float] = dc.field(default_factory=_Zeros3)
+    mobee: MobeeParams = dc.field(default_factory=MobeeParams)
+    attractor: RandomAttractors | FixedAttractor = dc.field(default_factory=RandomAttractors)
+
+
+@dc.dataclass
 class WorldEvent:
     """A scripted change of the world at a time: move an object or switch its role."""
 
@@ -133,6 +150,8 @@ class Scenario:
     # The iCub, or ``!ZeroPositionConfig {file: katana.xml}`` for a robot from a MoBeE XML file.
     robot: IcubConfig | ZeroPositionConfig = dc.field(default_factory=IcubConfig)
     objects: list[SceneObject] = dc.field(default_factory=list)
+    # Other robots in the same world, each with its own MoBeE (kinematic runs only).
+    companions: list[Companion] = dc.field(default_factory=list)
     mobee: MobeeParams = dc.field(default_factory=MobeeParams)
     # "kinematic": MoBeE's virtual dynamics (eq. 5.7) move the robot, no plant dynamics;
     # "dynamic": the MultibodyPlant is simulated and follows MoBeE through ``control``.
@@ -182,6 +201,14 @@ def ValidateScenario(scenario: Scenario, source: str = "scenario") -> None:
                f"got '{event.role}'")
         _Check(len(event.position) in (0, 3), source,
                f"world event at {event.time} s: position needs three numbers")
+    for companion in scenario.companions:
+        _Check(scenario.robot_model == "kinematic", source,
+               f"companion '{companion.name}': other robots run in kinematic scenarios only")
+        _Check(bool(companion.name) and companion.name not in names, source,
+               f"every companion needs a unique name, not an object's, got '{companion.name}'")
+        names.add(companion.name)
+        _Check(len(companion.position) == 3 and len(companion.rpy_deg) == 3, source,
+               f"companion '{companion.name}': position and rpy_deg need three numbers")
     if isinstance(scenario.attractor, RandomAttractors):
         _Check(scenario.attractor.period > 0, source, "attractor period must be > 0")
         _Check(0 < scenario.attractor.range_fraction <= 1, source,
