@@ -417,6 +417,22 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
                          f"{', '.join(clearances) or '-'} | {several} | "
                          f"{space.action_state[top]}->{space.action_goal[top]}: {tries[top]}, "
                          f"{100 * (1 - misses[top]):.0f} % |")
+            # Like Fig. 7.8-7.9: tries, values and visits; state-actions that sometimes miss
+            # their goal in red, the states never entered shaded.
+            figure, axes = plt.subplots(3, 1, figsize=(12, 7))
+            colours = np.where((misses > 0) & (tries >= 3), "tab:red", "tab:blue")
+            axes[0].bar(np.arange(len(tries)), tries, width=1.0, color=colours)
+            axes[0].set_title(f"{r['lattice']} lattice, {r['actions'][0]} actions: tries per "
+                              "state-action (red: sometimes ends elsewhere)")
+            axes[1].bar(np.arange(len(tries)), r["values"][0], width=1.0, color=colours)
+            axes[1].set_title("value V(s, a)")
+            visits = np.bincount(space.action_state, weights=tries, minlength=space.num_states)
+            axes[2].bar(np.arange(space.num_states), visits, width=1.0)
+            for state in never:
+                axes[2].axvspan(state - 0.5, state + 0.5, color="grey", alpha=0.4)
+            axes[2].set_title("actions taken from each state (grey: never entered)")
+            figure.tight_layout()
+            figure.savefig(output / f"7.3_{r['lattice']}.png", dpi=80)
         return header + lines
     if experiment == "7.2i":
         space = Lattice([0.25, 0.5, 0.75], 4)
