@@ -74,18 +74,21 @@ def _Scenario(agents: list[ExploringAgent], objects=()) -> Scenario:
 
 
 def _Explore(scenario: Scenario, stop, snapshots=(), chunk: float = 2.0,
-             keep: pathlib.Path | None = None) -> dict:
+             keep: pathlib.Path | None = None, observer=None) -> dict:
     """Runs until ``stop(records)``; returns per-agent tries (and values at ``snapshots``); with
-    ``keep``, saves the final checkpoint there (the learned models, for a planner to reuse)."""
+    ``keep``, saves the final checkpoint there (the learned models, for a planner to reuse);
+    ``observer(simulation)``, if given, returns a callable run on the root context after every
+    step of the simulation and a function giving its data for the result."""
     simulation = BuildSimulation(scenario)
     simulator = Simulator(simulation.diagram)
     simulator.Initialize()
     context = simulator.get_context()
     supervisor = simulation.diagram.GetSubsystemByName("attractor")
     supervisor_context = supervisor.GetMyContextFromRoot(context)
+    observe, observed = observer(simulation) if observer else (None, dict)
     taken, coverage, start = {}, [], time.perf_counter()
     while True:
-        Advance(simulation, simulator, context.get_time() + chunk)  # world events included
+        Advance(simulation, simulator, context.get_time() + chunk, after_chunk=observe)
         records = supervisor.Records(supervisor_context)
         done = sum(r.actions_done for r in records)
         coverage.append([done] + [int((r.explorer.tries > 0).sum()) for r in records])
@@ -106,7 +109,7 @@ def _Explore(scenario: Scenario, stop, snapshots=(), chunk: float = 2.0,
         goals=[r.explorer.space.centres[r.explorer.space.action_goal].tolist() for r in records],
         actions=[r.actions_done for r in records], snapshots=taken, coverage=coverage,
         simulated_seconds=context.get_time(), wall_seconds=time.perf_counter() - start,
-        penetrating_steps=report.penetrating_steps)
+        penetrating_steps=report.penetrating_steps, **observed())
 
 
 def _Misses(explorer) -> np.ndarray:
@@ -205,10 +208,39 @@ def RunThreeAgents(output: pathlib.Path, transitions: int) -> dict:
                                  nearest=16, explorer=ExplorerConfig(seed=2)),
                   ExploringAgent(name="torso", joints=TORSO, levels=[0.25, 0.5, 0.75], nearest=8,
                                  explorer=ExplorerConfig(seed=3))]
-        data = _Explore(_Scenario(agents, [TABLE]), chunk=5.0,
+        data = _Explore(_Scenario(agents, [TABLE]), chunk=5.0, observer=_TableContacts,
                         stop=lambda records: sum(r.actions_done for r in records) >= transitions)
         _Save(path, data)
     return json.loads(path.read_text())
+
+
+def _TableContacts(simulation, period: float = 0.1):
+    """Counts, every ``period`` seconds, which hand is inside a field with the table, for the
+    state-action each agent has in flight: a right-hand contact counts for the right arm's, a
+    left-hand contact for the left arm's, either for the torso's (ch. 7.4, Fig. 7.11-7.12)."""
+    supervisor = simulation.diagram.GetSubsystemByName("attractor")
+    table = simulation.world.geometry_id(TABLE.name)
+    names = simulation.robot.geometry_names
+    hands = {"right_arm": {"r_hand"}, "left_arm": {"l_hand"}, "torso": {"r_hand", "l_hand"}}
+    counts = None
+    next_sample = [0.0]
+
+    def Observe(context):
+        nonlocal counts
+        if context.get_time() < next_sample[0]:
+            return
+        next_sample[0] = context.get_time() + period
+        records = supervisor.Records(supervisor.GetMyContextFromRoot(context))
+        if counts is None:
+            counts = [np.zeros(r.explorer.space.num_state_actions, dtype=int) for r in records]
+        pairs = simulation.mobee.GetOutputPort("field_pairs").Eval(
+            simulation.mobee.GetMyContextFromRoot(context))
+        touching = {names[a] for a, b in zip(pairs.geometry_A, pairs.geometry_B) if b == table}
+        for agent, record, count in zip(supervisor.agent_names, records, counts):
+            if touching & hands[agent]:
+                count[record.state_action] += 1
+
+    return Observe, lambda: dict(table_contacts=[c.tolist() for c in counts or []])
 
 
 # Ch. 7.4.1 on the right arm's hypercube: a 20 cm box that jumps, at random times, into the arm's
@@ -510,6 +542,20 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
              f"- correlation of the right and the left arm's tries per state-action: "
              f"{correlation:.3f}",
              f"- penetrating control periods: {results['penetrating_steps']}"]
+    for name, tries, contacts in zip(results["agents"], results["tries"],
+                                     results.get("table_contacts", [])):
+        tries, contacts = np.array(tries), np.array(contacts)
+        top = np.argsort(tries)[::-1][:20]
+        from scipy.stats import spearmanr
+
+        lines.append(
+            f"- {name}: hand-table contact (samples every 0.1 s with a hand inside a field with "
+            f"the table) during {contacts.sum()} samples; the 20 most-tried state-actions "
+            f"({100 * tries[top].sum() / tries.sum():.0f} % of the tries) hold "
+            f"{100 * contacts[top].sum() / max(contacts.sum(), 1):.0f} % of them; rank "
+            f"correlation of tries and contact samples per state-action: "
+            f"{spearmanr(tries, contacts).statistic:.2f}; state-actions with contact: "
+            f"{int((contacts > 0).sum())} of {len(tries)}")
     for name, tries, misses, goals in zip(results["agents"], results["tries"],
                                           results["misses"], results["goals"]):
         tries, misses, goals = np.array(tries), np.array(misses), np.array(goals)
