@@ -306,7 +306,23 @@ class TestExperimentsSmoke(unittest.TestCase):
         experiments.main(["--experiment", "7.4", "--output", str(output), "--transitions", "6"])
         report = (output / "report_7.4.md").read_text()
         self.assertIn("correlation of the right and the left arm", report)
+        self.assertIn("hand-table contact", report)
         self.assertTrue((output / "7.4_three_agents.png").is_file())
+        experiments.main(["--experiment", "7.4.1", "--output", str(output), "--transitions", "4",
+                          "--runs", "1"])
+        self.assertIn("| moving_box |", (output / "report_7.4.1.md").read_text())
+
+    def test_detour_problems(self):
+        from mobee_drake.planning import experiments
+
+        # The square 0-1-3-2 (equidistant neighbours): with 0->1 unreliable, 0 -> 3 (over 1 or 2)
+        # and 2 -> 1 (over 0 or 3) have one risky and one safe shortest route; 3 -> 0 and 1 -> 2
+        # have two safe ones.
+        space = Lattice([0.0, 1.0], 2)
+        unreliable = np.array([(s, g) == (0, 1)
+                               for s, g in zip(space.action_state, space.action_goal)])
+        self.assertEqual(experiments._DetourProblems(space, unreliable), [(0, 3), (2, 1)])
+        self.assertEqual(experiments._DetourProblems(space, np.zeros_like(unreliable)), [])
 
 
 if __name__ == "__main__":
