@@ -73,18 +73,25 @@ def _Scenario(agents: list[ExploringAgent], objects=()) -> Scenario:
     return scenario
 
 
+def _Start(scenario: Scenario):
+    """The scenario built and initialised: the simulation, its simulator, the exploration
+    supervisor and the supervisor's context."""
+    simulation = BuildSimulation(scenario)
+    simulator = Simulator(simulation.diagram)
+    simulator.Initialize()
+    supervisor = simulation.diagram.GetSubsystemByName("attractor")
+    return (simulation, simulator, supervisor,
+            supervisor.GetMyContextFromRoot(simulator.get_context()))
+
+
 def _Explore(scenario: Scenario, stop, snapshots=(), chunk: float = 2.0,
              keep: pathlib.Path | None = None, observer=None) -> dict:
     """Runs until ``stop(records)``; returns per-agent tries (and values at ``snapshots``); with
     ``keep``, saves the final checkpoint there (the learned models, for a planner to reuse);
     ``observer(simulation)``, if given, returns a callable run on the root context after every
     step of the simulation and a function giving its data for the result."""
-    simulation = BuildSimulation(scenario)
-    simulator = Simulator(simulation.diagram)
-    simulator.Initialize()
+    simulation, simulator, supervisor, supervisor_context = _Start(scenario)
     context = simulator.get_context()
-    supervisor = simulation.diagram.GetSubsystemByName("attractor")
-    supervisor_context = supervisor.GetMyContextFromRoot(context)
     observe, observed = observer(simulation) if observer else (None, dict)
     taken, coverage, start = {}, [], time.perf_counter()
     while True:
@@ -296,12 +303,8 @@ def _Plan(model: pathlib.Path, problems, repeats: int, seed: int) -> dict:
                                strategy="planner", goal_state=problems[0][0], seed=seed))
     scenario = _Scenario([agent], [box])
     scenario.world_events = events
-    simulation = BuildSimulation(scenario)
-    simulator = Simulator(simulation.diagram)
-    simulator.Initialize()
+    simulation, simulator, supervisor, supervisor_context = _Start(scenario)
     context = simulator.get_context()
-    supervisor = simulation.diagram.GetSubsystemByName("attractor")
-    supervisor_context = supervisor.GetMyContextFromRoot(context)
 
     def Go(goal: int, max_actions: int = 12) -> tuple[int, np.ndarray]:
         """Heads for ``goal``; returns the actions taken and the transitions observed."""

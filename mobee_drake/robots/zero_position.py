@@ -190,12 +190,18 @@ class _Reader:
                default: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> np.ndarray:
         return np.array([self.Number(element, n, d) for n, d in zip(names, default)])
 
-    def Axis(self, element: _Element) -> np.ndarray:
-        """A shape's axis (hx, hy, hz): z when none is given, missing components zero."""
+    def SolidPlacement(self, element: _Element, state: dict) -> tuple[np.ndarray, np.ndarray]:
+        """A solid cylinder's or box's centre (px, py, pz from the current point) and axis
+        (hx, hy, hz: z when none is given, missing components zero)."""
+        if self.Flag(element, "field"):
+            self.Fail(element, "field volumes are supported for spheres only")
+        centre = state["point"] + self.Vector(element, ("px", "py", "pz"))
         names = ("hx", "hy", "hz")
-        if not any(n in element.attributes for n in names):
-            return np.array([0.0, 0.0, 1.0])
-        return self.Vector(element, names)
+        axis = (self.Vector(element, names) if any(n in element.attributes for n in names)
+                else np.array([0.0, 0.0, 1.0]))
+        if not np.any(axis):
+            self.Fail(element, "its axis (hx, hy, hz) is zero")
+        return centre, axis
 
     def Flag(self, element: _Element, name: str) -> bool:
         text = element.attributes.get(name, "false").strip().lower()
@@ -363,12 +369,7 @@ class _Reader:
         self.Children(element, state)
 
     def _cylinder(self, element: _Element, state: dict) -> None:
-        if self.Flag(element, "field"):
-            self.Fail(element, "field volumes are supported for spheres only")
-        centre = state["point"] + self.Vector(element, ("px", "py", "pz"))
-        axis = self.Axis(element)
-        if not np.any(axis):
-            self.Fail(element, "its axis (hx, hy, hz) is zero")
+        centre, axis = self.SolidPlacement(element, state)
         radius, height = self.Number(element, "radius"), self.Number(element, "height")
         if radius <= 0 or height <= 0:
             self.Fail(element, f"radius and height must be > 0, got {radius}, {height}")
@@ -380,12 +381,7 @@ class _Reader:
         self.Children(element, state)
 
     def _box(self, element: _Element, state: dict) -> None:
-        if self.Flag(element, "field"):
-            self.Fail(element, "field volumes are supported for spheres only")
-        centre = state["point"] + self.Vector(element, ("px", "py", "pz"))
-        axis = self.Axis(element)
-        if not np.any(axis):
-            self.Fail(element, "its height axis (hx, hy, hz) is zero")
+        centre, axis = self.SolidPlacement(element, state)
         size = [self.Number(element, "width"), self.Number(element, "depth"),
                 self.Number(element, "height")]
         if min(size) <= 0:
