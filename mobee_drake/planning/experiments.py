@@ -418,10 +418,12 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
         return header + lines
     if experiment == "7.2":
         figure, axis = plt.subplots(figsize=(7, 4))
-        for strategy in ("curious", "random", "least_tried"):
+        for strategy, colour in zip(("curious", "random", "least_tried"),
+                                    ("tab:green", "tab:red", "tab:blue")):
             for r in [r for r in results if r["strategy"] == strategy]:
                 coverage = np.array(r["coverage"])
-                axis.plot(coverage[:, 0], coverage[:, 1], label=f"{strategy} run {r['run']}")
+                axis.plot(coverage[:, 0], coverage[:, 1], color=colour,
+                          label=strategy if r["run"] == 0 else None)
                 full = coverage[coverage[:, 1] >= 1296, 0]
                 lines.append(f"| {strategy} | {r['run']} | {coverage[-1, 0]} | "
                              f"{coverage[-1, 1]} | {full[0] if len(full) else '-'} |")
