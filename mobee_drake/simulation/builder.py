@@ -134,7 +134,7 @@ def _AttractorSource(builder: DiagramBuilder, program, seed: int, mobee: Mobee,
 def _AddMobee(builder: DiagramBuilder, plant: MultibodyPlant, scene_graph: SceneGraph,
               robot: RobotOverlay, joints: list[str], params, time_step: float, prefix: str = ""):
     """One robot's MoBeE, its virtual dynamics (eq. 5.7) and the map of their state into the
-    plant's; returns the three systems and the selector matrix."""
+    plant's; returns MoBeE, the virtual dynamics, the selector matrix and its gain system."""
     mobee = builder.AddNamedSystem(f"{prefix}mobee", Mobee(plant, robot, joints=joints,
                                                            params=params))
     builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
@@ -196,12 +196,14 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None, *,
     builder.ExportInput(mobee.GetInputPort("config_force"), "config_force")
     builder.ExportInput(mobee.GetInputPort("marker_forces"), "marker_forces")
     companion_positions = []
-    for companion, (overlay, companion_joints) in zip(scenario.companions, companions):
+    for i, (companion, (overlay, companion_joints)) in enumerate(zip(scenario.companions,
+                                                                     companions)):
         other, other_virtual, _, other_to_plant = _AddMobee(
             builder, plant, scene_graph, overlay, companion_joints, companion.mobee,
             scenario.time_step, prefix=f"{companion.name}_")
         builder.Connect(other_virtual.get_output_port(), other.GetInputPort("state"))
-        builder.Connect(_AttractorSource(builder, companion.attractor, scenario.random_seed,
+        builder.Connect(_AttractorSource(builder, companion.attractor,
+                                         scenario.random_seed + 1 + i,  # its own draws
                                          other, other_virtual.get_output_port(), None,
                                          name=f"{companion.name}_attractor"),
                         other.GetInputPort("attractor"))
