@@ -229,14 +229,13 @@ def _TableContacts(simulation, period: float = 0.1):
     table = simulation.world.geometry_id(TABLE.name)
     names = simulation.robot.geometry_names
     hands = {"right_arm": {"r_hand"}, "left_arm": {"l_hand"}, "torso": {"r_hand", "l_hand"}}
-    counts = None
-    next_sample = [0.0]
+    counts, next_sample = None, 0.0
 
     def Observe(context):
-        nonlocal counts
-        if context.get_time() < next_sample[0]:
+        nonlocal counts, next_sample
+        if context.get_time() < next_sample:
             return
-        next_sample[0] = context.get_time() + period
+        next_sample = context.get_time() + period
         records = supervisor.Records(supervisor.GetMyContextFromRoot(context))
         if counts is None:
             counts = [np.zeros(r.explorer.space.num_state_actions, dtype=int) for r in records]

@@ -45,8 +45,11 @@ import pathlib
 import xml.parsers.expat
 
 import numpy as np
+from pydrake.common.eigen_geometry import AngleAxis
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
+from pydrake.multibody.parsing import Parser
 
+from mobee_drake.robots.assembly import AddModelWithOverlay
 from mobee_drake.robots.overlay import (
     MODELS_DIR,
     Box,
@@ -154,7 +157,6 @@ class _Reader:
 
     def __init__(self, source: str):
         self.source = source
-        self.links_sdf: list[str] = []
         self.joints_sdf: list[str] = []
         self.joint_points: dict[str, np.ndarray] = {ROOT_BODY: np.zeros(3)}
         self.parents: dict[str, str] = {}
@@ -163,7 +165,6 @@ class _Reader:
         self.primitives: list[Primitive] = []
         self.markers: list[Marker] = []
         self.clauses: list[Clause] = []
-        self.default_field = Overlay().default_field
 
     # ---- attributes -------------------------------------------------------------------------
     def Where(self, element: _Element) -> str:
@@ -322,14 +323,8 @@ class _Reader:
         state["motor"]["ranges"].append((low, high))
         point, parent = state["point"], state["body"]
         body = f"{name}_link"
-        offset = point - self.joint_points[parent]
         self.joint_points[body] = point
         self.parents[body] = parent
-        # Massless bodies are not simulated dynamically; give each a small inertia.
-        self.links_sdf.append(
-            f'<link name="{body}"><pose relative_to="{parent}">{_Xyz(offset)} 0 0 0</pose>'
-            "<inertial><mass>0.1</mass><inertia><ixx>1e-4</ixx><iyy>1e-4</iyy><izz>1e-4</izz>"
-            "<ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial></link>")
         self.joints_sdf.append(
             f'<joint name="{name}" type="revolute"><parent>{parent}</parent>'
             f"<child>{body}</child><axis><xyz>{_Xyz(axis)}</xyz><limit>"
@@ -438,6 +433,20 @@ class _Reader:
             self.Fail(element, f"{name}=\"{text}\" is not a list of "
                       f"{'integers' if kind is int else 'numbers'}")
 
+    def LinkSdf(self, body: str) -> str:
+        """A body as an SDFormat <link>: its pose at zero (parallel to its parent's, at its
+        joint's point), a small inertia (a massless body cannot be simulated dynamically) and its
+        primitives drawn as visuals."""
+        origin = self.joint_points[body]
+        visuals = "".join(_Visual(p, origin) for p in self.primitives if p.link == body)
+        if body == ROOT_BODY:
+            return f'<link name="{body}">{visuals}</link>'
+        parent = self.parents[body]
+        return (f'<link name="{body}"><pose relative_to="{parent}">'
+                f"{_Xyz(origin - self.joint_points[parent])} 0 0 0</pose>{visuals}"
+                "<inertial><mass>0.1</mass><inertia><ixx>1e-4</ixx><iyy>1e-4</iyy>"
+                "<izz>1e-4</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial></link>")
+
     def Exclusions(self) -> list[list[str]]:
         """Per body, its primitives with those of its parent and grandparent (see the module)."""
         on_body: dict[str, list[str]] = {}
@@ -493,8 +502,6 @@ def _ShortestRotation(axis: np.ndarray) -> RotationMatrix:
     if np.linalg.norm(cross) < 1e-12:
         return RotationMatrix() if cosine > 0 else RotationMatrix.MakeXRotation(math.pi)
     angle = math.atan2(float(np.linalg.norm(cross)), cosine)
-    from pydrake.common.eigen_geometry import AngleAxis
-
     return RotationMatrix(AngleAxis(angle, cross / np.linalg.norm(cross)))
 
 
@@ -520,13 +527,8 @@ def LoadZeroPositionTree(filename: str | pathlib.Path) -> ZeroPositionRobot:
                       clauses=reader.clauses)
     ValidateOverlay(overlay, source)
     sdf = (f'<?xml version="1.0"?><sdf version="1.9"><model name="{name}">'
-           f'<link name="{ROOT_BODY}"/>' + "".join(reader.links_sdf)
+           + "".join(reader.LinkSdf(body) for body in reader.joint_points)
            + "".join(reader.joints_sdf) + "</model></sdf>")
-    for body in reader.joint_points:  # each body's primitives, drawn
-        visuals = "".join(_Visual(p, reader.joint_points[body]) for p in reader.primitives
-                          if p.link == body)
-        sdf = sdf.replace(f'<link name="{body}"/>', f'<link name="{body}">{visuals}</link>', 1)
-        sdf = sdf.replace(f'<link name="{body}"><pose', f'<link name="{body}">{visuals}<pose', 1)
     return ZeroPositionRobot(name=name, source=source, sdf=sdf, overlay=overlay,
                              motors=tuple(reader.motors), joints=tuple(reader.joints))
 
@@ -536,10 +538,6 @@ def AddZeroPositionRobot(plant, scene_graph, robot: ZeroPositionRobot, *,
                          X_WRoot: RigidTransform | None = None, model_name: str | None = None):
     """Adds ``robot`` with its overlay to an unfinalized ``plant``, its root body welded at
     ``X_WRoot``; joints not in ``controlled_joints`` (all, by default) are welded at home."""
-    from pydrake.multibody.parsing import Parser
-
-    from mobee_drake.robots.assembly import AddModelWithOverlay
-
     name = model_name or robot.name
     return AddModelWithOverlay(
         plant, scene_graph,
