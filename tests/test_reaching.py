@@ -56,3 +56,156 @@ class TestPredictors(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class FakeRobot:
+    """A robot on a 2 x 2 lattice: transitions reach their goal unless the edge is blocked, and
+    a reach from state s puts the palm at ``palms[s]``."""
+
+    def __init__(self, space, palms, blocked=(), state=0):
+        self.space, self.palms, self.blocked, self.state = space, palms, set(blocked), state
+        self.reaches = 0
+
+    def SetProblem(self, target):
+        self.target = target
+
+    def State(self):
+        return self.state
+
+    def Transition(self, goal):
+        if (self.state, goal) not in self.blocked:
+            self.state = goal
+        return self.state
+
+    def Reach(self, target):
+        self.reaches += 1
+        return self.palms[self.state]
+
+
+def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10):
+    from mobee_drake.planning.state_space import Lattice
+    from mobee_drake.reaching.learner import ReachLearner, ReachLearningConfig
+
+    space = Lattice([0.25, 0.75], 2)  # states 0=(0,0) 1=(0,1) 2=(1,0) 3=(1,1)
+    T = np.zeros((space.num_state_actions, space.num_states))
+    T[np.arange(space.num_state_actions), space.action_goal] = 1.0
+    targets = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]) \
+        if targets is None else targets
+    return space, ReachLearner(space, T, targets, ReachLearningConfig(
+        strategy=strategy, seed=seed, max_actions=max_actions))
+
+
+PALMS = np.array([[0.3, 0, 0], [0.2, 0, 0], [0.1, 0, 0], [0.0, 0, 0]], dtype=float)
+
+
+class TestReachLearner(unittest.TestCase):
+    def test_source_numbering_of_reaches(self):
+        from mobee_drake.planning.state_space import Lattice
+        from mobee_drake.reaching.learner import ReachLearner
+
+        space = Lattice([0.25, 0.5, 0.75], 4)
+        learner = ReachLearner(space, np.zeros((432, 81)), np.zeros((1, 3)))
+        self.assertEqual(learner.Reach(57), 489)
+        self.assertEqual(learner.Reach(77), 509)
+        self.assertEqual(learner.num_state_actions, 513)
+
+    def test_a_reach_ends_the_policy(self):
+        space, learner = _Learner()
+        rewards = np.zeros(learner.num_state_actions)
+        rewards[learner.Reach(3)] = 1.0
+        q, v = learner.Values(rewards)
+        gamma = learner.config.gamma
+        # V(3) = 1 (the reach is terminal, not repeated), one step away gamma, two gamma^2.
+        np.testing.assert_allclose(v, [gamma ** 2, gamma, gamma, 1.0], atol=1e-3)
+        self.assertAlmostEqual(q[learner.Reach(3)], 1.0)
+
+    def test_fresh_optimist_reaches_at_once(self):
+        # Every reach predicts 1 (eq. 8.5, e_1 = 1) and a move is discounted: reach from here.
+        space, learner = _Learner()
+        robot = FakeRobot(space, PALMS, state=2)
+        result = learner.Explore(robot)
+        self.assertEqual((result.actions, result.reach), (1, learner.Reach(2)))
+        target = learner.targets[result.problem]
+        self.assertAlmostEqual(result.reward, 1 / (1 + np.linalg.norm(PALMS[2] - target)))
+        np.testing.assert_array_equal(learner.histories.History(learner.Reach(2))[1], [1.0])
+
+    def test_failed_transition_is_penalised_and_avoided(self):
+        space, learner = _Learner()
+        target = learner.targets[0]
+        for s in range(3):  # Bad reaches from states 0-2 for this target; state 3 untried.
+            for _ in range(20):
+                learner.histories.Record(learner.Reach(s), target, 1.0, 0.1)
+        robot = FakeRobot(space, PALMS, blocked={(0, 1)}, state=0)
+        learner.problem_tries[1:] = 1  # problem 0 is the least tried
+        result = learner.Explore(robot)
+        self.assertEqual(result.reach, learner.Reach(3))
+        tried = [row[2] for row in learner.log]
+        blocked = int(np.flatnonzero((space.action_state == 0) & (space.action_goal == 1))[0])
+        self.assertLessEqual(tried.count(blocked), 1)
+        self.assertEqual(result.failed_transitions, tried.count(blocked))
+        if blocked in tried:
+            self.assertEqual(learner.histories.History(blocked)[2].tolist(), [-10.0])
+            self.assertEqual(result.actions, 4)
+        else:
+            self.assertEqual(result.actions, 3)
+
+    def test_timeout(self):
+        space, learner = _Learner(max_actions=1)
+        target = learner.targets[0]
+        for _ in range(20):
+            learner.histories.Record(learner.Reach(0), target, 1.0, 0.1)
+        learner.problem_tries[1:] = 1
+        result = learner.Explore(FakeRobot(space, PALMS, state=0))
+        self.assertIsNone(result.reward)
+        self.assertEqual((result.actions, result.reach), (1, -1))
+
+    def test_least_tried_problems_first(self):
+        for strategy in ("random", "greedy", "intrinsic"):
+            space, learner = _Learner(strategy)
+            robot = FakeRobot(space, PALMS)
+            for round_ in range(1, 4):
+                for _ in range(3):
+                    learner.Explore(robot)
+                np.testing.assert_array_equal(learner.problem_tries, [round_] * 3)
+
+    def test_evaluation_leaves_the_learner_alone(self):
+        space, learner = _Learner("intrinsic")
+        robot = FakeRobot(space, PALMS)
+        for _ in range(6):
+            learner.Explore(robot)
+        before = (list(learner.log), learner.problem_tries.copy(),
+                  learner.rng.bit_generator.state,
+                  [learner.histories.History(sa)[2].copy()
+                   for sa in range(learner.num_state_actions)])
+        results = learner.Evaluate(robot, seed=7)
+        self.assertEqual(sorted(r.problem for r in results), [0, 1, 2])
+        self.assertTrue(all(r.reward is None or 0 < r.reward <= 1 for r in results))
+        self.assertEqual(learner.log, before[0])
+        np.testing.assert_array_equal(learner.problem_tries, before[1])
+        self.assertEqual(learner.rng.bit_generator.state, before[2])
+        for sa, rewards in enumerate(before[3]):
+            np.testing.assert_array_equal(learner.histories.History(sa)[2], rewards)
+
+    def test_exact_resume(self):
+        for strategy in ("random", "greedy", "intrinsic"):
+            space, whole = _Learner(strategy, seed=3)
+            robot = FakeRobot(space, PALMS, blocked={(0, 2), (3, 1)})
+            for _ in range(12):
+                whole.Explore(robot)
+            _, first = _Learner(strategy, seed=3)
+            robot = FakeRobot(space, PALMS, blocked={(0, 2), (3, 1)})
+            for _ in range(6):
+                first.Explore(robot)
+            arrays, data = first.ToArrays()
+            _, resumed = _Learner(strategy, seed=3)
+            resumed.LoadArrays(arrays, data)
+            for _ in range(6):
+                resumed.Explore(robot)
+            self.assertEqual(resumed.log, whole.log)
+            with self.assertRaisesRegex(ValueError, "configuration"):
+                _Learner("random" if strategy != "random" else "greedy", seed=3)[1].LoadArrays(
+                    arrays, data)
+
+    def test_bad_configuration(self):
+        with self.assertRaisesRegex(ValueError, "unknown reach-learning strategy 'curious'"):
+            _Learner("curious")

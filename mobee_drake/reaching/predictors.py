@@ -54,6 +54,14 @@ class RewardHistories:
     def __len__(self) -> int:
         return len(self.reaching)
 
+    def Copy(self) -> "RewardHistories":
+        """An independent copy (records replace a history's arrays, never change them)."""
+        twin = RewardHistories.__new__(RewardHistories)
+        twin.reaching = self.reaching
+        twin._targets, twin._estimates = list(self._targets), list(self._estimates)
+        twin._rewards = list(self._rewards)
+        return twin
+
     def History(self, state_action: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(targets, estimates, rewards) of one state-action, oldest first."""
         return (self._targets[state_action], self._estimates[state_action],

@@ -48,6 +48,7 @@ from mobee_drake.mobee.system import Mobee
 from mobee_drake.planning.explorers import LoadAgentModel
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
+from mobee_drake.reaching.executor import StateActionExecutor
 from mobee_drake.robots.assembly import JointStateSelector
 from mobee_drake.robots.overlay import RobotOverlay
 from mobee_drake.robots.scenario_robot import AddScenarioRobot
@@ -58,6 +59,7 @@ from mobee_drake.simulation.scenario import (
     FixedAttractor,
     Scenario,
     SliderAttractor,
+    StateActionAttractor,
 )
 from mobee_drake.simulation.virtual_dynamics import VirtualDynamics
 from mobee_drake.simulation.world import LiveWorld, ObjectPose
@@ -94,9 +96,19 @@ class Simulation:
 
 def _AttractorSource(builder: DiagramBuilder, program, seed: int, mobee: Mobee,
                      robot_state: OutputPort, meshcat: Meshcat | None,
-                     name: str = "attractor") -> OutputPort:
-    """The system that sets ``mobee``'s attractor according to ``program``."""
+                     name: str = "attractor") -> tuple[OutputPort, OutputPort | None]:
+    """The system that sets ``mobee``'s attractor according to ``program``: its attractor port
+    and, if it also sets the client's marker forces, their port."""
     lower, upper = mobee.position_limits
+    if isinstance(program, StateActionAttractor):
+        executor = builder.AddNamedSystem(name, StateActionExecutor(
+            num_joints=len(mobee.joints), marker_index=mobee.marker_index(program.forcing.marker),
+            num_markers=len(mobee.marker_names), initial_attractor=mobee.home,
+            forcing=program.forcing, timing=program.timing))
+        builder.Connect(robot_state, executor.GetInputPort("robot_state"))
+        builder.Connect(mobee.GetOutputPort("marker_positions"),
+                        executor.GetInputPort("marker_positions"))
+        return executor.GetOutputPort("attractor"), executor.GetOutputPort("marker_forces")
     if isinstance(program, ExploreAttractor):
         agents = [Agent(name=a.name, joints=a.joints,
                         space=Lattice(a.levels, len(a.joints), k=a.nearest or None),
@@ -107,19 +119,19 @@ def _AttractorSource(builder: DiagramBuilder, program, seed: int, mobee: Mobee,
             agents=agents, joints=mobee.joints, lower=lower, upper=upper, home=mobee.home,
             timing=program.timing))
         builder.Connect(robot_state, supervisor.GetInputPort("robot_state"))
-        return supervisor.get_output_port()
+        return supervisor.get_output_port(), None
     if isinstance(program, SliderAttractor):
         if meshcat is None:
             raise ValueError("the slider attractor needs Meshcat (run with --meshcat)")
         return builder.AddNamedSystem(name, SliderAttractorSource(
             meshcat=meshcat, joints=mobee.joints, lower=lower, upper=upper, home=mobee.home,
-            period=SLIDER_PERIOD)).get_output_port()
+            period=SLIDER_PERIOD)).get_output_port(), None
     if isinstance(program, FixedAttractor):
         q_star = mobee.home
         for joint, value in program.joints_deg.items():
             q_star[mobee.joint_index(joint)] = np.radians(value)
         mobee.CheckAttractor(q_star)
-        return builder.AddNamedSystem(name, ConstantVectorSource(q_star)).get_output_port()
+        return builder.AddNamedSystem(name, ConstantVectorSource(q_star)).get_output_port(), None
     babbling = np.ones(len(mobee.joints), dtype=bool)
     if program.joints:
         babbling[:] = False
@@ -128,7 +140,7 @@ def _AttractorSource(builder: DiagramBuilder, program, seed: int, mobee: Mobee,
     return builder.AddNamedSystem(name, RandomAttractorSource(
         lower=lower, upper=upper, home=mobee.home, babbling=babbling,
         range_fraction=program.range_fraction, period=program.period,
-        seed=seed)).get_output_port()
+        seed=seed)).get_output_port(), None
 
 
 def _AddMobee(builder: DiagramBuilder, plant: MultibodyPlant, scene_graph: SceneGraph,
@@ -191,10 +203,9 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None, *,
 
     mobee, virtual, selector, to_plant = _AddMobee(builder, plant, scene_graph, robot, joints,
                                                    scenario.mobee, scenario.time_step)
-    # The client's forces (eq. 5.9-5.10) are inputs of the diagram, for scripts and supervisors;
-    # unfixed, they are zero.
+    # The client's forces (eq. 5.9-5.10) are inputs of the diagram, for scripts and supervisors
+    # (unfixed, they are zero), unless the attractor program sets the marker forces.
     builder.ExportInput(mobee.GetInputPort("config_force"), "config_force")
-    builder.ExportInput(mobee.GetInputPort("marker_forces"), "marker_forces")
     companion_positions = []
     for i, (companion, (overlay, companion_joints)) in enumerate(zip(scenario.companions,
                                                                      companions)):
@@ -205,7 +216,7 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None, *,
         builder.Connect(_AttractorSource(builder, companion.attractor,
                                          scenario.random_seed + 1 + i,  # its own draws
                                          other, other_virtual.get_output_port(), None,
-                                         name=f"{companion.name}_attractor"),
+                                         name=f"{companion.name}_attractor")[0],
                         other.GetInputPort("attractor"))
         companion_positions.append(other_to_plant.get_output_port())
 
@@ -257,9 +268,13 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None, *,
         builder.Connect(controller.get_output_port_generalized_force(),
                         plant.get_applied_generalized_force_input_port())
 
-    attractor = _AttractorSource(builder, scenario.attractor, scenario.random_seed, mobee,
-                                 robot_state, meshcat)
+    attractor, marker_forces = _AttractorSource(builder, scenario.attractor,
+                                                scenario.random_seed, mobee, robot_state, meshcat)
     builder.Connect(attractor, mobee.GetInputPort("attractor"))
+    if marker_forces is None:
+        builder.ExportInput(mobee.GetInputPort("marker_forces"), "marker_forces")
+    else:
+        builder.Connect(marker_forces, mobee.GetInputPort("marker_forces"))
 
     monitor = builder.AddNamedSystem("safety_monitor", SafetyMonitor(
         names=world.names, period=scenario.time_step))
@@ -272,7 +287,7 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None, *,
 
         visualizer = AddViewer(builder, scenario=scenario, meshcat=meshcat, plant=plant,
                                scene_graph=scene_graph, mobee=mobee, attractor=attractor,
-                               marker_forces="marker_forces")
+                               marker_forces=marker_forces or "marker_forces")
 
     if prebuild is not None:
         prebuild(Parts(builder=builder, plant=plant, scene_graph=scene_graph, mobee=mobee,

@@ -12,6 +12,7 @@ import pathlib
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.planning.explorers import ExplorerConfig
 from mobee_drake.planning.supervisor import ActionTiming
+from mobee_drake.reaching.executor import ReachForcing
 from mobee_drake.robots.icub import IcubConfig
 from mobee_drake.robots.zero_position import ZeroPositionConfig
 from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
@@ -103,6 +104,15 @@ class ExploreAttractor:
 
 
 @dc.dataclass
+class StateActionAttractor:
+    """The attractor and a marker's force are set by a client's state-actions, one at a time:
+    transitions and dynamic reaches (ch. 8; see :mod:`mobee_drake.reaching.executor`)."""
+
+    forcing: ReachForcing = dc.field(default_factory=ReachForcing)
+    timing: ActionTiming = dc.field(default_factory=ActionTiming)
+
+
+@dc.dataclass
 class Companion:
     """Another robot in the same world with its own MoBeE (dissertation ch. 4.1.2, Fig. 4.5).
 
@@ -163,8 +173,8 @@ class Scenario:
     # The dynamic robot's plant step (s).
     plant_time_step: float = 0.001
     duration: float = 10.0
-    attractor: FixedAttractor | RandomAttractors | SliderAttractor | ExploreAttractor = dc.field(
-        default_factory=FixedAttractor)
+    attractor: (FixedAttractor | RandomAttractors | SliderAttractor | ExploreAttractor
+                | StateActionAttractor) = dc.field(default_factory=FixedAttractor)
     world_events: list[WorldEvent] = dc.field(default_factory=list)
     visualization: Visualization = dc.field(default_factory=Visualization)
     random_seed: int = 0

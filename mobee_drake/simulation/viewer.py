@@ -140,10 +140,12 @@ def _AddAttractorRobot(builder: DiagramBuilder, scenario: Scenario, scene_graph:
 
 def AddViewer(builder: DiagramBuilder, *, scenario: Scenario, meshcat: Meshcat,
               plant: MultibodyPlant, scene_graph: SceneGraph, mobee: Mobee,
-              attractor: OutputPort, marker_forces: str | None = None) -> MeshcatVisualizer:
+              attractor: OutputPort,
+              marker_forces: OutputPort | str | None = None) -> MeshcatVisualizer:
     """Adds the Meshcat viewer of a scenario; returns the illustration visualizer.
 
-    ``marker_forces`` names the diagram input that carries the client's marker forces, if any.
+    ``marker_forces`` is the port, or names the diagram input, that carries the client's marker
+    forces, if any.
     """
     settings = scenario.visualization
     if settings.show_attractor:
@@ -162,8 +164,10 @@ def AddViewer(builder: DiagramBuilder, *, scenario: Scenario, meshcat: Meshcat,
     builder.Connect(mobee.GetOutputPort("field_contacts"), forces.GetInputPort("field_contacts"))
     builder.Connect(mobee.GetOutputPort("marker_positions"),
                     forces.GetInputPort("marker_positions"))
-    if marker_forces is not None:
+    if isinstance(marker_forces, str):
         builder.ConnectInput(marker_forces, forces.GetInputPort("marker_forces"))
+    elif marker_forces is not None:
+        builder.Connect(marker_forces, forces.GetInputPort("marker_forces"))
     if settings.trail_marker:
         trail = builder.AddNamedSystem("trail", TrailDrawer(
             meshcat=meshcat, marker_index=mobee.marker_index(settings.trail_marker),

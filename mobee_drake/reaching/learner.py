@@ -1,0 +1,250 @@
+"""The reach learner (dissertation ch. 8.1-8.3): problem-tries over a learned MDP with reaches.
+
+The state-action space is the learned MDP's (ch. 6-7) plus one *reaching* state-action per state,
+numbered after the transitions (reach of state s = ``num_transitions + s``; with the rank-3
+lattice of ch. 7.2, 432 + s, the source's numbering: its favourite reaches 489 and 509 start from
+states 57 and 77). The MDP's transition probabilities plan the moves and are not updated (ch.
+8.1); a reach ends the policy (its row of T is empty), so its value is its reward.
+
+Rewards per problem (a reach target x*) come from the state-actions' histories (eq. 8.2):
+transitions predict eq. 8.1 (0 when untried); reaches predict by strategy (ch. 8.3.2):
+
+- ``random``: 1 on one reaching state-action drawn at the start of the problem-try, 0 on the rest;
+- ``greedy`` (greedy optimistic): eq. 8.5;
+- ``intrinsic`` (intrinsically motivated): eq. 8.7, the expected error of eq. 8.5's prediction.
+
+A *problem-try* (ch. 8.3.1): value iteration on the problem's rewards, the greedy state-action
+of the robot's state, recorded in its history with the prediction of eq. 8.1 or 8.5 made before
+it ran and the reward it got: a reach gets eq. 8.4 and ends the try; a transition gets 0, or -10
+when it did not reach a state of higher value (ch. 8.1). The rewards are predicted anew before
+every action, so a transition that just failed is avoided at once. After ``max_actions`` actions
+without a reach the try times out.
+
+Exploration (ch. 8.3.2) picks the least-tried problem (random among ties). Evaluations (ch. 8.3.3)
+put the robot in a random state (a reward of 1 on every transition into it), then try the
+shuffled problems greedily (eq. 8.1 and 8.5) and sum the reaches' rewards; they never write to
+the learner's histories. Choice where the source is silent: during an evaluation problem-try, its
+own records (a failed transition's -10) are kept in a scratch copy of the histories for the rest
+of that try only, so the greedy policy does not repeat a failing transition until it times out.
+
+The learner draws from its own seeded generator and keeps a log of every action it took, from
+which its histories are rebuilt exactly (checkpoints, :meth:`ReachLearner.FromArrays`).
+"""
+
+import dataclasses as dc
+from typing import Protocol
+
+import numpy as np
+
+from mobee_drake.planning.state_space import StateActionSpace
+from mobee_drake.planning.value_iteration import ValueIteration
+from mobee_drake.reaching.predictors import ReachReward, RewardHistories, TransitionReward
+
+STRATEGIES = ("random", "greedy", "intrinsic")
+
+
+@dc.dataclass
+class ReachLearningConfig:
+    """The reach learner's settings (ch. 8.3-8.4: gamma 0.9, 10 actions per problem-try)."""
+
+    strategy: str = "intrinsic"
+    gamma: float = 0.9
+    # Value iteration stops when no V(s, a) changes by this much in a sweep.
+    delta: float = 1e-4
+    max_actions: int = 10
+    seed: int = 0
+
+    def Validate(self) -> None:
+        if self.strategy not in STRATEGIES:
+            raise ValueError(f"unknown reach-learning strategy '{self.strategy}'; strategies "
+                             "are " + ", ".join(STRATEGIES))
+        if not 0 <= self.gamma < 1:
+            raise ValueError(f"gamma must be in [0, 1), got {self.gamma}")
+        if self.max_actions < 1:
+            raise ValueError(f"max_actions must be >= 1, got {self.max_actions}")
+
+
+class Robot(Protocol):
+    """What the learner needs of a robot (see :mod:`mobee_drake.reaching.robot`)."""
+
+    def SetProblem(self, target: np.ndarray) -> None:
+        """Puts the problem's target object into the world (replacing the previous one)."""
+
+    def State(self) -> int:
+        """The MDP state of the robot's configuration."""
+
+    def Transition(self, goal: int) -> int:
+        """Moves toward state ``goal``'s centre; returns the state where the robot settled."""
+
+    def Reach(self, target: np.ndarray) -> np.ndarray:
+        """Reaches for ``target`` from the current state; returns where the marker got to."""
+
+
+@dc.dataclass
+class TryResult:
+    """What one problem-try did."""
+
+    problem: int
+    actions: int
+    # The reach's reward, or None when the try timed out.
+    reward: float | None
+    # The reaching state-action tried, or -1.
+    reach: int
+    failed_transitions: int
+
+
+# Columns of the action log: problem-try, problem, state-action, state before, state after,
+# estimate, reward, target x, y, z.
+LOG_COLUMNS = ("try", "problem", "state_action", "state", "outcome", "estimate", "reward",
+               "x", "y", "z")
+
+
+class ReachLearner:
+    """Learns which pre-reach states suit which targets (ch. 8)."""
+
+    def __init__(self, space: StateActionSpace, transitions: np.ndarray, targets: np.ndarray,
+                 config: ReachLearningConfig | None = None):
+        self.config = config = config or ReachLearningConfig()
+        config.Validate()
+        m, k = space.num_states, space.num_state_actions
+        if transitions.shape != (k, m):
+            raise ValueError(f"transition probabilities must be ({k}, {m}), got "
+                             f"{transitions.shape}")
+        self.space, self.targets = space, np.asarray(targets, dtype=float)
+        self.num_transitions = k
+        # The state of every state-action (transitions, then one reach per state) and T, whose
+        # reach rows are empty: a reach ends the policy.
+        self.action_state = np.concatenate([space.action_state, np.arange(m)])
+        self.reaching = np.arange(k + m) >= k
+        self._T = np.vstack([transitions, np.zeros((m, m))])
+        # Value iteration wants the state-actions sorted by state.
+        self._order = np.argsort(self.action_state, kind="stable")
+        self._T_sorted = self._T[self._order]
+        self.histories = RewardHistories(self.reaching)
+        self.problem_tries = np.zeros(len(self.targets), dtype=int)
+        self.rng = np.random.default_rng(config.seed)
+        self.log: list[tuple] = []
+
+    @property
+    def num_state_actions(self) -> int:
+        return len(self.action_state)
+
+    def Reach(self, state: int) -> int:
+        """The reaching state-action of ``state``."""
+        return self.num_transitions + state
+
+    def Actions(self, state: int) -> np.ndarray:
+        return np.append(self.space.Actions(state), self.Reach(state))
+
+    # ------------------------------------------------------------------------------------------
+    # Planning.
+
+    def Rewards(self, target: np.ndarray, reach_rewards: str, histories=None,
+                random_reach: int = -1) -> np.ndarray:
+        """The problem's reward matrix: eq. 8.1 on transitions; on reaches ``reach_rewards``:
+        "random" (1 on ``random_reach``), "greedy" (eq. 8.5) or "intrinsic" (eq. 8.7)."""
+        histories = self.histories if histories is None else histories
+        rewards = np.array([histories.Predict(sa, target)
+                            for sa in range(self.num_transitions)] + [0.0] * self.space.num_states)
+        reaches = np.arange(self.num_transitions, self.num_state_actions)
+        if reach_rewards == "random":
+            rewards[random_reach] = 1.0
+        elif reach_rewards == "greedy":
+            rewards[reaches] = [histories.Predict(sa, target) for sa in reaches]
+        else:
+            rewards[reaches] = [histories.PredictIntrinsic(sa, target) for sa in reaches]
+        return rewards
+
+    def Values(self, rewards: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """V(s, a) (in state-action numbering) and V(s) by value iteration (Alg. 7)."""
+        q_sorted, v = ValueIteration(self._T_sorted, rewards[self._order],
+                                     self.action_state[self._order], self.space.num_states,
+                                     self.config.gamma, self.config.delta)
+        q = np.empty_like(q_sorted)
+        q[self._order] = q_sorted
+        return q, v
+
+    def _Greedy(self, q: np.ndarray, state: int, rng) -> int:
+        actions = self.Actions(state)
+        scores = q[actions]
+        return int(rng.choice(actions[scores >= scores.max() - 1e-12]))
+
+    # ------------------------------------------------------------------------------------------
+    # Acting.
+
+    def _Try(self, robot: Robot, problem: int, reach_rewards: str, histories: RewardHistories,
+             rng, log: list | None) -> TryResult:
+        target = self.targets[problem]
+        robot.SetProblem(target)
+        random_reach = (self.Reach(int(rng.integers(self.space.num_states)))
+                        if reach_rewards == "random" else -1)
+        failed = 0
+        for action in range(1, self.config.max_actions + 1):
+            q, v = self.Values(self.Rewards(target, reach_rewards, histories, random_reach))
+            state = robot.State()
+            sa = self._Greedy(q, state, rng)
+            estimate = histories.Predict(sa, target)  # eq. 8.1 or 8.5, before it runs
+            if self.reaching[sa]:
+                reward, outcome = ReachReward(robot.Reach(target), target), state
+            else:
+                outcome = robot.Transition(int(self.space.action_goal[sa]))
+                reward = TransitionReward(v[state], v[outcome])
+                failed += reward < 0
+            histories.Record(sa, target, estimate, reward)
+            if log is not None:
+                log.append((int(self.problem_tries.sum()), problem, sa, state, outcome, estimate,
+                            reward, *target))
+            if self.reaching[sa]:
+                return TryResult(problem, action, reward, sa, failed)
+        return TryResult(problem, self.config.max_actions, None, -1, failed)
+
+    def Explore(self, robot: Robot) -> TryResult:
+        """One exploratory problem-try on the least-tried problem (ch. 8.3.2)."""
+        least = np.flatnonzero(self.problem_tries == self.problem_tries.min())
+        problem = int(self.rng.choice(least))
+        result = self._Try(robot, problem, self.config.strategy, self.histories, self.rng,
+                           self.log)
+        self.problem_tries[problem] += 1
+        return result
+
+    def Evaluate(self, robot: Robot, seed) -> list[TryResult]:
+        """One exploitation evaluation (ch. 8.3.3) with its own generator ``seed``: a random start
+        state, then every problem, shuffled, greedily; the learner's state is not changed."""
+        rng = np.random.default_rng(seed)
+        start = int(rng.integers(self.space.num_states))
+        into_start = np.append((self.space.action_goal == start).astype(float),
+                               np.zeros(self.space.num_states))
+        q, _ = self.Values(into_start)
+        for _ in range(self.config.max_actions):
+            state = robot.State()
+            if state == start:
+                break
+            robot.Transition(int(self.space.action_goal[self._Greedy(q, state, rng)]))
+        return [self._Try(robot, int(problem), "greedy", self.histories.Copy(), rng, None)
+                for problem in rng.permutation(len(self.targets))]
+
+    # ------------------------------------------------------------------------------------------
+    # Saving and resuming.
+
+    def ToArrays(self) -> tuple[dict[str, np.ndarray], dict]:
+        """The learner's state as arrays and JSON-able data (generator state)."""
+        return (dict(log=np.array(self.log, dtype=float).reshape(-1, len(LOG_COLUMNS)),
+                     problem_tries=self.problem_tries),
+                dict(config=dc.asdict(self.config), generator=self.rng.bit_generator.state))
+
+    def LoadArrays(self, arrays, data: dict) -> None:
+        """Restores :meth:`ToArrays`' state into this (fresh) learner: the histories are rebuilt
+        from the log, record by record."""
+        if self.log:
+            raise ValueError("load a saved state into a fresh learner only")
+        saved = ReachLearningConfig(**data["config"])
+        if saved != self.config:
+            raise ValueError(f"the saved learner's configuration {saved} is not this one's "
+                             f"{self.config}")
+        for row in np.asarray(arrays["log"]):
+            entry = (int(row[0]), int(row[1]), int(row[2]), int(row[3]), int(row[4]),
+                     float(row[5]), float(row[6]), *map(float, row[7:]))
+            self.log.append(entry)
+            self.histories.Record(entry[2], np.array(entry[7:]), entry[5], entry[6])
+        self.problem_tries[...] = arrays["problem_tries"]
+        self.rng.bit_generator.state = data["generator"]
