@@ -64,8 +64,11 @@ TABLE = SceneObject(name="table", shape=BoxShape(size=[0.6, 1.0, 0.04]),
                     position=[-0.40, 0.0, -0.12])
 
 
-def _Scenario(agents: list[ExploringAgent], objects=()) -> Scenario:
+def ExplorationScenario(agents: list[ExploringAgent], objects=(), robot=None) -> Scenario:
+    """A headless kinematic scenario in which ``agents`` explore (``robot``: the iCub's
+    configuration, by default the upper body's joints)."""
     scenario = Scenario()
+    scenario.robot = robot or scenario.robot
     scenario.objects = list(objects)
     scenario.attractor = ExploreAttractor(agents=agents)
     scenario.time_step = 0.02
@@ -84,7 +87,7 @@ def _Start(scenario: Scenario):
             supervisor.GetMyContextFromRoot(simulator.get_context()))
 
 
-def _Explore(scenario: Scenario, stop, snapshots=(), chunk: float = 2.0,
+def Explore(scenario: Scenario, stop, snapshots=(), chunk: float = 2.0,
              keep: pathlib.Path | None = None, observer=None) -> dict:
     """Runs until ``stop(records)``; returns per-agent tries (and values at ``snapshots``); with
     ``keep``, saves the final checkpoint there (the learned models, for a planner to reuse);
@@ -141,7 +144,7 @@ def RunHypercube(output: pathlib.Path, runs: int, gammas=(0.5, 0.9, 0.99)) -> li
             if not path.exists():
                 agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=[0.25, 0.75],
                                        explorer=ExplorerConfig(gamma=gamma, seed=run))
-                data = _Explore(_Scenario([agent]),
+                data = Explore(ExplorationScenario([agent]),
                                 stop=lambda records: records[0].explorer.tries.min() >= 5,
                                 snapshots=(50, 320))
                 _Save(path, dict(gamma=gamma, run=run, **data))
@@ -158,7 +161,7 @@ def RunCoverage(output: pathlib.Path, transitions: int, runs: int) -> list[dict]
                 agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM,
                                        levels=[0.25, 0.5, 0.75], nearest=16,
                                        explorer=ExplorerConfig(strategy=strategy, seed=run))
-                data = _Explore(_Scenario([agent]),
+                data = Explore(ExplorationScenario([agent]),
                                 stop=lambda records: records[0].actions_done >= transitions)
                 _Save(path, dict(strategy=strategy, run=run, **data))
             results.append(json.loads(path.read_text()))
@@ -177,7 +180,7 @@ def RunInitializations(output: pathlib.Path, runs: int,
                         name="right_arm", joints=RIGHT_ARM, levels=[0.25, 0.5, 0.75],
                         explorer=ExplorerConfig(initialization=initialization, gamma=gamma,
                                                 seed=run))
-                    data = _Explore(_Scenario([agent]),
+                    data = Explore(ExplorationScenario([agent]),
                                     stop=lambda records: records[0].explorer.tries.min() >= 5)
                     _Save(path, dict(initialization=initialization, gamma=gamma, run=run,
                                      **data))
@@ -199,7 +202,7 @@ def RunRank4(output: pathlib.Path, transitions: int | None) -> list[dict]:
         if not path.exists():
             agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=levels,
                                    explorer=ExplorerConfig(seed=0))
-            data = _Explore(_Scenario([agent]), chunk=5.0,
+            data = Explore(ExplorationScenario([agent]), chunk=5.0,
                             stop=lambda records, budget=budget: records[0].actions_done >= budget)
             _Save(path, dict(lattice=name, levels=levels, **data))
         results.append(json.loads(path.read_text()))
@@ -215,7 +218,7 @@ def RunThreeAgents(output: pathlib.Path, transitions: int) -> dict:
                                  nearest=16, explorer=ExplorerConfig(seed=2)),
                   ExploringAgent(name="torso", joints=TORSO, levels=[0.25, 0.5, 0.75], nearest=8,
                                  explorer=ExplorerConfig(seed=3))]
-        data = _Explore(_Scenario(agents, [TABLE]), chunk=5.0, observer=_TableContacts,
+        data = Explore(ExplorationScenario(agents, [TABLE]), chunk=5.0, observer=_TableContacts,
                         stop=lambda records: sum(r.actions_done for r in records) >= transitions)
         _Save(path, data)
     return json.loads(path.read_text())
@@ -300,7 +303,7 @@ def _Plan(model: pathlib.Path, problems, repeats: int, seed: int) -> dict:
     agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=[0.25, 0.75],
                            model=str(model), explorer=ExplorerConfig(
                                strategy="planner", goal_state=problems[0][0], seed=seed))
-    scenario = _Scenario([agent], [box])
+    scenario = ExplorationScenario([agent], [box])
     scenario.world_events = events
     simulation, simulator, supervisor, supervisor_context = _Start(scenario)
     context = simulator.get_context()
@@ -342,9 +345,9 @@ def RunDynamicPlanning(output: pathlib.Path, transitions: int, repeats: int) -> 
             agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=[0.25, 0.75],
                                    explorer=ExplorerConfig(seed=0))
             box, events = _MovingBox(seed=0, horizon=12.0 * transitions)
-            scenario = _Scenario([agent], [box] if trained == "moving_box" else [])
+            scenario = ExplorationScenario([agent], [box] if trained == "moving_box" else [])
             scenario.world_events = events if trained == "moving_box" else []
-            _Explore(scenario, chunk=5.0, keep=models[trained],
+            Explore(scenario, chunk=5.0, keep=models[trained],
                      stop=lambda records: records[0].actions_done >= transitions)
     learned = {trained: LoadAgentModel(str(model), "right_arm", ExplorerConfig())
                for trained, model in models.items()}

@@ -1,0 +1,108 @@
+"""The reach learner's robot: the kinematic iCub under MoBeE, one state-action at a time.
+
+The target's role (ch. 8.1 footnote 2: a target is an obstacle until the reach touches it): the
+target sphere is an obstacle of MoBeE's world (``SetProblem``); during a reach, and only then, a
+transient collision filter excludes the pairs of the reaching marker's body (the hand) and the
+target, so the palm may touch and enter it while the rest of the arm is still kept out; the
+filter is removed when the reach has ended (settled back at its state's centre). A transition
+therefore must go around the target, and fails when it cannot.
+"""
+
+import numpy as np
+from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
+from pydrake.systems.analysis import Simulator
+
+from mobee_drake.planning.state_space import StateActionSpace
+from mobee_drake.reaching.executor import StateActionExecutor
+from mobee_drake.reaching.targets import TARGET_NAME, TargetObject
+from mobee_drake.simulation.builder import BuildSimulation
+from mobee_drake.simulation.checkpoint import LoadCheckpoint, SaveCheckpoint
+from mobee_drake.simulation.scenario import Scenario, StateActionAttractor
+
+
+class SimulatedRobot:
+    """Runs the learner's state-actions in a scenario with a :class:`StateActionAttractor`.
+
+    ``joints`` are the MDP's joints (``space``'s dimensions, in fractions of their ranges); the
+    rest of MoBeE's joints stay at home.
+    """
+
+    def __init__(self, scenario: Scenario, joints: list[str], space: StateActionSpace,
+                 target_radius: float, poll: float = 0.1):
+        if not isinstance(scenario.attractor, StateActionAttractor):
+            raise ValueError("the reach learner's scenario needs a StateActionAttractor")
+        self.simulation = simulation = BuildSimulation(scenario)
+        self.simulator = Simulator(simulation.diagram)
+        self.simulator.Initialize()
+        self.context = self.simulator.get_mutable_context()
+        self.executor: StateActionExecutor = simulation.diagram.GetSubsystemByName("attractor")
+        self._executor_context = self.executor.GetMyMutableContextFromRoot(self.context)
+        mobee = simulation.mobee
+        unknown = [j for j in joints if j not in mobee.joints]
+        if unknown:
+            raise ValueError(f"the MDP's joints {unknown} are not MoBeE's: "
+                             + ", ".join(mobee.joints))
+        self.space, self._poll, self._radius = space, poll, target_radius
+        self._columns = np.array([mobee.joints.index(j) for j in joints])
+        self._lower, self._upper = mobee.position_limits
+        self._home = mobee.home
+        plant = simulation.plant
+        marker = scenario.attractor.forcing.marker
+        hand = [m.body_name for m in simulation.robot.markers if m.name == marker][0]
+        self._hand = [g for g, frame in simulation.robot.geometry_frames.items()
+                      if plant.get_frame(frame).body().name() == hand]
+
+    # The configuration of a state's centre, and the state of the robot's configuration.
+    def _Centre(self, state: int) -> np.ndarray:
+        q = self._home.copy()
+        span = self._upper[self._columns] - self._lower[self._columns]
+        q[self._columns] = self._lower[self._columns] + self.space.centres[state] * span
+        return q
+
+    def State(self) -> int:
+        q = self.simulation.robot_state.Eval(self.context)[:len(self._home)]
+        span = self._upper[self._columns] - self._lower[self._columns]
+        return self.space.StateOf((q[self._columns] - self._lower[self._columns]) / span)
+
+    def SetProblem(self, target: np.ndarray) -> None:
+        world = self.simulation.world
+        if TARGET_NAME in world.names:
+            world.Move(self.context, TARGET_NAME, [float(c) for c in target])
+        else:
+            world.Add(self.context, TargetObject(target, self._radius))
+
+    def _Finish(self) -> None:
+        while not self.executor.Done(self._executor_context):
+            self.simulator.AdvanceTo(self.context.get_time() + self._poll)
+
+    def Transition(self, goal: int) -> int:
+        self.executor.StartTransition(self._executor_context, self._Centre(goal))
+        self._Finish()
+        return self.State()
+
+    def Reach(self, target: np.ndarray) -> np.ndarray:
+        scene_graph = self.simulation.scene_graph
+        filters = scene_graph.collision_filter_manager(
+            scene_graph.GetMyMutableContextFromRoot(self.context))
+        touch = filters.ApplyTransient(CollisionFilterDeclaration().ExcludeBetween(
+            GeometrySet(self._hand),
+            GeometrySet(self.simulation.world.geometry_id(TARGET_NAME))))
+        self.executor.StartReach(self._executor_context, self._Centre(self.State()), target)
+        self._Finish()
+        filters.RemoveDeclaration(touch)
+        return self.executor.ReachedPosition(self._executor_context)
+
+    @property
+    def simulated_seconds(self) -> float:
+        return self.context.get_time()
+
+    def Save(self, folder) -> None:
+        """Saves where the robot is (and the executor's state) as a simulation checkpoint."""
+        SaveCheckpoint(self.simulation, self.context, folder)
+
+    def Load(self, folder) -> None:
+        LoadCheckpoint(self.simulation, self.context, folder)
+
+    def PenetratingSteps(self) -> int:
+        monitor = self.simulation.monitor
+        return monitor.Report(monitor.GetMyContextFromRoot(self.context)).penetrating_steps
