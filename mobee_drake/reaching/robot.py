@@ -10,7 +10,7 @@ therefore must go around the target, and fails when it cannot.
 
 import numpy as np
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
-from pydrake.systems.analysis import Simulator
+from pydrake.systems.analysis import InitializeParams, Simulator
 
 from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.reaching.executor import StateActionExecutor
@@ -49,6 +49,8 @@ class SimulatedRobot:
         plant = simulation.plant
         marker = scenario.attractor.forcing.marker
         hand = [m.body_name for m in simulation.robot.markers if m.name == marker][0]
+        # The current problem's target (None before the first problem).
+        self.target: np.ndarray | None = None
         self._hand = [g for g, frame in simulation.robot.geometry_frames.items()
                       if plant.get_frame(frame).body().name() == hand]
 
@@ -65,6 +67,7 @@ class SimulatedRobot:
         return self.space.StateOf((q[self._columns] - self._lower[self._columns]) / span)
 
     def SetProblem(self, target: np.ndarray) -> None:
+        self.target = np.asarray(target, dtype=float)
         world = self.simulation.world
         if TARGET_NAME in world.names:
             world.Move(self.context, TARGET_NAME, [float(c) for c in target])
@@ -102,6 +105,7 @@ class SimulatedRobot:
 
     def Load(self, folder) -> None:
         LoadCheckpoint(self.simulation, self.context, folder)
+        self.simulator.Initialize(InitializeParams(suppress_initialization_events=True))
 
     def PenetratingSteps(self) -> int:
         monitor = self.simulation.monitor

@@ -1,0 +1,368 @@
+"""The reach-learning battery of dissertation ch. 8.4 (Fig. 8.2, 8.4-8.8) on the kinematic iCub.
+
+1. The MDP (ch. 8.3: the rank-3 lattice of ch. 7.2, equidistant neighbours, 81 states and 432
+   state-actions over the right shoulder and elbow): a curious agent explores until every
+   state-action was tried ``--mdp-tries`` times (5, as in ch. 7.2), without targets; its
+   transition probabilities are then fixed.
+2. For every strategy (random, greedy optimistic, intrinsic) and seed, a run of
+   ``--problem-tries`` exploratory problem-tries (6400 in the source) on the 27 targets, with
+   ``--evaluations`` exploitation evaluations (5) when the count reaches each stage (100, 200,
+   400, ..., 6400), gamma 0.9. Runs go to ``--workers`` processes; each checkpoints (the learner,
+   its evaluations and the simulation, atomically) every ``--checkpoint-every`` problem-tries and
+   after every stage's evaluations, and resumes from its checkpoint after a kill; a progress bar
+   per run shows the problem-tries done.
+3. Plots like Fig. 8.2 (cumulative reward of every evaluation per stage), 8.4-8.6 (the reaching
+   state-actions chosen in evaluations), 8.7 (exploratory tries per problem and state-action) and
+   8.8 (failed transitions per state-action), and ``report.md`` beside the source's claims.
+
+Run: ``mobee-drake experiment ch8 --output results/ch8`` (the whole battery), or a reduced one:
+``mobee-drake experiment ch8 --problem-tries 400 --seeds 2``.
+"""
+
+import argparse
+import concurrent.futures
+import dataclasses as dc
+import json
+import multiprocessing
+import os
+import pathlib
+import shutil
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+from mobee_drake.planning.experiments import RIGHT_ARM, ExplorationScenario, Explore
+from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
+from mobee_drake.reaching.learner import STRATEGIES, ReachLearner, ReachLearningConfig
+from mobee_drake.reaching.robot import SimulatedRobot
+from mobee_drake.reaching.targets import LoadTargetGrid
+from mobee_drake.robots.icub import IcubConfig
+from mobee_drake.simulation.scenario import ExploringAgent, Scenario, StateActionAttractor
+
+SOURCE_STAGES = (100, 200, 400, 800, 1600, 3200, 6400)
+LEVELS = [0.25, 0.5, 0.75]
+AGENT = "right_arm"
+# Robot hours of the source's five runs per strategy (ch. 8.4).
+SOURCE_HOURS = {"random": 207, "greedy": 109, "intrinsic": 113}
+
+
+def _Robot() -> IcubConfig:
+    return IcubConfig(controlled_joints=RIGHT_ARM)
+
+
+def TrainMdp(folder: pathlib.Path, min_tries: int, seed: int = 0):
+    """The curious agent's model of the rank-3 lattice, learned once (kept in ``folder``)."""
+    if not (folder / f"{AGENT}.npz").is_file():
+        agent = ExploringAgent(name=AGENT, joints=RIGHT_ARM, levels=LEVELS,
+                               explorer=ExplorerConfig(seed=seed))
+        Explore(ExplorationScenario([agent], robot=_Robot()), chunk=5.0, keep=folder,
+                stop=lambda records: records[0].explorer.tries.min() >= min_tries)
+    return LoadAgentModel(str(folder), AGENT, ExplorerConfig())
+
+
+@dc.dataclass
+class RunSettings:
+    strategy: str
+    seed: int
+    problem_tries: int
+    stages: list[int]
+    evaluations: int
+    checkpoint_every: int
+
+
+def _ReachScenario() -> Scenario:
+    scenario = Scenario()
+    scenario.robot = _Robot()
+    scenario.attractor = StateActionAttractor()
+    scenario.time_step = 0.02
+    scenario.visualization.meshcat = False
+    return scenario
+
+
+def _Checkpoint(folder: pathlib.Path, robot: SimulatedRobot, learner: ReachLearner,
+                data: dict) -> None:
+    """Saves the simulation, the learner and ``data`` (evaluations, wall time) atomically."""
+    staging = pathlib.Path(tempfile.mkdtemp(dir=folder.parent, prefix=f".{folder.name}-"))
+    robot.Save(staging / "simulation")
+    arrays, learner_data = learner.ToArrays()
+    np.savez(staging / "learner.npz", **arrays)
+    (staging / "learner.json").write_text(json.dumps(dict(learner=learner_data, **data)))
+    old = folder.with_name(f".{folder.name}-old")
+    shutil.rmtree(old, ignore_errors=True)
+    if folder.exists():
+        os.replace(folder, old)
+    os.replace(staging, folder)
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def _WriteJson(path: pathlib.Path, data) -> None:
+    temporary = path.with_suffix(".tmp")
+    temporary.write_text(json.dumps(data))
+    os.replace(temporary, path)
+
+
+def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings) -> dict:
+    """One run of the battery (resumes from ``run_dir/checkpoint``); returns its result."""
+    result_path = run_dir / "result.json"
+    if result_path.is_file():
+        return json.loads(result_path.read_text())
+    run_dir.mkdir(parents=True, exist_ok=True)
+    model = LoadAgentModel(str(mdp_dir), AGENT, ExplorerConfig())
+    grid = LoadTargetGrid()
+    learner = ReachLearner(model.space, model.transitions.Probabilities(), grid.Centres(),
+                           ReachLearningConfig(strategy=settings.strategy, seed=settings.seed))
+    robot = SimulatedRobot(_ReachScenario(), RIGHT_ARM, model.space, grid.radius)
+    checkpoint = run_dir / "checkpoint"
+    data = dict(evaluations={}, wall_seconds=0.0, target=None)
+    if checkpoint.is_dir():
+        saved = json.loads((checkpoint / "learner.json").read_text())
+        learner.LoadArrays(np.load(checkpoint / "learner.npz"), saved.pop("learner"))
+        robot.Load(checkpoint / "simulation")
+        data = saved
+        if data["target"] is not None:
+            robot.SetProblem(np.array(data["target"]))
+    started = time.perf_counter() - data["wall_seconds"]
+
+    def Save():
+        data["wall_seconds"] = time.perf_counter() - started
+        data["target"] = None if robot.target is None else robot.target.tolist()
+        _Checkpoint(checkpoint, robot, learner, data)
+        _WriteJson(run_dir / "progress.json", dict(
+            problem_tries=int(learner.problem_tries.sum()), total=settings.problem_tries))
+
+    while True:
+        done = int(learner.problem_tries.sum())
+        if done in settings.stages and str(done) not in data["evaluations"]:
+            data["evaluations"][str(done)] = [
+                [dc.asdict(r) for r in learner.Evaluate(robot, seed=(settings.seed, done, e))]
+                for e in range(settings.evaluations)]
+            Save()
+        if done >= settings.problem_tries:
+            break
+        learner.Explore(robot)
+        if (done + 1) % settings.checkpoint_every == 0:
+            Save()
+    Save()
+    arrays, _ = learner.ToArrays()
+    result = dict(settings=dc.asdict(settings), evaluations=data["evaluations"],
+                  log=arrays["log"].tolist(), simulated_seconds=robot.simulated_seconds,
+                  wall_seconds=data["wall_seconds"],
+                  penetrating_steps=robot.PenetratingSteps(),
+                  num_transitions=learner.num_transitions,
+                  num_states=learner.space.num_states)
+    _WriteJson(result_path, result)
+    return result
+
+
+def RunBattery(output: pathlib.Path, strategies, seeds: int, problem_tries: int, stages,
+               evaluations: int, mdp_tries: int, workers: int,
+               checkpoint_every: int = 50) -> list[dict]:
+    """The MDP, then every (strategy, seed) run in ``workers`` processes, with progress bars."""
+    from tqdm import tqdm
+
+    mdp_dir = output / f"mdp_tries{mdp_tries}"
+    TrainMdp(mdp_dir, mdp_tries)
+    runs = {f"{strategy}_seed{seed}": RunSettings(strategy, seed, problem_tries, list(stages),
+                                                 evaluations, checkpoint_every)
+            for strategy in strategies for seed in range(seeds)}
+    context = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context) as pool:
+        futures = {name: pool.submit(RunOne, output / "runs" / name, mdp_dir, settings)
+                   for name, settings in runs.items()}
+        bars = {name: tqdm(total=problem_tries, desc=name, position=i, leave=True,
+                           unit="try", dynamic_ncols=True)
+                for i, name in enumerate(runs)}
+        while True:
+            for name, bar in bars.items():
+                progress = output / "runs" / name / "progress.json"
+                if futures[name].done():
+                    bar.n = problem_tries
+                elif progress.is_file():
+                    try:
+                        bar.n = json.loads(progress.read_text())["problem_tries"]
+                    except (json.JSONDecodeError, KeyError):
+                        pass
+                bar.refresh()
+            if all(f.done() for f in futures.values()):
+                break
+            time.sleep(2.0)
+        for bar in bars.values():
+            bar.close()
+        return [futures[name].result() for name in runs]
+
+
+def _Stacked(axis, stack: np.ndarray, x=None, width=1.0) -> None:
+    """Bars of the rows of ``stack`` stacked in colours."""
+    x = np.arange(stack.shape[1]) if x is None else x
+    bottom = np.zeros(stack.shape[1])
+    for row in stack:
+        axis.bar(x, row, bottom=bottom, width=width)
+        bottom += row
+
+
+def _Cumulative(evaluation: list[dict]) -> float:
+    """The reward summed over an evaluation's problem-tries (reaches only; a timeout gets 0)."""
+    return sum(r["reward"] or 0.0 for r in evaluation)
+
+
+def Report(output: pathlib.Path, results: list[dict]) -> str:
+    """Plots like Fig. 8.2, 8.4-8.8 and a markdown report; returns the report."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    strategies = [s for s in STRATEGIES if any(r["settings"]["strategy"] == s for r in results)]
+    by_strategy = {s: [r for r in results if r["settings"]["strategy"] == s] for s in strategies}
+    stages = sorted({int(k) for r in results for k in r["evaluations"]})
+    k, m = results[0]["num_transitions"], results[0]["num_states"]
+    lines = ["## Cumulative reward of the exploitation evaluations (Fig. 8.2)", "",
+             "Sum of the reaches' rewards (eq. 8.4) over the 27 problems of one evaluation (a "
+             "problem-try that timed out adds 0); mean and standard deviation over all "
+             "evaluations of all seeds.", "",
+             "| strategy | " + " | ".join(str(s) for s in stages) + " |",
+             "|---|" + "---:|" * len(stages)]
+    means = {}
+    figure, axes = plt.subplots(1, len(strategies), figsize=(5 * len(strategies), 4),
+                                squeeze=False, sharey=True)
+    for axis, strategy in zip(axes[0], strategies):
+        table = np.array([[[_Cumulative(e) for e in r["evaluations"][str(stage)]]
+                           for stage in stages] for r in by_strategy[strategy]])
+        means[strategy] = table.mean(axis=(0, 2))
+        lines.append(f"| {strategy} | " + " | ".join(
+            f"{mu:.2f} ± {sd:.2f}" for mu, sd in zip(means[strategy], table.std(axis=(0, 2))))
+            + " |")
+        # One colour per evaluation (seed after seed), stacked per stage.
+        _Stacked(axis, table.transpose(0, 2, 1).reshape(-1, len(stages)),
+                 x=np.arange(len(stages)), width=0.6)
+        axis.set_xticks(np.arange(len(stages)), [str(s) for s in stages])
+        axis.set_xlabel("exploratory problem-tries")
+        axis.set_title(strategy)
+    axes[0, 0].set_ylabel("cumulative reward, evaluations stacked")
+    figure.tight_layout()
+    figure.savefig(output / "8.2_cumulative_reward.png", dpi=80)
+
+    # Fig. 8.4-8.6: the reaching state-actions chosen in evaluations, per stage, seeds stacked.
+    for strategy in strategies:
+        figure, axes = plt.subplots(len(stages), 1, figsize=(10, 1.6 * len(stages)),
+                                    squeeze=False, sharex=True)
+        for axis, stage in zip(axes[:, 0], stages):
+            counts = np.array([np.bincount(
+                [t["reach"] - k for e in r["evaluations"][str(stage)] for t in e
+                 if t["reach"] >= 0], minlength=m) for r in by_strategy[strategy]])
+            _Stacked(axis, counts)
+            axis.set_ylabel(str(stage), rotation=0, labelpad=20)
+        axes[-1, 0].set_xlabel(f"reaching state-action - {k} (its state)")
+        axes[0, 0].set_title(f"{strategy}: reaches chosen in evaluations, seeds stacked")
+        figure.tight_layout()
+        figure.savefig(output / f"8.4-8.6_reaches_{strategy}.png", dpi=80)
+
+    # Fig. 8.7: exploratory tries per problem (row) and state-action (column), mean over seeds.
+    figure, axes = plt.subplots(len(stages), len(strategies),
+                                figsize=(5 * len(strategies), 1.4 * len(stages)), squeeze=False)
+    num_problems = 27
+    for column, strategy in enumerate(strategies):
+        for row, stage in enumerate(stages):
+            image = np.zeros((num_problems, k + m))
+            for r in by_strategy[strategy]:
+                log = np.array(r["log"]).reshape(-1, 10)
+                log = log[log[:, 0] < stage]
+                np.add.at(image, (log[:, 1].astype(int), log[:, 2].astype(int)), 1.0)
+            axes[row, column].imshow(image / len(by_strategy[strategy]), aspect="auto",
+                                     cmap="jet", interpolation="nearest")
+            axes[row, column].set_xticks([])
+            axes[row, column].set_yticks([])
+            if column == 0:
+                axes[row, column].set_ylabel(str(stage))
+        axes[-1, column].set_xlabel(strategy)
+    figure.tight_layout()
+    figure.savefig(output / "8.7_problem_tries.png", dpi=80)
+
+    # Fig. 8.8: failed transitions (reward -10) per state-action, seeds stacked.
+    figure, axes = plt.subplots(len(strategies), 1, figsize=(10, 2.2 * len(strategies)),
+                                squeeze=False, sharex=True)
+    lines += ["", "## Robot time, failed transitions and reaches", "",
+              "| strategy | runs | robot hours (all runs) | source's robot hours (5 runs of 6400) "
+              "| actions per problem-try | failed transitions per problem-try | timed-out "
+              "problem-tries | wall hours (all runs) | penetrating control periods |",
+              "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    hours = {}
+    for axis, strategy in zip(axes[:, 0], strategies):
+        counts, actions, failed, timeouts, tries = [], 0, 0, 0, 0
+        for r in by_strategy[strategy]:
+            log = np.array(r["log"]).reshape(-1, 10)
+            negative = log[log[:, 6] < 0]
+            counts.append(np.bincount(negative[:, 2].astype(int), minlength=k)[:k])
+            actions += len(log)
+            failed += len(negative)
+            tries += r["settings"]["problem_tries"]
+            reaches = log[log[:, 2] >= k]
+            timeouts += r["settings"]["problem_tries"] - len(reaches)
+        _Stacked(axis, np.array(counts))
+        axis.set_title(f"{strategy}: failed transitions per state-action, seeds stacked")
+        hours[strategy] = sum(r["simulated_seconds"] for r in by_strategy[strategy]) / 3600
+        lines.append(
+            f"| {strategy} | {len(by_strategy[strategy])} | {hours[strategy]:.1f} | "
+            f"{SOURCE_HOURS[strategy]} | {actions / tries:.2f} | {failed / tries:.2f} | "
+            f"{timeouts} | {sum(r['wall_seconds'] for r in by_strategy[strategy]) / 3600:.2f} | "
+            f"{sum(r['penetrating_steps'] for r in by_strategy[strategy])} |")
+    axes[-1, 0].set_xlabel("transition state-action")
+    figure.tight_layout()
+    figure.savefig(output / "8.8_failed_transitions.png", dpi=80)
+
+    lines += ["", "## The source's claims (ch. 8.4)", ""]
+    if {"intrinsic", "random", "greedy"} <= set(means):
+        first, after = stages[0], [i for i, s in enumerate(stages) if s >= 800]
+        worst_first = means["intrinsic"][0] <= min(means["random"][0], means["greedy"][0])
+        steady = bool(np.all(np.diff(means["intrinsic"]) >= 0))
+        best_after = all(means["intrinsic"][i] > max(means["random"][i], means["greedy"][i])
+                         for i in after) if after else None
+        ratio = hours["random"] / np.mean([hours["greedy"], hours["intrinsic"]])
+        lines += [
+            f"- intrinsic motivation is the least competent after {first} problem-tries: "
+            f"{'yes' if worst_first else 'no'} ({means['intrinsic'][0]:.2f} against random "
+            f"{means['random'][0]:.2f}, greedy {means['greedy'][0]:.2f});",
+            f"- it improves steadily: {'yes' if steady else 'no'} (means "
+            + ", ".join(f"{x:.2f}" for x in means["intrinsic"]) + ");",
+            "- it is the best from 800 problem-tries on: "
+            + ("not measured (no stage >= 800)" if best_after is None
+               else "yes" if best_after else "no") + ";",
+            f"- random exploration takes {ratio:.2f} times the robot time of the other two "
+            f"(source: 207 h against 109 and 113 h, 1.86 times)."]
+    return "\n".join(lines)
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(prog="mobee-drake experiment ch8", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--output", default="results/ch8")
+    parser.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))
+    parser.add_argument("--seeds", type=int, default=5)
+    parser.add_argument("--problem-tries", type=int, default=6400)
+    parser.add_argument("--stages", type=int, nargs="+", default=None,
+                        help="when to evaluate (default: the source's 100, 200, ..., 6400 up to "
+                             "--problem-tries)")
+    parser.add_argument("--evaluations", type=int, default=5)
+    parser.add_argument("--mdp-tries", type=int, default=5,
+                        help="the MDP is learned until every state-action was tried this often")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--checkpoint-every", type=int, default=50)
+    argv = sys.argv[1:] if argv is None else argv
+    args = parser.parse_args(argv)
+    stages = args.stages or [s for s in SOURCE_STAGES if s <= args.problem_tries]
+    if any(s < 0 or s > args.problem_tries for s in stages):
+        parser.error(f"--stages must lie in 0..{args.problem_tries}")
+    output = pathlib.Path(args.output)
+    output.mkdir(parents=True, exist_ok=True)
+    results = RunBattery(output, args.strategies, args.seeds, args.problem_tries, stages,
+                         args.evaluations, args.mdp_tries, args.workers, args.checkpoint_every)
+    report = output / "report.md"
+    report.write_text(f"# Reach learning (ch. 8.4)\n\n`mobee-drake experiment ch8 "
+                      f"{' '.join(argv)}`\n\n" + Report(output, results) + "\n")
+    print(report.read_text())
+
+
+if __name__ == "__main__":
+    main()

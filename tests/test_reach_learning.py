@@ -1,0 +1,192 @@
+"""The state-action executor (fixed input ports), and the reach-learning battery on the robot."""
+
+import json
+import pathlib
+import tempfile
+import unittest
+from unittest import mock
+
+import numpy as np
+from pydrake.systems.analysis import Simulator
+
+from mobee_drake.planning.supervisor import ActionTiming
+from mobee_drake.reaching.executor import Phase, ReachForcing, StateActionExecutor
+
+
+class TestStateActionExecutor(unittest.TestCase):
+    def setUp(self):
+        self.timing = ActionTiming(settle_speed=0.1, settle_time=0.5, min_duration=1.0,
+                                   timeout=5.0)
+        self.forcing = ReachForcing(marker="palm", force=300.0, softening=0.05)
+        self.dut = StateActionExecutor(num_joints=2, marker_index=1, num_markers=2,
+                                       initial_attractor=np.array([0.1, 0.2]),
+                                       forcing=self.forcing, timing=self.timing, period=0.1)
+        self.simulator = Simulator(self.dut)
+        self.context = self.simulator.get_mutable_context()
+        self.markers = np.array([9.0, 9.0, 9.0, 0.1, 0.2, 0.3])
+        self.dut.GetInputPort("marker_positions").FixValue(self.context, self.markers)
+        self.Velocity([0.0, 0.0])
+
+    def Velocity(self, v):
+        self.dut.GetInputPort("robot_state").FixValue(self.context, np.concatenate([[0, 0], v]))
+
+    def Attractor(self):
+        return self.dut.GetOutputPort("attractor").Eval(self.context)
+
+    def Forces(self):
+        return self.dut.GetOutputPort("marker_forces").Eval(self.context).reshape(2, 3)
+
+    def test_idle_keeps_the_initial_attractor_and_no_force(self):
+        self.simulator.AdvanceTo(3.0)
+        np.testing.assert_array_equal(self.Attractor(), [0.1, 0.2])
+        np.testing.assert_array_equal(self.Forces(), 0.0)
+        self.assertTrue(self.dut.Done(self.context))
+
+    def test_transition_ends_when_settled(self):
+        self.dut.StartTransition(self.context, np.array([0.5, -0.5]))
+        np.testing.assert_array_equal(self.Attractor(), [0.5, -0.5])
+        np.testing.assert_array_equal(self.Forces(), 0.0)
+        self.Velocity([0.0, 0.2])  # moving: not settled
+        self.simulator.AdvanceTo(2.05)
+        self.assertEqual(self.dut.CurrentPhase(self.context), Phase.MOVING)
+        self.Velocity([0.05, -0.05])  # slow from the poll at 2.1 s; settled 0.5 s later
+        self.simulator.AdvanceTo(2.55)
+        self.assertFalse(self.dut.Done(self.context))
+        self.simulator.AdvanceTo(2.65)
+        self.assertTrue(self.dut.Done(self.context))
+        self.assertEqual(self.dut.FinishedActions(self.context), 1)
+        np.testing.assert_array_equal(self.Attractor(), [0.5, -0.5])  # q* stays
+
+    def test_transition_times_out(self):
+        self.dut.StartTransition(self.context, np.array([0.5, -0.5]))
+        self.Velocity([1.0, 0.0])
+        self.simulator.AdvanceTo(4.95)
+        self.assertFalse(self.dut.Done(self.context))
+        self.simulator.AdvanceTo(5.05)
+        self.assertTrue(self.dut.Done(self.context))
+
+    def test_reach_forces_then_returns(self):
+        target = np.array([0.4, 0.6, 0.3])
+        self.dut.StartReach(self.context, np.array([0.3, 0.3]), target)
+        error = target - self.markers[3:]  # |error| = 0.5
+        np.testing.assert_allclose(self.Forces()[1], 300.0 * error / 0.55)
+        np.testing.assert_array_equal(self.Forces()[0], 0.0)
+        np.testing.assert_array_equal(self.Attractor(), [0.3, 0.3])
+        self.simulator.AdvanceTo(1.55)  # slow since 0.1 s: settled at the 1.0 s minimum
+        self.assertEqual(self.dut.CurrentPhase(self.context), Phase.RETURNING)
+        np.testing.assert_array_equal(self.dut.ReachedPosition(self.context), self.markers[3:])
+        np.testing.assert_array_equal(self.Forces(), 0.0)
+        # Settles a second time (a new phase: min_duration again) and ends.
+        self.simulator.AdvanceTo(1.95)
+        self.assertFalse(self.dut.Done(self.context))
+        self.simulator.AdvanceTo(2.05)
+        self.assertTrue(self.dut.Done(self.context))
+
+    def test_bad_commands(self):
+        with self.assertRaisesRegex(ValueError, "q\\* must have 2 entries"):
+            self.dut.StartTransition(self.context, np.zeros(3))
+        with self.assertRaisesRegex(ValueError, "three finite numbers"):
+            self.dut.StartReach(self.context, np.zeros(2), [0, np.nan, 0])
+        self.dut.StartTransition(self.context, np.zeros(2))
+        with self.assertRaisesRegex(ValueError, "in flight"):
+            self.dut.StartTransition(self.context, np.zeros(2))
+
+
+class TestTargets(unittest.TestCase):
+    def test_grid_of_27_clear_of_the_robot_at_home(self):
+        from mobee_drake.reaching.targets import LoadTargetGrid
+
+        grid = LoadTargetGrid()
+        centres = grid.Centres()
+        self.assertEqual(centres.shape, (27, 3))
+        self.assertEqual(len(np.unique(centres, axis=0)), 27)
+        self.assertTrue(np.all(centres[:, 0] < -0.1))  # in front of the robot (it faces -x)
+
+    def test_bad_grid_file(self):
+        from mobee_drake.reaching.targets import LoadTargetGrid
+        from mobee_drake.yaml_io import YamlFileError
+
+        with tempfile.TemporaryDirectory() as folder:
+            path = pathlib.Path(folder) / "grid.yaml"
+            path.write_text("radius: 0.05\nx: [0.1]\ny: []\nz: [0.2]\n")
+            with self.assertRaisesRegex(YamlFileError, "grid.yaml: 'y' needs at least one"):
+                LoadTargetGrid(path)
+
+
+class TestBattery(unittest.TestCase):
+    """A reduced battery on the kinematic iCub: every strategy, real reaches and evaluations."""
+
+    @classmethod
+    def setUpClass(cls):
+        from mobee_drake.reaching.experiments import RunSettings, TrainMdp
+
+        cls.folder = tempfile.TemporaryDirectory()
+        cls.output = pathlib.Path(cls.folder.name)
+        cls.mdp = cls.output / "mdp"
+        cls.model = TrainMdp(cls.mdp, min_tries=1)
+        cls.Settings = RunSettings
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.folder.cleanup()
+
+    def Run(self, name, settings):
+        from mobee_drake.reaching.experiments import RunOne
+
+        return RunOne(self.output / name, self.mdp, settings)
+
+    def test_mdp_tried_everything(self):
+        self.assertEqual(self.model.space.num_state_actions, 432)
+        self.assertGreaterEqual(self.model.tries.min(), 1)
+
+    def test_reduced_battery(self):
+        from mobee_drake.reaching.learner import STRATEGIES
+
+        results = [self.Run(s, self.Settings(s, 0, 12, [0, 12], 1, 5)) for s in STRATEGIES]
+        for result in results:
+            log = np.array(result["log"])
+            # Every problem-try ended with a reach or after at most 10 actions.
+            self.assertEqual(sorted(result["evaluations"]), ["0", "12"])
+            self.assertEqual(int(log[:, 0].max()), 11)
+            reaches = log[log[:, 2] >= 432]
+            self.assertTrue(np.all((reaches[:, 6] > 0) & (reaches[:, 6] <= 1)))
+            transitions = log[log[:, 2] < 432]
+            self.assertTrue(np.all(np.isin(transitions[:, 6], [0.0, -10.0])))
+            # A reach's state is where the robot was, and it stays there.
+            np.testing.assert_array_equal(reaches[:, 2] - 432, reaches[:, 3])
+            # Least-tried problems first: 12 tries on 12 different problems.
+            self.assertEqual(len(np.unique(log[log[:, 2] >= 432][:, 1])), len(reaches))
+            for evaluation in result["evaluations"].values():
+                self.assertEqual(sorted(t["problem"] for t in evaluation[0]), list(range(27)))
+        # Fresh learners evaluate alike (same start, same greedy ties from the same seed).
+        self.assertEqual(len({json.dumps(r["evaluations"]["0"]) for r in results}), 1)
+        from mobee_drake.reaching.experiments import Report
+
+        report = Report(self.output, results)
+        self.assertIn("| intrinsic |", report)
+        for figure in ("8.2_cumulative_reward.png", "8.7_problem_tries.png",
+                       "8.8_failed_transitions.png", "8.4-8.6_reaches_greedy.png"):
+            self.assertTrue((self.output / figure).is_file(), figure)
+
+    def test_resume_after_a_kill_is_exact(self):
+        from mobee_drake.reaching.learner import ReachLearner
+
+        settings = self.Settings("intrinsic", 1, 10, [0, 6, 10], 1, 3)
+        whole = self.Run("whole", settings)
+        explore, calls = ReachLearner.Explore, []
+
+        def Dying(learner, robot):
+            calls.append(1)
+            if len(calls) == 8:
+                raise KeyboardInterrupt
+            return explore(learner, robot)
+
+        with mock.patch.object(ReachLearner, "Explore", Dying):
+            with self.assertRaises(KeyboardInterrupt):
+                self.Run("killed", settings)
+        saved = json.loads((self.output / "killed" / "progress.json").read_text())
+        self.assertEqual(saved["problem_tries"], 6)
+        resumed = self.Run("killed", settings)
+        self.assertEqual(resumed["log"], whole["log"])
+        self.assertEqual(resumed["evaluations"], whole["evaluations"])
+        self.assertAlmostEqual(resumed["simulated_seconds"], whole["simulated_seconds"])
