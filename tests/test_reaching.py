@@ -82,9 +82,10 @@ class FakeRobot:
         return self.palms[self.state]
 
 
-def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10):
+def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10, predictor="weighted"):
     from mobee_drake.planning.state_space import Lattice
     from mobee_drake.reaching.learner import ReachLearner, ReachLearningConfig
+    from mobee_drake.reaching.predictors import PredictorConfig
 
     space = Lattice([0.25, 0.75], 2)  # states 0=(0,0) 1=(0,1) 2=(1,0) 3=(1,1)
     T = np.zeros((space.num_state_actions, space.num_states))
@@ -92,7 +93,8 @@ def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10):
     targets = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]) \
         if targets is None else targets
     return space, ReachLearner(space, T, targets, ReachLearningConfig(
-        strategy=strategy, seed=seed, max_actions=max_actions))
+        strategy=strategy, seed=seed, max_actions=max_actions,
+        predictor=PredictorConfig(predictor)))
 
 
 PALMS = np.array([[0.3, 0, 0], [0.2, 0, 0], [0.1, 0, 0], [0.0, 0, 0]], dtype=float)
@@ -187,17 +189,19 @@ class TestReachLearner(unittest.TestCase):
             np.testing.assert_array_equal(learner.histories.History(sa)[2], rewards)
 
     def test_exact_resume(self):
-        for strategy in ("random", "greedy", "intrinsic"):
-            space, whole = _Learner(strategy, seed=3)
+        for strategy, predictor in [("random", "weighted"), ("greedy", "weighted"),
+                                    ("intrinsic", "weighted"),
+                                    ("intrinsic", "gaussian_process")]:
+            space, whole = _Learner(strategy, seed=3, predictor=predictor)
             robot = FakeRobot(space, PALMS, blocked={(0, 2), (3, 1)})
             for _ in range(12):
                 whole.Explore(robot)
-            _, first = _Learner(strategy, seed=3)
+            _, first = _Learner(strategy, seed=3, predictor=predictor)
             robot = FakeRobot(space, PALMS, blocked={(0, 2), (3, 1)})
             for _ in range(6):
                 first.Explore(robot)
             arrays, data = first.ToArrays()
-            _, resumed = _Learner(strategy, seed=3)
+            _, resumed = _Learner(strategy, seed=3, predictor=predictor)
             resumed.LoadArrays(arrays, data)
             for _ in range(6):
                 resumed.Explore(robot)
@@ -209,3 +213,53 @@ class TestReachLearner(unittest.TestCase):
     def test_bad_configuration(self):
         with self.assertRaisesRegex(ValueError, "unknown reach-learning strategy 'curious'"):
             _Learner("curious")
+
+
+class TestGaussianProcessPredictor(unittest.TestCase):
+    def setUp(self):
+        from mobee_drake.reaching.predictors import PredictorConfig
+
+        self.config = PredictorConfig("gaussian_process", length_scale=0.1, noise_ratio=0.25)
+        self.histories = RewardHistories([False, True], self.config)
+
+    def test_closed_forms(self):
+        h, rho = self.histories, 0.25
+        self.assertEqual(h.Predict(1, [0, 0, 0]), 1.0)  # the prior: optimistic
+        h.Record(1, [0, 0, 0], 1.0, 0.6)
+        # One record: prior + (v - prior) k / (1 + rho).
+        self.assertAlmostEqual(h.Predict(1, [0, 0, 0]), 1 - 0.4 / (1 + rho))
+        d = 0.05
+        self.assertAlmostEqual(h.Predict(1, [d, 0, 0]),
+                               1 - 0.4 * np.exp(-d ** 2 / (2 * 0.1 ** 2)) / (1 + rho))
+        # Far from every record the prediction returns to the prior (eq. 8.5 approaches it only
+        # as 1 / distance).
+        self.assertAlmostEqual(h.Predict(1, [2, 0, 0]), 1.0, places=9)
+        # Two records at one target pool: their mean, with half the noise.
+        h.Record(1, [0, 0, 0], 0.9, 0.8)
+        self.assertAlmostEqual(h.Predict(1, [0, 0, 0]), 1 - 0.3 / (1 + rho / 2))
+        # The intrinsic prediction fits the errors e - r = 0.4, 0.1 the same way.
+        self.assertAlmostEqual(h.PredictIntrinsic(1, [0, 0, 0]), 1 - 0.75 / (1 + rho / 2))
+        # Transitions: prior 0.
+        h.Record(0, [0, 0, 0], 0.0, FAILED_TRANSITION_REWARD)
+        self.assertAlmostEqual(h.Predict(0, [0, 0, 0]), -10 / (1 + rho))
+
+    def test_local_unlike_the_weighted_average(self):
+        # A good reach at one target and a bad one 30 cm away: the GP keeps them apart, eq. 8.5
+        # blurs them (ch. 8.5).
+        weighted = RewardHistories([True])
+        for h in (self.histories, weighted):
+            for _ in range(10):
+                h.Record(0 if h is weighted else 1, [0, 0, 0], 1.0, 0.95)
+                h.Record(0 if h is weighted else 1, [0.3, 0, 0], 1.0, 0.5)
+        self.assertGreater(self.histories.Predict(1, [0, 0, 0]), 0.9)
+        self.assertLess(self.histories.Predict(1, [0.3, 0, 0]), 0.6)
+        self.assertLess(weighted.Predict(0, [0, 0, 0]), 0.9)
+        self.assertGreater(weighted.Predict(0, [0.3, 0, 0]), 0.6)
+
+    def test_bad_config(self):
+        from mobee_drake.reaching.predictors import PredictorConfig
+
+        with self.assertRaisesRegex(ValueError, "unknown reward predictor 'net'"):
+            RewardHistories([True], PredictorConfig("net"))
+        with self.assertRaisesRegex(ValueError, "length_scale"):
+            RewardHistories([True], PredictorConfig("gaussian_process", length_scale=0.0))

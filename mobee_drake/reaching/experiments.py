@@ -36,6 +36,7 @@ import numpy as np
 from mobee_drake.planning.experiments import RIGHT_ARM, ExplorationScenario, Explore
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
 from mobee_drake.reaching.learner import STRATEGIES, ReachLearner, ReachLearningConfig
+from mobee_drake.reaching.predictors import PREDICTORS, PredictorConfig
 from mobee_drake.reaching.robot import SimulatedRobot
 from mobee_drake.reaching.targets import LoadTargetGrid
 from mobee_drake.robots.icub import IcubConfig
@@ -70,6 +71,8 @@ class RunSettings:
     stages: list[int]
     evaluations: int
     checkpoint_every: int
+    # "weighted" (eq. 8.1-8.7) or "gaussian_process".
+    predictor: str = "weighted"
 
 
 def _ReachScenario() -> Scenario:
@@ -112,7 +115,8 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings) 
     model = LoadAgentModel(str(mdp_dir), AGENT, ExplorerConfig())
     grid = LoadTargetGrid()
     learner = ReachLearner(model.space, model.transitions.Probabilities(), grid.Centres(),
-                           ReachLearningConfig(strategy=settings.strategy, seed=settings.seed))
+                           ReachLearningConfig(strategy=settings.strategy, seed=settings.seed,
+                                               predictor=PredictorConfig(settings.predictor)))
     robot = SimulatedRobot(_ReachScenario(), RIGHT_ARM, model.space, grid.radius)
     checkpoint = run_dir / "checkpoint"
     data = dict(evaluations={}, wall_seconds=0.0, target=None)
@@ -157,15 +161,15 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings) 
 
 
 def RunBattery(output: pathlib.Path, strategies, seeds: int, problem_tries: int, stages,
-               evaluations: int, mdp_tries: int, workers: int,
-               checkpoint_every: int = 50) -> list[dict]:
+               evaluations: int, mdp_tries: int, workers: int, checkpoint_every: int = 50,
+               predictor: str = "weighted") -> list[dict]:
     """The MDP, then every (strategy, seed) run in ``workers`` processes, with progress bars."""
     from tqdm import tqdm
 
     mdp_dir = output / f"mdp_tries{mdp_tries}"
     TrainMdp(mdp_dir, mdp_tries)
     runs = {f"{strategy}_seed{seed}": RunSettings(strategy, seed, problem_tries, list(stages),
-                                                 evaluations, checkpoint_every)
+                                                 evaluations, checkpoint_every, predictor)
             for strategy in strategies for seed in range(seeds)}
     context = multiprocessing.get_context("spawn")
     with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context) as pool:
@@ -349,6 +353,9 @@ def main(argv=None) -> None:
                         help="the MDP is learned until every state-action was tried this often")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--checkpoint-every", type=int, default=50)
+    parser.add_argument("--predictor", choices=PREDICTORS, default="weighted",
+                        help="the reward predictor: the source's weighted averages (eq. 8.1-8.7) "
+                             "or a Gaussian process (use another --output)")
     argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(argv)
     stages = args.stages or [s for s in SOURCE_STAGES if s <= args.problem_tries]
@@ -357,7 +364,8 @@ def main(argv=None) -> None:
     output = pathlib.Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
     results = RunBattery(output, args.strategies, args.seeds, args.problem_tries, stages,
-                         args.evaluations, args.mdp_tries, args.workers, args.checkpoint_every)
+                         args.evaluations, args.mdp_tries, args.workers, args.checkpoint_every,
+                         args.predictor)
     report = output / "report.md"
     report.write_text(f"# Reach learning (ch. 8.4)\n\n`mobee-drake experiment ch8 "
                       f"{' '.join(argv)}`\n\n" + Report(output, results) + "\n")

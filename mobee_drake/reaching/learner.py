@@ -38,7 +38,12 @@ import numpy as np
 
 from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.planning.value_iteration import ValueIteration
-from mobee_drake.reaching.predictors import ReachReward, RewardHistories, TransitionReward
+from mobee_drake.reaching.predictors import (
+    PredictorConfig,
+    ReachReward,
+    RewardHistories,
+    TransitionReward,
+)
 
 STRATEGIES = ("random", "greedy", "intrinsic")
 
@@ -53,8 +58,11 @@ class ReachLearningConfig:
     delta: float = 1e-4
     max_actions: int = 10
     seed: int = 0
+    # The source's weighted averages (eq. 8.1-8.7) or a Gaussian process (ch. 8.5).
+    predictor: PredictorConfig = dc.field(default_factory=PredictorConfig)
 
     def Validate(self) -> None:
+        self.predictor.Validate()
         if self.strategy not in STRATEGIES:
             raise ValueError(f"unknown reach-learning strategy '{self.strategy}'; strategies "
                              "are " + ", ".join(STRATEGIES))
@@ -120,7 +128,7 @@ class ReachLearner:
         # Value iteration wants the state-actions sorted by state.
         self._order = np.argsort(self.action_state, kind="stable")
         self._T_sorted = self._T[self._order]
-        self.histories = RewardHistories(self.reaching)
+        self.histories = RewardHistories(self.reaching, config.predictor)
         self.problem_tries = np.zeros(len(self.targets), dtype=int)
         self.rng = np.random.default_rng(config.seed)
         self.log: list[tuple] = []
@@ -237,7 +245,8 @@ class ReachLearner:
         from the log, record by record."""
         if self.log:
             raise ValueError("load a saved state into a fresh learner only")
-        saved = ReachLearningConfig(**data["config"])
+        saved = ReachLearningConfig(**{**data["config"], "predictor": PredictorConfig(
+            **data["config"]["predictor"])})
         if saved != self.config:
             raise ValueError(f"the saved learner's configuration {saved} is not this one's "
                              f"{self.config}")

@@ -9,9 +9,43 @@ weighs each past reward by ``1 / (1 + |x* - x*_i|)``:
 - reaches, eq. 8.5: ``(1 + sum w_i r_i) / (1 + sum w_i)``, optimistic both with no history and
   for targets far from every one tried (the rewards of eq. 8.4 lie in (0, 1]);
 - intrinsic, eq. 8.7: eq. 8.5 over the past prediction errors ``e_i - r_i`` (eq. 8.6).
+
+A stronger predictor, asked for in ch. 8.5 and 9.4.4 (``PredictorConfig(kind="gaussian_process")``):
+Gaussian-process regression over the workspace with the same priors (0 for transitions, 1 for
+reaches and their errors) as its mean, so it is optimistic far from experience as eq. 8.5 is, but
+follows the data closely near it instead of averaging over every target ever tried (the failing
+of eq. 8.1-8.7 that ch. 8.5 describes: one large reward soon predicted for all problems). The
+kernel is squared-exponential, ``exp(-|x - x'|^2 / (2 l^2))``, with independent noise of
+``noise_ratio`` times the signal variance per record; the posterior mean does not depend on the
+signal variance. Records at the same target are pooled (their mean, with noise divided by their
+count: exact for this model), so a history over the 27 grid targets is a 27-point GP however long
+it is.
 """
 
+import dataclasses as dc
+
 import numpy as np
+from scipy.linalg import cho_factor, cho_solve
+
+PREDICTORS = ("weighted", "gaussian_process")
+
+
+@dc.dataclass
+class PredictorConfig:
+    """Which predictor (eq. 8.1-8.7, or a Gaussian process) and the process's settings."""
+
+    kind: str = "weighted"
+    # The kernel's length scale (m) and the noise variance relative to the signal's.
+    length_scale: float = 0.1
+    noise_ratio: float = 0.25
+
+    def Validate(self) -> None:
+        if self.kind not in PREDICTORS:
+            raise ValueError(f"unknown reward predictor '{self.kind}'; predictors are "
+                             + ", ".join(PREDICTORS))
+        if not (self.length_scale > 0 and self.noise_ratio > 0):
+            raise ValueError(f"the predictor's length_scale and noise_ratio must be > 0, got "
+                             f"{self.length_scale} and {self.noise_ratio}")
 
 # The reward of a state transition that does not climb the value function (ch. 8.1).
 FAILED_TRANSITION_REWARD = -10.0
@@ -37,19 +71,55 @@ def WeightedEstimate(target: np.ndarray, targets: np.ndarray, values: np.ndarray
     return float((prior + weights @ values) / (prior + weights.sum()))
 
 
+class GaussianProcessFit:
+    """The posterior mean of a GP with constant prior mean fitted to (targets, values)."""
+
+    def __init__(self, targets: np.ndarray, values: np.ndarray, prior: float,
+                 config: PredictorConfig):
+        self.prior, self._scale = prior, 2.0 * config.length_scale ** 2
+        unique, inverse, counts = np.unique(targets, axis=0, return_inverse=True,
+                                            return_counts=True)
+        means = np.bincount(inverse.ravel(), weights=values) / counts
+        gram = self._Kernel(unique, unique) + np.diag(config.noise_ratio / counts)
+        self._points = unique
+        self._alpha = cho_solve(cho_factor(gram), means - prior)
+
+    def _Kernel(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        squared = np.sum((a[:, None, :] - b[None, :, :]) ** 2, axis=2)
+        return np.exp(-squared / self._scale)
+
+    def __call__(self, target: np.ndarray) -> float:
+        return float(self.prior + self._Kernel(target[None], self._points)[0] @ self._alpha)
+
+
 class RewardHistories:
     """The histories ``H_{s,a}`` (eq. 8.2) of every state-action, and the predictions from them.
 
     ``reaching[sa]`` says whether a state-action is a reach (eq. 8.5, 8.7) or a state transition
-    (eq. 8.1).
+    (eq. 8.1); ``predictor`` chooses the weighted averages of the source or a Gaussian process.
     """
 
-    def __init__(self, reaching: np.ndarray):
+    def __init__(self, reaching: np.ndarray, predictor: PredictorConfig | None = None):
         self.reaching = np.asarray(reaching, dtype=bool)
+        self.predictor = predictor or PredictorConfig()
+        self.predictor.Validate()
         n = len(self.reaching)
         self._targets = [np.zeros((0, 3)) for _ in range(n)]
         self._estimates = [np.zeros(0) for _ in range(n)]
         self._rewards = [np.zeros(0) for _ in range(n)]
+        # Gaussian-process fits by (state-action, intrinsic?), dropped when a history grows.
+        self._fits: dict[tuple[int, bool], GaussianProcessFit] = {}
+
+    def _Estimate(self, state_action: int, target, values: np.ndarray, prior: float,
+                  intrinsic: bool) -> float:
+        target = np.asarray(target, dtype=float)
+        if self.predictor.kind == "weighted" or len(values) == 0:
+            return WeightedEstimate(target, self._targets[state_action], values, prior)
+        fit = self._fits.get((state_action, intrinsic))
+        if fit is None:
+            fit = GaussianProcessFit(self._targets[state_action], values, prior, self.predictor)
+            self._fits[state_action, intrinsic] = fit
+        return fit(target)
 
     def __len__(self) -> int:
         return len(self.reaching)
@@ -57,7 +127,7 @@ class RewardHistories:
     def Copy(self) -> "RewardHistories":
         """An independent copy (records replace a history's arrays, never change them)."""
         twin = RewardHistories.__new__(RewardHistories)
-        twin.reaching = self.reaching
+        twin.reaching, twin.predictor, twin._fits = self.reaching, self.predictor, dict(self._fits)
         twin._targets, twin._estimates = list(self._targets), list(self._estimates)
         twin._rewards = list(self._rewards)
         return twin
@@ -70,14 +140,12 @@ class RewardHistories:
     def Predict(self, state_action: int, target) -> float:
         """The expected reward (eq. 8.1 for transitions, 8.5 for reaches)."""
         prior = 1.0 if self.reaching[state_action] else 0.0
-        return WeightedEstimate(np.asarray(target, dtype=float), self._targets[state_action],
-                                self._rewards[state_action], prior)
+        return self._Estimate(state_action, target, self._rewards[state_action], prior, False)
 
     def PredictIntrinsic(self, state_action: int, target) -> float:
         """The expected prediction error of a reach (eq. 8.7 over eq. 8.6)."""
         errors = self._estimates[state_action] - self._rewards[state_action]
-        return WeightedEstimate(np.asarray(target, dtype=float), self._targets[state_action],
-                                errors, 1.0)
+        return self._Estimate(state_action, target, errors, 1.0, True)
 
     def Record(self, state_action: int, target, estimate: float, reward: float) -> None:
         """Appends ``{x*, e, r}`` to ``H_{s,a}`` (eq. 8.2)."""
@@ -85,3 +153,5 @@ class RewardHistories:
                                                   np.asarray(target, dtype=float)[None]])
         self._estimates[state_action] = np.append(self._estimates[state_action], estimate)
         self._rewards[state_action] = np.append(self._rewards[state_action], reward)
+        self._fits.pop((state_action, False), None)
+        self._fits.pop((state_action, True), None)
