@@ -135,6 +135,21 @@ class TestBattery(unittest.TestCase):
 
         return RunOne(self.output / name, self.mdp, settings)
 
+    def test_watch_in_meshcat(self):
+        from pydrake.geometry import Meshcat
+
+        from mobee_drake.reaching.experiments import RIGHT_ARM, ReachScenario
+        from mobee_drake.reaching.robot import SimulatedRobot
+
+        meshcat = Meshcat()
+        robot = SimulatedRobot(ReachScenario(), RIGHT_ARM, self.model.space, 0.05,
+                               meshcat=meshcat)
+        robot.simulator.set_target_realtime_rate(0.0)  # the test need not wait
+        robot.SetProblem(np.array([-0.23, 0.22, 0.19]))
+        state = robot.State()
+        robot.Transition(int(self.model.space.action_goal[self.model.space.Actions(state)[0]]))
+        self.assertTrue(meshcat.HasPath("/drake/illustration"))
+
     def test_mdp_tried_everything(self):
         self.assertEqual(self.model.space.num_state_actions, 432)
         self.assertGreaterEqual(self.model.tries.min(), 1)

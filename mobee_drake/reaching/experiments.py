@@ -16,7 +16,8 @@
    8.8 (failed transitions per state-action), and ``report.md`` beside the source's claims.
 
 Run: ``mobee-drake experiment ch8 --output results/ch8`` (the whole battery), or a reduced one:
-``mobee-drake experiment ch8 --problem-tries 400 --seeds 2``.
+``mobee-drake experiment ch8 --problem-tries 400 --seeds 2``; watch one run in Meshcat:
+``mobee-drake experiment ch8 --watch --strategies intrinsic``.
 """
 
 import argparse
@@ -75,7 +76,8 @@ class RunSettings:
     predictor: str = "weighted"
 
 
-def _ReachScenario() -> Scenario:
+def ReachScenario() -> Scenario:
+    """The reach learner's headless kinematic iCub: MoBeE on the right shoulder and elbow."""
     scenario = Scenario()
     scenario.robot = _Robot()
     scenario.attractor = StateActionAttractor()
@@ -106,8 +108,10 @@ def _WriteJson(path: pathlib.Path, data) -> None:
     os.replace(temporary, path)
 
 
-def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings) -> dict:
-    """One run of the battery (resumes from ``run_dir/checkpoint``); returns its result."""
+def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
+           meshcat=None) -> dict:
+    """One run of the battery (resumes from ``run_dir/checkpoint``); returns its result. With
+    ``meshcat``, the run is shown there in real time."""
     result_path = run_dir / "result.json"
     if result_path.is_file():
         return json.loads(result_path.read_text())
@@ -117,7 +121,8 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings) 
     learner = ReachLearner(model.space, model.transitions.Probabilities(), grid.Centres(),
                            ReachLearningConfig(strategy=settings.strategy, seed=settings.seed,
                                                predictor=PredictorConfig(settings.predictor)))
-    robot = SimulatedRobot(_ReachScenario(), RIGHT_ARM, model.space, grid.radius)
+    robot = SimulatedRobot(ReachScenario(), RIGHT_ARM, model.space, grid.radius,
+                           meshcat=meshcat)
     checkpoint = run_dir / "checkpoint"
     data = dict(evaluations={}, wall_seconds=0.0, target=None)
     if checkpoint.is_dir():
@@ -353,6 +358,9 @@ def main(argv=None) -> None:
                         help="the MDP is learned until every state-action was tried this often")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--checkpoint-every", type=int, default=50)
+    parser.add_argument("--watch", action="store_true",
+                        help="run only the first strategy's seed 0, in this process, shown in "
+                             "Meshcat in real time (the address is printed)")
     parser.add_argument("--predictor", choices=PREDICTORS, default="weighted",
                         help="the reward predictor: the source's weighted averages (eq. 8.1-8.7) "
                              "or a Gaussian process (use another --output)")
@@ -363,6 +371,15 @@ def main(argv=None) -> None:
         parser.error(f"--stages must lie in 0..{args.problem_tries}")
     output = pathlib.Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
+    if args.watch:
+        from pydrake.geometry import StartMeshcat
+
+        mdp_dir = output / f"mdp_tries{args.mdp_tries}"
+        TrainMdp(mdp_dir, args.mdp_tries)
+        settings = RunSettings(args.strategies[0], 0, args.problem_tries, stages,
+                               args.evaluations, args.checkpoint_every, args.predictor)
+        RunOne(output / "runs" / f"watch_{settings.strategy}", mdp_dir, settings, StartMeshcat())
+        return
     results = RunBattery(output, args.strategies, args.seeds, args.problem_tries, stages,
                          args.evaluations, args.mdp_tries, args.workers, args.checkpoint_every,
                          args.predictor)

@@ -24,15 +24,17 @@ class SimulatedRobot:
     """Runs the learner's state-actions in a scenario with a :class:`StateActionAttractor`.
 
     ``joints`` are the MDP's joints (``space``'s dimensions, in fractions of their ranges); the
-    rest of MoBeE's joints stay at home.
+    rest of MoBeE's joints stay at home. With ``meshcat`` the robot is shown there, in real time.
     """
 
     def __init__(self, scenario: Scenario, joints: list[str], space: StateActionSpace,
-                 target_radius: float, poll: float = 0.1):
+                 target_radius: float, poll: float = 0.1, meshcat=None):
         if not isinstance(scenario.attractor, StateActionAttractor):
             raise ValueError("the reach learner's scenario needs a StateActionAttractor")
-        self.simulation = simulation = BuildSimulation(scenario)
+        self.simulation = simulation = BuildSimulation(scenario, meshcat)
         self.simulator = Simulator(simulation.diagram)
+        if meshcat is not None:
+            self.simulator.set_target_realtime_rate(1.0)
         self.simulator.Initialize()
         self.context = self.simulator.get_mutable_context()
         self.executor: StateActionExecutor = simulation.diagram.GetSubsystemByName("attractor")
