@@ -27,9 +27,7 @@ import json
 import multiprocessing
 import os
 import pathlib
-import shutil
 import sys
-import tempfile
 import time
 
 import numpy as np
@@ -41,6 +39,7 @@ from mobee_drake.reaching.predictors import PREDICTORS, PredictorConfig
 from mobee_drake.reaching.robot import SimulatedRobot
 from mobee_drake.reaching.targets import LoadTargetGrid
 from mobee_drake.robots.icub import IcubConfig
+from mobee_drake.simulation.checkpoint import WriteFolderAtomically
 from mobee_drake.simulation.scenario import ExploringAgent, Scenario, StateActionAttractor
 
 SOURCE_STAGES = (100, 200, 400, 800, 1600, 3200, 6400)
@@ -89,17 +88,14 @@ def ReachScenario() -> Scenario:
 def _Checkpoint(folder: pathlib.Path, robot: SimulatedRobot, learner: ReachLearner,
                 data: dict) -> None:
     """Saves the simulation, the learner and ``data`` (evaluations, wall time) atomically."""
-    staging = pathlib.Path(tempfile.mkdtemp(dir=folder.parent, prefix=f".{folder.name}-"))
-    robot.Save(staging / "simulation")
-    arrays, learner_data = learner.ToArrays()
-    np.savez(staging / "learner.npz", **arrays)
-    (staging / "learner.json").write_text(json.dumps(dict(learner=learner_data, **data)))
-    old = folder.with_name(f".{folder.name}-old")
-    shutil.rmtree(old, ignore_errors=True)
-    if folder.exists():
-        os.replace(folder, old)
-    os.replace(staging, folder)
-    shutil.rmtree(old, ignore_errors=True)
+
+    def Write(staging: pathlib.Path) -> None:
+        robot.Save(staging / "simulation")
+        arrays, learner_data = learner.ToArrays()
+        np.savez(staging / "learner.npz", **arrays)
+        (staging / "learner.json").write_text(json.dumps(dict(learner=learner_data, **data)))
+
+    WriteFolderAtomically(folder, Write)
 
 
 def _WriteJson(path: pathlib.Path, data) -> None:

@@ -41,22 +41,13 @@ def _DiscreteStates(simulation: Simulation, context):
             yield f"{system.get_name()}/{i}", sub_context.get_discrete_state(i).value()
 
 
-def SaveCheckpoint(simulation: Simulation, context, folder: str | pathlib.Path) -> None:
-    """Saves the state of ``context`` (the diagram's root context) into ``folder``."""
+def WriteFolderAtomically(folder: str | pathlib.Path, write) -> None:
+    """Calls ``write(staging)`` on a new folder beside ``folder``, then renames it into place, so
+    that ``folder`` is always either the old or the new whole."""
     folder = pathlib.Path(folder)
     folder.parent.mkdir(parents=True, exist_ok=True)
     staging = pathlib.Path(tempfile.mkdtemp(dir=folder.parent, prefix=f".{folder.name}-"))
-    np.savez(staging / "simulation.npz", time=context.get_time(),
-             **{key: value for key, value in _DiscreteStates(simulation, context)})
-    supervisor = _Supervisor(simulation)
-    if supervisor is not None:
-        records = supervisor.Records(supervisor.GetMyContextFromRoot(context))
-        for name, record in zip(supervisor.agent_names, records):
-            arrays, data = ExplorerToArrays(record.explorer)
-            np.savez(staging / f"{name}.npz", **arrays)
-            data["record"] = {k: v for k, v in dc.asdict(record).items() if k != "explorer"}
-            data["record"]["slow_since"] = float(record.slow_since)
-            (staging / f"{name}.json").write_text(json.dumps(data, indent=1))
+    write(staging)
     if folder.exists():
         old = folder.with_name(f".{folder.name}-old")
         shutil.rmtree(old, ignore_errors=True)
@@ -65,6 +56,26 @@ def SaveCheckpoint(simulation: Simulation, context, folder: str | pathlib.Path) 
         shutil.rmtree(old, ignore_errors=True)
     else:
         os.replace(staging, folder)
+
+
+def SaveCheckpoint(simulation: Simulation, context, folder: str | pathlib.Path) -> None:
+    """Saves the state of ``context`` (the diagram's root context) into ``folder``."""
+
+    def Write(staging: pathlib.Path) -> None:
+        np.savez(staging / "simulation.npz", time=context.get_time(),
+                 **{key: value for key, value in _DiscreteStates(simulation, context)})
+        supervisor = _Supervisor(simulation)
+        if supervisor is not None:
+            records = supervisor.Records(supervisor.GetMyContextFromRoot(context))
+            for name, record in zip(supervisor.agent_names, records):
+                arrays, data = ExplorerToArrays(record.explorer)
+                np.savez(staging / f"{name}.npz", **arrays)
+                data["record"] = {k: v for k, v in dc.asdict(record).items()
+                                  if k != "explorer"}
+                data["record"]["slow_since"] = float(record.slow_since)
+                (staging / f"{name}.json").write_text(json.dumps(data, indent=1))
+
+    WriteFolderAtomically(folder, Write)
 
 
 def LoadCheckpoint(simulation: Simulation, context, folder: str | pathlib.Path) -> None:
