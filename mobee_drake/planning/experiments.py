@@ -130,7 +130,8 @@ def _Misses(explorer) -> np.ndarray:
     return np.where(explorer.tries > 0, 1 - hits / np.maximum(explorer.tries, 1), 0.0)
 
 
-def _Save(path: pathlib.Path, data: dict) -> None:
+def SaveJson(path: pathlib.Path, data: dict) -> None:
+    """Writes ``data`` as JSON beside ``path`` and renames it into place."""
     temporary = path.with_suffix(".tmp")
     temporary.write_text(json.dumps(data))
     os.replace(temporary, path)
@@ -147,7 +148,7 @@ def RunHypercube(output: pathlib.Path, runs: int, gammas=(0.5, 0.9, 0.99)) -> li
                 data = Explore(ExplorationScenario([agent]),
                                 stop=lambda records: records[0].explorer.tries.min() >= 5,
                                 snapshots=(50, 320))
-                _Save(path, dict(gamma=gamma, run=run, **data))
+                SaveJson(path, dict(gamma=gamma, run=run, **data))
             results.append(json.loads(path.read_text()))
     return results
 
@@ -163,7 +164,7 @@ def RunCoverage(output: pathlib.Path, transitions: int, runs: int) -> list[dict]
                                        explorer=ExplorerConfig(strategy=strategy, seed=run))
                 data = Explore(ExplorationScenario([agent]),
                                 stop=lambda records: records[0].actions_done >= transitions)
-                _Save(path, dict(strategy=strategy, run=run, **data))
+                SaveJson(path, dict(strategy=strategy, run=run, **data))
             results.append(json.loads(path.read_text()))
     return results
 
@@ -182,7 +183,7 @@ def RunInitializations(output: pathlib.Path, runs: int,
                                                 seed=run))
                     data = Explore(ExplorationScenario([agent]),
                                     stop=lambda records: records[0].explorer.tries.min() >= 5)
-                    _Save(path, dict(initialization=initialization, gamma=gamma, run=run,
+                    SaveJson(path, dict(initialization=initialization, gamma=gamma, run=run,
                                      **data))
                 results.append(json.loads(path.read_text()))
     return results
@@ -204,7 +205,7 @@ def RunRank4(output: pathlib.Path, transitions: int | None) -> list[dict]:
                                    explorer=ExplorerConfig(seed=0))
             data = Explore(ExplorationScenario([agent]), chunk=5.0,
                             stop=lambda records, budget=budget: records[0].actions_done >= budget)
-            _Save(path, dict(lattice=name, levels=levels, **data))
+            SaveJson(path, dict(lattice=name, levels=levels, **data))
         results.append(json.loads(path.read_text()))
     return results
 
@@ -220,7 +221,7 @@ def RunThreeAgents(output: pathlib.Path, transitions: int) -> dict:
                                  explorer=ExplorerConfig(seed=3))]
         data = Explore(ExplorationScenario(agents, [TABLE]), chunk=5.0, observer=_TableContacts,
                         stop=lambda records: sum(r.actions_done for r in records) >= transitions)
-        _Save(path, data)
+        SaveJson(path, data)
     return json.loads(path.read_text())
 
 
@@ -361,7 +362,7 @@ def RunDynamicPlanning(output: pathlib.Path, transitions: int, repeats: int) -> 
         path = output / f"7.4.1_plans_{trained}_{transitions}_{repeats}.json"
         if not path.exists():
             plans = [GreedyPlan(explorer, start, goal) for start, goal in problems]
-            _Save(path, dict(reliability=_Reliability(explorer).tolist(), plans=plans,
+            SaveJson(path, dict(reliability=_Reliability(explorer).tolist(), plans=plans,
                              **(_Plan(models[trained], problems, repeats, seed=1)
                                 if problems else dict(episodes=[]))))
         results[trained] = json.loads(path.read_text())

@@ -25,14 +25,18 @@ import concurrent.futures
 import dataclasses as dc
 import json
 import multiprocessing
-import os
 import pathlib
 import sys
 import time
 
 import numpy as np
 
-from mobee_drake.planning.experiments import RIGHT_ARM, ExplorationScenario, Explore
+from mobee_drake.planning.experiments import (
+    RIGHT_ARM,
+    ExplorationScenario,
+    Explore,
+    SaveJson,
+)
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
 from mobee_drake.reaching.learner import STRATEGIES, ReachLearner, ReachLearningConfig
 from mobee_drake.reaching.predictors import PREDICTORS, PredictorConfig
@@ -98,12 +102,6 @@ def _Checkpoint(folder: pathlib.Path, robot: SimulatedRobot, learner: ReachLearn
     WriteFolderAtomically(folder, Write)
 
 
-def _WriteJson(path: pathlib.Path, data) -> None:
-    temporary = path.with_suffix(".tmp")
-    temporary.write_text(json.dumps(data))
-    os.replace(temporary, path)
-
-
 def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
            meshcat=None) -> dict:
     """One run of the battery (resumes from ``run_dir/checkpoint``); returns its result. With
@@ -134,7 +132,7 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
         data["wall_seconds"] = time.perf_counter() - started
         data["target"] = None if robot.target is None else robot.target.tolist()
         _Checkpoint(checkpoint, robot, learner, data)
-        _WriteJson(run_dir / "progress.json", dict(
+        SaveJson(run_dir / "progress.json", dict(
             problem_tries=int(learner.problem_tries.sum()), total=settings.problem_tries))
 
     while True:
@@ -157,7 +155,7 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
                   penetrating_steps=robot.PenetratingSteps(),
                   num_transitions=learner.num_transitions,
                   num_states=learner.space.num_states)
-    _WriteJson(result_path, result)
+    SaveJson(result_path, result)
     return result
 
 
