@@ -88,7 +88,7 @@ def _Start(scenario: Scenario):
 
 
 def Explore(scenario: Scenario, stop, snapshots=(), chunk: float = 2.0,
-             keep: pathlib.Path | None = None, observer=None) -> dict:
+            keep: pathlib.Path | None = None, observer=None) -> dict:
     """Runs until ``stop(records)``; returns per-agent tries (and values at ``snapshots``); with
     ``keep``, saves the final checkpoint there (the learned models, for a planner to reuse);
     ``observer(simulation)``, if given, returns a callable run on the root context after every
@@ -146,8 +146,8 @@ def RunHypercube(output: pathlib.Path, runs: int, gammas=(0.5, 0.9, 0.99)) -> li
                 agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=[0.25, 0.75],
                                        explorer=ExplorerConfig(gamma=gamma, seed=run))
                 data = Explore(ExplorationScenario([agent]),
-                                stop=lambda records: records[0].explorer.tries.min() >= 5,
-                                snapshots=(50, 320))
+                               stop=lambda records: records[0].explorer.tries.min() >= 5,
+                               snapshots=(50, 320))
                 SaveJson(path, dict(gamma=gamma, run=run, **data))
             results.append(json.loads(path.read_text()))
     return results
@@ -163,7 +163,7 @@ def RunCoverage(output: pathlib.Path, transitions: int, runs: int) -> list[dict]
                                        levels=[0.25, 0.5, 0.75], nearest=16,
                                        explorer=ExplorerConfig(strategy=strategy, seed=run))
                 data = Explore(ExplorationScenario([agent]),
-                                stop=lambda records: records[0].actions_done >= transitions)
+                               stop=lambda records: records[0].actions_done >= transitions)
                 SaveJson(path, dict(strategy=strategy, run=run, **data))
             results.append(json.loads(path.read_text()))
     return results
@@ -182,9 +182,9 @@ def RunInitializations(output: pathlib.Path, runs: int,
                         explorer=ExplorerConfig(initialization=initialization, gamma=gamma,
                                                 seed=run))
                     data = Explore(ExplorationScenario([agent]),
-                                    stop=lambda records: records[0].explorer.tries.min() >= 5)
+                                   stop=lambda records: records[0].explorer.tries.min() >= 5)
                     SaveJson(path, dict(initialization=initialization, gamma=gamma, run=run,
-                                     **data))
+                                        **data))
                 results.append(json.loads(path.read_text()))
     return results
 
@@ -204,7 +204,7 @@ def RunRank4(output: pathlib.Path, transitions: int | None) -> list[dict]:
             agent = ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=levels,
                                    explorer=ExplorerConfig(seed=0))
             data = Explore(ExplorationScenario([agent]), chunk=5.0,
-                            stop=lambda records, budget=budget: records[0].actions_done >= budget)
+                           stop=lambda records, budget=budget: records[0].actions_done >= budget)
             SaveJson(path, dict(lattice=name, levels=levels, **data))
         results.append(json.loads(path.read_text()))
     return results
@@ -220,7 +220,7 @@ def RunThreeAgents(output: pathlib.Path, transitions: int) -> dict:
                   ExploringAgent(name="torso", joints=TORSO, levels=[0.25, 0.5, 0.75], nearest=8,
                                  explorer=ExplorerConfig(seed=3))]
         data = Explore(ExplorationScenario(agents, [TABLE]), chunk=5.0, observer=_TableContacts,
-                        stop=lambda records: sum(r.actions_done for r in records) >= transitions)
+                       stop=lambda records: sum(r.actions_done for r in records) >= transitions)
         SaveJson(path, data)
     return json.loads(path.read_text())
 
@@ -349,7 +349,7 @@ def RunDynamicPlanning(output: pathlib.Path, transitions: int, repeats: int) -> 
             scenario = ExplorationScenario([agent], [box] if trained == "moving_box" else [])
             scenario.world_events = events if trained == "moving_box" else []
             Explore(scenario, chunk=5.0, keep=models[trained],
-                     stop=lambda records: records[0].actions_done >= transitions)
+                    stop=lambda records: records[0].actions_done >= transitions)
     learned = {trained: LoadAgentModel(str(model), "right_arm", ExplorerConfig())
                for trained, model in models.items()}
     space = learned["moving_box"].space
@@ -363,8 +363,8 @@ def RunDynamicPlanning(output: pathlib.Path, transitions: int, repeats: int) -> 
         if not path.exists():
             plans = [GreedyPlan(explorer, start, goal) for start, goal in problems]
             SaveJson(path, dict(reliability=_Reliability(explorer).tolist(), plans=plans,
-                             **(_Plan(models[trained], problems, repeats, seed=1)
-                                if problems else dict(episodes=[]))))
+                                **(_Plan(models[trained], problems, repeats, seed=1)
+                                   if problems else dict(episodes=[]))))
         results[trained] = json.loads(path.read_text())
     return results
 

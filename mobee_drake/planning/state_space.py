@@ -45,6 +45,14 @@ class StateActionSpace:
         """The state (nearest centre) of a configuration given in fractions of range."""
         return int(self._tree.query(fractions)[1])
 
+    def StateOfConfiguration(self, q: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> int:
+        """The state of joint positions ``q`` (rad) of joints with limits ``lower``, ``upper``."""
+        return self.StateOf((q - lower) / (upper - lower))
+
+    def Centre(self, state: int, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+        """A state's centre as joint positions (rad) of joints with limits ``lower``, ``upper``."""
+        return lower + self.centres[state] * (upper - lower)
+
     @property
     def _tree(self) -> cKDTree:
         tree = self.__dict__.get("_kdtree")

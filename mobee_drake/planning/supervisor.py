@@ -117,17 +117,13 @@ class ExplorationSupervisor(LeafSystem):
                                      prerequisites_of_calc={self.abstract_state_ticket(
                                          self._records)})
 
-    # The robot's configuration of an agent's joints, in fractions of their ranges.
-    def _Fractions(self, q: np.ndarray, columns: np.ndarray) -> np.ndarray:
-        return (q[columns] - self._lower[columns]) / (self._upper[columns] - self._lower[columns])
-
-    def _Goal(self, agent: Agent, columns: np.ndarray, state_action: int) -> np.ndarray:
-        centre = agent.space.centres[agent.space.action_goal[state_action]]
-        return self._lower[columns] + centre * (self._upper[columns] - self._lower[columns])
+    def _StateOf(self, agent: Agent, columns: np.ndarray, q: np.ndarray) -> int:
+        return agent.space.StateOfConfiguration(q[columns], self._lower[columns],
+                                                self._upper[columns])
 
     def _Begin(self, agent: Agent, columns, explorer: Explorer, q: np.ndarray, time: float,
                actions_done: int) -> AgentRecord:
-        state = agent.space.StateOf(self._Fractions(q, columns))
+        state = self._StateOf(agent, columns, q)
         return AgentRecord(explorer=explorer, state=state,
                            state_action=explorer.ChooseAction(state), started=time,
                            slow_since=np.inf, actions_done=actions_done)
@@ -159,7 +155,7 @@ class ExplorationSupervisor(LeafSystem):
                        and now - slow_since >= timing.settle_time)
             if settled or elapsed >= timing.timeout:
                 explorer = record.explorer.Copy()
-                outcome = agent.space.StateOf(self._Fractions(q, columns))
+                outcome = self._StateOf(agent, columns, q)
                 explorer.Observe(record.state_action, outcome)
                 if (explorer.config.strategy == "planner"
                         and outcome == explorer.config.goal_state):
@@ -180,7 +176,8 @@ class ExplorationSupervisor(LeafSystem):
         for agent, columns, record in zip(self._agents, self._columns,
                                           context.get_abstract_state(int(self._records))
                                           .get_value()):
-            q_star[columns] = self._Goal(agent, columns, record.state_action)
+            q_star[columns] = agent.space.Centre(agent.space.action_goal[record.state_action],
+                                                 self._lower[columns], self._upper[columns])
         output.SetFromVector(q_star)
 
     def Records(self, context) -> tuple[AgentRecord, ...]:
@@ -211,7 +208,7 @@ class ExplorationSupervisor(LeafSystem):
                              f"(0..{config.space.num_states - 1})")
         explorer.config = dc.replace(explorer.config, goal_state=goal)
         q = self._state_port.Eval(context)[:self._n]
-        state = config.space.StateOf(self._Fractions(q, columns))
+        state = self._StateOf(config, columns, q)
         if state == goal:
             records[i] = dc.replace(records[i], explorer=explorer, state=state, arrived=True)
         else:

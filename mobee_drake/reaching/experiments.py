@@ -38,7 +38,12 @@ from mobee_drake.planning.experiments import (
     SaveJson,
 )
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
-from mobee_drake.reaching.learner import STRATEGIES, ReachLearner, ReachLearningConfig
+from mobee_drake.reaching.learner import (
+    LOG_COLUMNS,
+    STRATEGIES,
+    ReachLearner,
+    ReachLearningConfig,
+)
 from mobee_drake.reaching.predictors import PREDICTORS, PredictorConfig
 from mobee_drake.reaching.robot import SimulatedRobot
 from mobee_drake.reaching.targets import LoadTargetGrid
@@ -265,12 +270,12 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
     # Fig. 8.7: exploratory tries per problem (row) and state-action (column), mean over seeds.
     figure, axes = plt.subplots(len(stages), len(strategies),
                                 figsize=(5 * len(strategies), 1.4 * len(stages)), squeeze=False)
-    num_problems = 27
+    num_problems = len(results[0]["evaluations"][str(stages[0])][0])
     for column, strategy in enumerate(strategies):
         for row, stage in enumerate(stages):
             image = np.zeros((num_problems, k + m))
             for r in by_strategy[strategy]:
-                log = np.array(r["log"]).reshape(-1, 10)
+                log = np.array(r["log"]).reshape(-1, len(LOG_COLUMNS))
                 log = log[log[:, 0] < stage]
                 np.add.at(image, (log[:, 1].astype(int), log[:, 2].astype(int)), 1.0)
             axes[row, column].imshow(image / len(by_strategy[strategy]), aspect="auto",
@@ -295,7 +300,7 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
     for axis, strategy in zip(axes[:, 0], strategies):
         counts, actions, failed, timeouts, tries = [], 0, 0, 0, 0
         for r in by_strategy[strategy]:
-            log = np.array(r["log"]).reshape(-1, 10)
+            log = np.array(r["log"]).reshape(-1, len(LOG_COLUMNS))
             negative = log[log[:, 6] < 0]
             counts.append(np.bincount(negative[:, 2].astype(int), minlength=k)[:k])
             actions += len(log)

@@ -59,14 +59,14 @@ class SimulatedRobot:
     # The configuration of a state's centre, and the state of the robot's configuration.
     def _Centre(self, state: int) -> np.ndarray:
         q = self._home.copy()
-        span = self._upper[self._columns] - self._lower[self._columns]
-        q[self._columns] = self._lower[self._columns] + self.space.centres[state] * span
+        q[self._columns] = self.space.Centre(state, self._lower[self._columns],
+                                             self._upper[self._columns])
         return q
 
     def State(self) -> int:
         q = self.simulation.robot_state.Eval(self.context)[:len(self._home)]
-        span = self._upper[self._columns] - self._lower[self._columns]
-        return self.space.StateOf((q[self._columns] - self._lower[self._columns]) / span)
+        return self.space.StateOfConfiguration(q[self._columns], self._lower[self._columns],
+                                               self._upper[self._columns])
 
     def SetProblem(self, target: np.ndarray) -> None:
         self.target = np.asarray(target, dtype=float)
