@@ -7,8 +7,10 @@ import unittest
 from unittest import mock
 
 import numpy as np
+from pydrake.common.value import AbstractValue
 from pydrake.systems.analysis import Simulator
 
+from mobee_drake.mobee.fields import FieldPairs
 from mobee_drake.planning.supervisor import ActionTiming
 from mobee_drake.reaching.executor import Phase, ReachForcing, StateActionExecutor
 
@@ -25,7 +27,16 @@ class TestStateActionExecutor(unittest.TestCase):
         self.context = self.simulator.get_mutable_context()
         self.markers = np.array([9.0, 9.0, 9.0, 0.1, 0.2, 0.3])
         self.dut.GetInputPort("marker_positions").FixValue(self.context, self.markers)
+        self.Pairs([])
         self.Velocity([0.0, 0.0])
+
+    def Pairs(self, b_is_robot):
+        """Fixes MoBeE's field pairs: one per entry, against the robot (True) or not."""
+        k = len(b_is_robot)
+        pairs = FieldPairs([None] * k, [None] * k, np.zeros(k), np.full(k, 0.05),
+                           np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)),
+                           np.array(b_is_robot, dtype=bool))
+        self.dut.GetInputPort("field_pairs").FixValue(self.context, AbstractValue.Make(pairs))
 
     def Velocity(self, v):
         self.dut.GetInputPort("robot_state").FixValue(self.context, np.concatenate([[0, 0], v]))
@@ -81,6 +92,23 @@ class TestStateActionExecutor(unittest.TestCase):
         self.assertFalse(self.dut.Done(self.context))
         self.simulator.AdvanceTo(2.05)
         self.assertTrue(self.dut.Done(self.context))
+
+    def test_felt_object_latches_for_one_action(self):
+        self.dut.StartTransition(self.context, np.array([0.5, -0.5]))
+        self.Velocity([0.0, 0.2])
+        self.Pairs([True, True])  # a self-collision: the robot's own body
+        self.simulator.AdvanceTo(0.55)
+        self.assertFalse(self.dut.FeltObject(self.context))
+        self.Pairs([True, False])  # and an object, felt at the poll at 0.6 s ...
+        self.simulator.AdvanceTo(0.65)
+        self.assertTrue(self.dut.FeltObject(self.context))
+        self.Pairs([])  # ... is remembered until the action ends
+        self.Velocity([0.0, 0.0])
+        self.simulator.AdvanceTo(2.0)
+        self.assertTrue(self.dut.Done(self.context))
+        self.assertTrue(self.dut.FeltObject(self.context))
+        self.dut.StartTransition(self.context, np.array([0.1, 0.1]))  # a new action forgets it
+        self.assertFalse(self.dut.FeltObject(self.context))
 
     def test_bad_commands(self):
         with self.assertRaisesRegex(ValueError, "q\\* must have 2 entries"):
@@ -149,6 +177,48 @@ class TestBattery(unittest.TestCase):
         state = robot.State()
         robot.Transition(int(self.model.space.action_goal[self.model.space.Actions(state)[0]]))
         self.assertTrue(meshcat.HasPath("/drake/illustration"))
+
+    def test_fields_feel_the_target_in_the_way(self):
+        from mobee_drake.reaching.experiments import RIGHT_ARM, ReachScenario
+        from mobee_drake.reaching.robot import SimulatedRobot
+
+        space = self.model.space
+        robot = SimulatedRobot(ReachScenario(), RIGHT_ARM, space, 0.05)
+        start = robot.State()
+        goal = int(space.action_goal[space.Actions(start)[0]])
+        robot.SetProblem(np.array([1.0, 1.0, 1.0]))  # far away
+        self.assertEqual(robot.Transition(goal), goal)
+        self.assertFalse(robot.FeltObject())
+        mobee = robot.simulation.mobee
+        palm = mobee.GetOutputPort("marker_positions").Eval(
+            mobee.GetMyContextFromRoot(robot.context)).reshape(-1, 3)[
+                mobee.marker_index("r_palm")]
+        self.assertEqual(robot.Transition(start), start)
+        robot.SetProblem(palm)  # where the palm was at the goal: in the way
+        robot.Transition(goal)
+        self.assertTrue(robot.FeltObject())
+
+    def test_mdp_learned_with_the_reaches(self):
+        from mobee_drake.planning.explorers import Explorer
+        from mobee_drake.planning.state_space import Lattice
+        from mobee_drake.reaching.experiments import LEVELS, RIGHT_ARM
+
+        np.testing.assert_array_equal(Lattice(LEVELS, len(RIGHT_ARM)).action_goal,
+                                      self.model.space.action_goal)
+        result = self.Run("simultaneous", self.Settings("random", 0, 8, [8], 1, 4,
+                                                        mdp="simultaneous"))
+        log = np.array(result["log"])
+        counts = np.load(self.output / "simultaneous" / "mdp.npz")["counts"]
+        initial = Explorer(self.model.space).transitions.counts
+        # The model learned from transitions only, each recording 0 (model updates) or -10 (the
+        # fields felt the target in the way); at most one outcome count per logged transition.
+        transitions = log[log[:, 2] < 432]
+        self.assertTrue(np.all(np.isin(transitions[:, 6], [0.0, -10.0])))
+        updated = np.flatnonzero(np.any(counts != initial, axis=1))
+        self.assertTrue(set(updated) <= set(transitions[transitions[:, 6] == 0, 2].astype(int)))
+        self.assertGreater(len(updated), 0)
+        # An observation adds 1, or 2 when it opens a new outcome's bin (Alg. 6).
+        self.assertLessEqual(counts.sum() - initial.sum(), 2 * len(transitions))
 
     def test_mdp_tried_everything(self):
         self.assertEqual(self.model.space.num_state_actions, 432)

@@ -59,12 +59,14 @@ if __name__ == "__main__":
 
 
 class FakeRobot:
-    """A robot on a 2 x 2 lattice: transitions reach their goal unless the edge is blocked, and
-    a reach from state s puts the palm at ``palms[s]``."""
+    """A robot on a 2 x 2 lattice: transitions reach their goal unless the edge is blocked (by
+    the robot's own body, or by an ``obstacles`` edge, where the fields feel the target), and a
+    reach from state s puts the palm at ``palms[s]``."""
 
-    def __init__(self, space, palms, blocked=(), state=0):
+    def __init__(self, space, palms, blocked=(), state=0, obstacles=()):
         self.space, self.palms, self.blocked, self.state = space, palms, set(blocked), state
-        self.reaches = 0
+        self.obstacles = set(obstacles)
+        self.reaches, self.felt = 0, False
 
     def SetProblem(self, target):
         self.target = target
@@ -73,16 +75,22 @@ class FakeRobot:
         return self.state
 
     def Transition(self, goal):
-        if (self.state, goal) not in self.blocked:
+        edge = (self.state, goal)
+        self.felt = edge in self.obstacles
+        if edge not in self.blocked | self.obstacles:
             self.state = goal
         return self.state
 
     def Reach(self, target):
-        self.reaches += 1
+        self.reaches, self.felt = self.reaches + 1, False
         return self.palms[self.state]
 
+    def FeltObject(self):
+        return self.felt
 
-def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10, predictor="weighted"):
+
+def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10, predictor="weighted",
+             learn_mdp=False):
     from mobee_drake.planning.state_space import Lattice
     from mobee_drake.reaching.learner import ReachLearner, ReachLearningConfig
     from mobee_drake.reaching.predictors import PredictorConfig
@@ -94,7 +102,7 @@ def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10, predictor=
         if targets is None else targets
     return space, ReachLearner(space, T, targets, ReachLearningConfig(
         strategy=strategy, seed=seed, max_actions=max_actions,
-        predictor=PredictorConfig(predictor)))
+        predictor=PredictorConfig(predictor), learn_mdp=learn_mdp))
 
 
 PALMS = np.array([[0.3, 0, 0], [0.2, 0, 0], [0.1, 0, 0], [0.0, 0, 0]], dtype=float)
@@ -189,26 +197,68 @@ class TestReachLearner(unittest.TestCase):
             np.testing.assert_array_equal(learner.histories.History(sa)[2], rewards)
 
     def test_exact_resume(self):
-        for strategy, predictor in [("random", "weighted"), ("greedy", "weighted"),
-                                    ("intrinsic", "weighted"),
-                                    ("intrinsic", "gaussian_process")]:
-            space, whole = _Learner(strategy, seed=3, predictor=predictor)
-            robot = FakeRobot(space, PALMS, blocked={(0, 2), (3, 1)})
+        for strategy, predictor, learn_mdp in [
+                ("random", "weighted", False), ("greedy", "weighted", False),
+                ("intrinsic", "weighted", False), ("intrinsic", "gaussian_process", False),
+                ("random", "weighted", True), ("intrinsic", "weighted", True)]:
+            space, whole = _Learner(strategy, seed=3, predictor=predictor, learn_mdp=learn_mdp)
+
+            def Robot(space=space):
+                return FakeRobot(space, PALMS, blocked={(0, 2), (3, 1)}, obstacles={(1, 3)})
+
+            robot = Robot()
             for _ in range(12):
                 whole.Explore(robot)
-            _, first = _Learner(strategy, seed=3, predictor=predictor)
-            robot = FakeRobot(space, PALMS, blocked={(0, 2), (3, 1)})
+            _, first = _Learner(strategy, seed=3, predictor=predictor, learn_mdp=learn_mdp)
+            robot = Robot()
             for _ in range(6):
                 first.Explore(robot)
             arrays, data = first.ToArrays()
-            _, resumed = _Learner(strategy, seed=3, predictor=predictor)
+            _, resumed = _Learner(strategy, seed=3, predictor=predictor, learn_mdp=learn_mdp)
             resumed.LoadArrays(arrays, data)
             for _ in range(6):
                 resumed.Explore(robot)
             self.assertEqual(resumed.log, whole.log)
+            np.testing.assert_array_equal(resumed.model.counts, whole.model.counts)
             with self.assertRaisesRegex(ValueError, "configuration"):
                 _Learner("random" if strategy != "random" else "greedy", seed=3)[1].LoadArrays(
                     arrays, data)
+
+    def test_learned_mdp_tells_model_updates_from_penalties(self):
+        # Ch. 9.4.1: from state 0, the edge to 1 is blocked by the robot's own body (a model
+        # update, no penalty), the edge to 2 by the target (felt: -10, the model untouched).
+        space, learner = _Learner(targets=np.zeros((1, 3)), learn_mdp=True)
+        target = learner.targets[0]
+        for s in range(3):  # Bad reaches from states 0-2; state 3 untried (optimistic).
+            for _ in range(5):
+                learner.histories.Record(learner.Reach(s), target, 1.0, 0.1)
+        robot = FakeRobot(space, PALMS, blocked={(0, 1)}, obstacles={(0, 2)})
+        initial = learner.model.counts.copy()
+        for _ in range(4):
+            learner.Explore(robot)
+        edge = {g: int(np.flatnonzero((space.action_state == 0) & (space.action_goal == g))[0])
+                for g in (1, 2)}
+        tried = [row[2] for row in learner.log]
+        n1, n2 = tried.count(edge[1]), tried.count(edge[2])
+        self.assertGreaterEqual(min(n1, n2), 1)
+        # Self-blocked: rewards 0; the counts learned "stays in 0" n1 times (a new bin starts at
+        # 1, Alg. 6), so T(0 -> 1) fell from 1 to 1 / (2 + n1).
+        self.assertEqual(learner.histories.History(edge[1])[2].tolist(), [0.0] * n1)
+        expected = initial[edge[1]].copy()
+        expected[0] = 1 + n1
+        np.testing.assert_array_equal(learner.model.counts[edge[1]], expected)
+        # Rewarding that edge alone: V(0) = 1 + gamma (p_stay V(0) + p_go V(1)), V(1) = gamma V(0).
+        _, v = learner.Values(np.eye(learner.num_state_actions)[edge[1]])
+        gamma, p_go = learner.config.gamma, 1 / (2 + n1)
+        self.assertAlmostEqual(v[0], 1 / (1 - gamma * (1 - p_go) - gamma ** 2 * p_go), delta=0.01)
+        # Blocked by the target: penalised, model unchanged; nothing else was learned.
+        self.assertEqual(learner.histories.History(edge[2])[2].tolist(), [-10.0] * n2)
+        changed = np.flatnonzero(np.any(learner.model.counts != initial, axis=1))
+        self.assertEqual(changed.tolist(), [edge[1]])
+        # Evaluations do not teach the model.
+        counts = learner.model.counts.copy()
+        learner.Evaluate(FakeRobot(space, PALMS, blocked={(0, 1), (2, 3)}), seed=1)
+        np.testing.assert_array_equal(learner.model.counts, counts)
 
     def test_bad_configuration(self):
         with self.assertRaisesRegex(ValueError, "unknown reach-learning strategy 'curious'"):

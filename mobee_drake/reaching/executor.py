@@ -14,6 +14,11 @@ The force on the marker points at the target with a magnitude that fades within
 How far the marker gets is decided by MoBeE: the squashed force against the attractor spring,
 the joint limits, the constraints and the obstacles.
 
+The executor also notes whether MoBeE's fields felt a workspace object (a field pair whose other
+geometry is not the robot's) at any poll of the action in flight: the learner of ch. 9.4.1 tells
+a problem's obstacle from its own model's error by it. Sampled at the poll period, like the
+settling; a touch shorter than a poll can be missed, a transition blocked by an object is not.
+
 Everything the executor knows is in its discrete state, so a checkpoint of the diagram's
 discrete states (:mod:`mobee_drake.simulation.checkpoint`) holds the action in flight too.
 """
@@ -22,8 +27,10 @@ import dataclasses as dc
 import enum
 
 import numpy as np
+from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
 
+from mobee_drake.mobee.fields import NO_FIELD_PAIRS, FieldPairs
 from mobee_drake.planning.supervisor import ActionTiming
 
 
@@ -55,25 +62,29 @@ class StateActionExecutor(LeafSystem):
         input_ports:
         - robot_state
         - marker_positions
+        - field_pairs
         output_ports:
         - attractor
         - marker_forces
 
     ``robot_state`` is (q, v) of MoBeE's n joints, ``marker_positions`` MoBeE's output of the same
-    name (3m); ``attractor`` is q* (n), ``marker_forces`` the force on every marker (3m, zero but
-    on the reaching marker while it is forced).
+    name (3m), ``field_pairs`` MoBeE's :class:`FieldPairs`; ``attractor`` is q* (n),
+    ``marker_forces`` the force on every marker (3m, zero but on the reaching marker while it is
+    forced).
 
     A client starts an action with :meth:`StartTransition` or :meth:`StartReach` and polls
-    :meth:`Done`; :meth:`ReachedPosition` is the marker's position at the end of the forcing.
+    :meth:`Done`; :meth:`ReachedPosition` is the marker's position at the end of the forcing,
+    :meth:`FeltObject` whether the fields felt a workspace object during the action.
     """
 
     # The discrete state: phase, the number of actions finished, the phase's start time, since
     # when the robot has been slow (inf: not slow), the target x*, the marker's position when the
-    # forcing stopped, q*.
+    # forcing stopped, whether the fields felt an object, q*.
     _PHASE, _FINISHED, _STARTED, _SLOW_SINCE = range(4)
     _TARGET = slice(4, 7)
     _REACHED = slice(7, 10)
-    _Q_STAR = 10
+    _FELT_OBJECT = 10
+    _Q_STAR = 11
 
     def __init__(self, *, num_joints: int, marker_index: int, num_markers: int,
                  initial_attractor: np.ndarray, forcing: ReachForcing | None = None,
@@ -90,6 +101,8 @@ class StateActionExecutor(LeafSystem):
         initial[self._Q_STAR:] = initial_attractor
         self._state_port = self.DeclareVectorInputPort("robot_state", 2 * num_joints)
         self._markers_port = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
+        self._pairs_port = self.DeclareAbstractInputPort("field_pairs",
+                                                         AbstractValue.Make(NO_FIELD_PAIRS))
         self._state = self.DeclareDiscreteState(BasicVector(initial))
         self.DeclarePeriodicDiscreteUpdateEvent(period_sec=period, offset_sec=period,
                                                 update=self._Poll)
@@ -124,6 +137,9 @@ class StateActionExecutor(LeafSystem):
             return
         now, timing = context.get_time(), self._timing
         v = self._state_port.Eval(context)[self._n:]
+        pairs: FieldPairs = self._pairs_port.Eval(context)
+        if not np.all(pairs.b_is_robot):
+            x[self._FELT_OBJECT] = 1.0
         slow = np.max(np.abs(v), initial=0.0) < timing.settle_speed
         x[self._SLOW_SINCE] = min(x[self._SLOW_SINCE], now) if slow else np.inf
         elapsed = now - x[self._STARTED]
@@ -147,6 +163,7 @@ class StateActionExecutor(LeafSystem):
         if x[self._PHASE] != Phase.IDLE:
             raise ValueError(f"an action is in flight (phase {Phase(int(x[self._PHASE])).name})")
         x[self._PHASE], x[self._STARTED], x[self._SLOW_SINCE] = phase, context.get_time(), np.inf
+        x[self._FELT_OBJECT] = 0.0
         x[self._Q_STAR:] = q_star
         if target is not None:
             x[self._TARGET] = target
@@ -176,3 +193,7 @@ class StateActionExecutor(LeafSystem):
     def ReachedPosition(self, context) -> np.ndarray:
         """Where the marker was when the last reach's forcing stopped (world, m)."""
         return self._Vector(context)[self._REACHED].copy()
+
+    def FeltObject(self, context) -> bool:
+        """Whether MoBeE's fields felt a workspace object during the last (or current) action."""
+        return bool(self._Vector(context)[self._FELT_OBJECT])

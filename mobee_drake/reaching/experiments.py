@@ -15,6 +15,11 @@
    state-actions chosen in evaluations), 8.7 (exploratory tries per problem and state-action) and
    8.8 (failed transitions per state-action), and ``report.md`` beside the source's claims.
 
+Beyond the source (ch. 9.4.1), ``--mdp simultaneous``: no MDP is learned first; every run starts
+from the optimistic initialisation of ch. 6 and learns the MDP with the reaches, telling a model
+update from a penalty by whether MoBeE's fields felt the target (see
+:mod:`mobee_drake.reaching.learner`); each run keeps its final counts in ``mdp.npz``.
+
 Run: ``mobee-drake experiment ch8 --output results/ch8`` (the whole battery), or a reduced one:
 ``mobee-drake experiment ch8 --problem-tries 400 --seeds 2``; watch one run in Meshcat:
 ``mobee-drake experiment ch8 --watch --strategies intrinsic``.
@@ -37,7 +42,8 @@ from mobee_drake.planning.experiments import (
     Explore,
     SaveJson,
 )
-from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
+from mobee_drake.planning.explorers import Explorer, ExplorerConfig, LoadAgentModel
+from mobee_drake.planning.state_space import Lattice
 from mobee_drake.reaching.learner import (
     LOG_COLUMNS,
     STRATEGIES,
@@ -52,6 +58,8 @@ from mobee_drake.simulation.checkpoint import WriteFolderAtomically
 from mobee_drake.simulation.scenario import ExploringAgent, Scenario, StateActionAttractor
 
 SOURCE_STAGES = (100, 200, 400, 800, 1600, 3200, 6400)
+# Where the MDP comes from: learned first and fixed (ch. 8), or with the reaches (ch. 9.4.1).
+MDPS = ("learned_first", "simultaneous")
 LEVELS = [0.25, 0.5, 0.75]
 AGENT = "right_arm"
 # Robot hours of the source's five runs per strategy (ch. 8.4).
@@ -82,6 +90,8 @@ class RunSettings:
     checkpoint_every: int
     # "weighted" (eq. 8.1-8.7) or "gaussian_process".
     predictor: str = "weighted"
+    # One of MDPS.
+    mdp: str = "learned_first"
 
 
 def ReachScenario() -> Scenario:
@@ -115,11 +125,15 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
     if result_path.is_file():
         return json.loads(result_path.read_text())
     run_dir.mkdir(parents=True, exist_ok=True)
-    model = LoadAgentModel(str(mdp_dir), AGENT, ExplorerConfig())
+    simultaneous = settings.mdp == "simultaneous"
+    # The optimistic initial model of the MDP's lattice, or the model learned first.
+    model = (Explorer(Lattice(LEVELS, len(RIGHT_ARM))) if simultaneous
+             else LoadAgentModel(str(mdp_dir), AGENT, ExplorerConfig()))
     grid = LoadTargetGrid()
-    learner = ReachLearner(model.space, model.transitions.Probabilities(), grid.Centres(),
+    learner = ReachLearner(model.space, model.transitions.counts, grid.Centres(),
                            ReachLearningConfig(strategy=settings.strategy, seed=settings.seed,
-                                               predictor=PredictorConfig(settings.predictor)))
+                                               predictor=PredictorConfig(settings.predictor),
+                                               learn_mdp=simultaneous))
     robot = SimulatedRobot(ReachScenario(), RIGHT_ARM, model.space, grid.radius,
                            meshcat=meshcat)
     checkpoint = run_dir / "checkpoint"
@@ -154,27 +168,37 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
             Save()
     Save()
     arrays, _ = learner.ToArrays()
+    extra = {}
+    if simultaneous:
+        counts = learner.model.counts
+        np.savez(run_dir / "mdp.npz", counts=counts)
+        # The state-actions the model learned about, and their learned chance of success.
+        updated = np.flatnonzero(np.any(counts != model.transitions.counts, axis=1))
+        success = counts[updated, model.space.action_goal[updated]] / counts[updated].sum(axis=1)
+        extra = dict(mdp=dict(updated_state_actions=len(updated),
+                              success_probability=float(success.mean()) if len(updated) else None))
     result = dict(settings=dc.asdict(settings), evaluations=data["evaluations"],
                   log=arrays["log"].tolist(), simulated_seconds=robot.simulated_seconds,
                   wall_seconds=data["wall_seconds"],
                   penetrating_steps=robot.PenetratingSteps(),
                   num_transitions=learner.num_transitions,
-                  num_states=learner.space.num_states)
+                  num_states=learner.space.num_states, **extra)
     SaveJson(result_path, result)
     return result
 
 
-def RunBattery(output: pathlib.Path, strategies, seeds: int, problem_tries: int, stages,
-               evaluations: int, mdp_tries: int, workers: int, checkpoint_every: int = 50,
-               predictor: str = "weighted") -> list[dict]:
-    """The MDP, then every (strategy, seed) run in ``workers`` processes, with progress bars."""
+def RunBattery(output: pathlib.Path, strategies, seeds: int, settings: RunSettings,
+               mdp_tries: int, workers: int) -> list[dict]:
+    """The MDP (unless learned with the reaches), then a run of ``settings`` for every strategy
+    and seed in ``workers`` processes, with progress bars."""
     from tqdm import tqdm
 
     mdp_dir = output / f"mdp_tries{mdp_tries}"
-    TrainMdp(mdp_dir, mdp_tries)
-    runs = {f"{strategy}_seed{seed}": RunSettings(strategy, seed, problem_tries, list(stages),
-                                                 evaluations, checkpoint_every, predictor)
+    if settings.mdp == "learned_first":
+        TrainMdp(mdp_dir, mdp_tries)
+    runs = {f"{strategy}_seed{seed}": dc.replace(settings, strategy=strategy, seed=seed)
             for strategy in strategies for seed in range(seeds)}
+    problem_tries = settings.problem_tries
     context = multiprocessing.get_context("spawn")
     with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context) as pool:
         futures = {name: pool.submit(RunOne, output / "runs" / name, mdp_dir, settings)
@@ -320,6 +344,20 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
     figure.tight_layout()
     figure.savefig(output / "8.8_failed_transitions.png", dpi=80)
 
+    if all("mdp" in r for r in results):
+        lines += ["", "## The MDP learned with the reaches (ch. 9.4.1)", "",
+                  f"State-actions (of {k}) whose model was updated (tried without the fields "
+                  "feeling the target), and their learned probability of reaching their goal "
+                  "state (the optimistic initialisation says 0.5), mean over seeds.", "",
+                  "| strategy | state-actions updated | P(goal) |", "|---|---:|---:|"]
+        for strategy in strategies:
+            runs = [r["mdp"] for r in by_strategy[strategy]]
+            success = [r["success_probability"] for r in runs
+                       if r["success_probability"] is not None]
+            lines.append(f"| {strategy} | "
+                         f"{np.mean([r['updated_state_actions'] for r in runs]):.0f} | "
+                         + (f"{np.mean(success):.2f} |" if success else "- |"))
+
     lines += ["", "## The source's claims (ch. 8.4)", "",
               "Differences of the mean cumulative reward, with Welch's t-test over the "
               "evaluations (a claim about an order holds only with p < 0.05).", ""]
@@ -369,6 +407,9 @@ def main(argv=None) -> None:
     parser.add_argument("--predictor", choices=PREDICTORS, default="weighted",
                         help="the reward predictor: the source's weighted averages (eq. 8.1-8.7) "
                              "or a Gaussian process (use another --output)")
+    parser.add_argument("--mdp", choices=MDPS, default="learned_first",
+                        help="learn the MDP first and keep it (ch. 8), or learn it with the "
+                             "reaches (ch. 9.4.1; use another --output)")
     argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(argv)
     stages = args.stages or [s for s in SOURCE_STAGES if s <= args.problem_tries]
@@ -376,18 +417,18 @@ def main(argv=None) -> None:
         parser.error(f"--stages must lie in 0..{args.problem_tries}")
     output = pathlib.Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
+    settings = RunSettings(args.strategies[0], 0, args.problem_tries, stages, args.evaluations,
+                           args.checkpoint_every, args.predictor, args.mdp)
     if args.watch:
         from pydrake.geometry import StartMeshcat
 
         mdp_dir = output / f"mdp_tries{args.mdp_tries}"
-        TrainMdp(mdp_dir, args.mdp_tries)
-        settings = RunSettings(args.strategies[0], 0, args.problem_tries, stages,
-                               args.evaluations, args.checkpoint_every, args.predictor)
+        if settings.mdp == "learned_first":
+            TrainMdp(mdp_dir, args.mdp_tries)
         RunOne(output / "runs" / f"watch_{settings.strategy}", mdp_dir, settings, StartMeshcat())
         return
-    results = RunBattery(output, args.strategies, args.seeds, args.problem_tries, stages,
-                         args.evaluations, args.mdp_tries, args.workers, args.checkpoint_every,
-                         args.predictor)
+    results = RunBattery(output, args.strategies, args.seeds, settings, args.mdp_tries,
+                         args.workers)
     report = output / "report.md"
     report.write_text(f"# Reach learning (ch. 8.4)\n\n`mobee-drake experiment ch8 "
                       f"{' '.join(argv)}`\n\n" + Report(output, results) + "\n")

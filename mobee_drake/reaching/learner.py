@@ -3,8 +3,8 @@
 The state-action space is the learned MDP's (ch. 6-7) plus one *reaching* state-action per state,
 numbered after the transitions (reach of state s = ``num_transitions + s``; with the rank-3
 lattice of ch. 7.2, 432 + s, the source's numbering: its favourite reaches 489 and 509 start from
-states 57 and 77). The MDP's transition probabilities plan the moves and are not updated (ch.
-8.1); a reach ends the policy (its row of T is empty), so its value is its reward.
+states 57 and 77). The MDP's transition probabilities plan the moves and, as in ch. 8.1, are not
+updated; a reach ends the policy (its row of T is empty), so its value is its reward.
 
 Rewards per problem (a reach target x*) come from the state-actions' histories (eq. 8.2):
 transitions predict eq. 8.1 (0 when untried); reaches predict by strategy (ch. 8.3.2):
@@ -27,6 +27,16 @@ the learner's histories. Choice where the source is silent: during an evaluation
 own records (a failed transition's -10) are kept in a scratch copy of the histories for the rest
 of that try only, so the greedy policy does not repeat a failing transition until it times out.
 
+Beyond the source (ch. 9.4.1, ``learn_mdp``): the MDP is learned at the same time as the reaches,
+its outcome counts updated by the transitions (from the optimistic initialisation of ch. 6, or from
+a model learned before). A transition that fails to climb the value function is then ambiguous: the
+robot's own MDP may be wrong, or the problem's target may be in the way. MoBeE's fields tell them
+apart: if they felt a workspace object during the transition (self-collisions feel the robot's own
+body), it is the problem's: -10 in its history and no model update; otherwise it is a model update
+and records 0. Choice where the source is silent: a transition that felt an object but did climb
+records 0 and does not update the model either (the object disturbed it, so its outcome says
+nothing about the robot alone).
+
 The learner draws from its own seeded generator and keeps a log of every action it took, from
 which its histories are rebuilt exactly (checkpoints, :meth:`ReachLearner.FromArrays`).
 """
@@ -36,6 +46,7 @@ from typing import Protocol
 
 import numpy as np
 
+from mobee_drake.planning.curiosity import TransitionCounts
 from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.planning.value_iteration import ValueIteration
 from mobee_drake.reaching.predictors import (
@@ -60,6 +71,8 @@ class ReachLearningConfig:
     seed: int = 0
     # The source's weighted averages (eq. 8.1-8.7) or a Gaussian process (ch. 8.5).
     predictor: PredictorConfig = dc.field(default_factory=PredictorConfig)
+    # Whether the MDP is learned with the reaches (ch. 9.4.1) or fixed (ch. 8.1).
+    learn_mdp: bool = False
 
     def Validate(self) -> None:
         self.predictor.Validate()
@@ -87,6 +100,10 @@ class Robot(Protocol):
     def Reach(self, target: np.ndarray) -> np.ndarray:
         """Reaches for ``target`` from the current state; returns where the marker got to."""
 
+    def FeltObject(self) -> bool:
+        """Whether MoBeE's fields felt a workspace object (not the robot's own body) during the
+        last action; asked only when the MDP is learned with the reaches."""
+
 
 @dc.dataclass
 class TryResult:
@@ -110,24 +127,30 @@ LOG_COLUMNS = ("try", "problem", "state_action", "state", "outcome", "estimate",
 class ReachLearner:
     """Learns which pre-reach states suit which targets (ch. 8)."""
 
-    def __init__(self, space: StateActionSpace, transitions: np.ndarray, targets: np.ndarray,
-                 config: ReachLearningConfig | None = None):
+    def __init__(self, space: StateActionSpace, transition_counts: np.ndarray,
+                 targets: np.ndarray, config: ReachLearningConfig | None = None):
+        """``transition_counts`` are the MDP's outcome counts per state-action (as
+        :class:`~mobee_drake.planning.curiosity.TransitionCounts` keeps them; normalised rows give
+        T), copied: with ``learn_mdp`` the learner's own transitions add to them."""
         self.config = config = config or ReachLearningConfig()
         config.Validate()
         m, k = space.num_states, space.num_state_actions
-        if transitions.shape != (k, m):
-            raise ValueError(f"transition probabilities must be ({k}, {m}), got "
-                             f"{transitions.shape}")
+        if transition_counts.shape != (k, m):
+            raise ValueError(f"transition counts must be ({k}, {m}), got "
+                             f"{transition_counts.shape}")
         self.space, self.targets = space, np.asarray(targets, dtype=float)
         self.num_transitions = k
-        # The state of every state-action (transitions, then one reach per state) and T, whose
-        # reach rows are empty: a reach ends the policy.
+        self.model = TransitionCounts(k, m)
+        self.model.counts[...] = transition_counts
+        # The state of every state-action (transitions, then one reach per state); a reach's row
+        # of T is empty: a reach ends the policy.
         self.action_state = np.concatenate([space.action_state, np.arange(m)])
         self.reaching = np.arange(k + m) >= k
-        self._T = np.vstack([transitions, np.zeros((m, m))])
-        # Value iteration wants the state-actions sorted by state.
+        # Value iteration wants the state-actions sorted by state: T in that order, and where
+        # each state-action went.
         self._order = np.argsort(self.action_state, kind="stable")
-        self._T_sorted = self._T[self._order]
+        self._rank = np.argsort(self._order)
+        self._T_sorted = np.vstack([self.model.Probabilities(), np.zeros((m, m))])[self._order]
         self.histories = RewardHistories(self.reaching, config.predictor)
         self.problem_tries = np.zeros(len(self.targets), dtype=int)
         self.rng = np.random.default_rng(config.seed)
@@ -180,8 +203,16 @@ class ReachLearner:
     # ------------------------------------------------------------------------------------------
     # Acting.
 
+    def _Observe(self, state_action: int, outcome: int) -> None:
+        """A model update (``learn_mdp``): adds the outcome to the counts and to T."""
+        self.model.Observe(state_action, outcome)
+        row = self.model.counts[state_action]
+        self._T_sorted[self._rank[state_action]] = row / row.sum()
+
     def _Try(self, robot: Robot, problem: int, reach_rewards: str, histories: RewardHistories,
-             rng, log: list | None) -> TryResult:
+             rng, learn: bool) -> TryResult:
+        """One problem-try; ``learn`` says whether it is exploration (logged; with ``learn_mdp``
+        the model learns) or an evaluation (``histories`` a scratch copy)."""
         target = self.targets[problem]
         robot.SetProblem(target)
         random_reach = (self.Reach(int(rng.integers(self.space.num_states)))
@@ -197,11 +228,17 @@ class ReachLearner:
             else:
                 outcome = robot.Transition(int(self.space.action_goal[sa]))
                 reward = TransitionReward(v[state], v[outcome])
+                if self.config.learn_mdp:  # ch. 9.4.1: the problem's penalty or the model's
+                    felt = robot.FeltObject()
+                    if not felt:
+                        reward = 0.0
+                        if learn:
+                            self._Observe(sa, outcome)
                 failed += reward < 0
             histories.Record(sa, target, estimate, reward)
-            if log is not None:
-                log.append((int(self.problem_tries.sum()), problem, sa, state, outcome, estimate,
-                            reward, *target))
+            if learn:
+                self.log.append((int(self.problem_tries.sum()), problem, sa, state, outcome,
+                                 estimate, reward, *target))
             if self.reaching[sa]:
                 return TryResult(problem, action, reward, sa, failed)
         return TryResult(problem, self.config.max_actions, None, -1, failed)
@@ -211,7 +248,7 @@ class ReachLearner:
         least = np.flatnonzero(self.problem_tries == self.problem_tries.min())
         problem = int(self.rng.choice(least))
         result = self._Try(robot, problem, self.config.strategy, self.histories, self.rng,
-                           self.log)
+                           learn=True)
         self.problem_tries[problem] += 1
         return result
 
@@ -228,21 +265,26 @@ class ReachLearner:
             if state == start:
                 break
             robot.Transition(int(self.space.action_goal[self._Greedy(q, state, rng)]))
-        return [self._Try(robot, int(problem), "greedy", self.histories.Copy(), rng, None)
+        return [self._Try(robot, int(problem), "greedy", self.histories.Copy(), rng,
+                          learn=False)
                 for problem in rng.permutation(len(self.targets))]
 
     # ------------------------------------------------------------------------------------------
     # Saving and resuming.
 
     def ToArrays(self) -> tuple[dict[str, np.ndarray], dict]:
-        """The learner's state as arrays and JSON-able data (generator state)."""
-        return (dict(log=np.array(self.log, dtype=float).reshape(-1, len(LOG_COLUMNS)),
-                     problem_tries=self.problem_tries),
-                dict(config=dc.asdict(self.config), generator=self.rng.bit_generator.state))
+        """The learner's state as arrays (the log, tries and, with ``learn_mdp``, the MDP's
+        counts) and JSON-able data (configuration, generator state)."""
+        arrays = dict(log=np.array(self.log, dtype=float).reshape(-1, len(LOG_COLUMNS)),
+                      problem_tries=self.problem_tries)
+        if self.config.learn_mdp:
+            arrays["transition_counts"] = self.model.counts
+        return arrays, dict(config=dc.asdict(self.config),
+                            generator=self.rng.bit_generator.state)
 
     def LoadArrays(self, arrays, data: dict) -> None:
         """Restores :meth:`ToArrays`' state into this (fresh) learner: the histories are rebuilt
-        from the log, record by record."""
+        from the log, record by record; a learned MDP is restored from its counts."""
         if self.log:
             raise ValueError("load a saved state into a fresh learner only")
         saved = ReachLearningConfig(**{**data["config"], "predictor": PredictorConfig(
@@ -256,4 +298,7 @@ class ReachLearner:
             self.log.append(entry)
             self.histories.Record(entry[2], np.array(entry[7:]), entry[5], entry[6])
         self.problem_tries[...] = arrays["problem_tries"]
+        if self.config.learn_mdp:
+            self.model.counts[...] = arrays["transition_counts"]
+            self._T_sorted[self._rank[:self.num_transitions]] = self.model.Probabilities()
         self.rng.bit_generator.state = data["generator"]

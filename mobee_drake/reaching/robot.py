@@ -97,6 +97,9 @@ class SimulatedRobot:
         filters.RemoveDeclaration(touch)
         return self.executor.ReachedPosition(self._executor_context)
 
+    def FeltObject(self) -> bool:
+        return self.executor.FeltObject(self._executor_context)
+
     @property
     def simulated_seconds(self) -> float:
         return self.context.get_time()

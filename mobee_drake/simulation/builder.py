@@ -108,6 +108,7 @@ def _AttractorSource(builder: DiagramBuilder, program, seed: int, mobee: Mobee,
         builder.Connect(robot_state, executor.GetInputPort("robot_state"))
         builder.Connect(mobee.GetOutputPort("marker_positions"),
                         executor.GetInputPort("marker_positions"))
+        builder.Connect(mobee.GetOutputPort("field_pairs"), executor.GetInputPort("field_pairs"))
         return executor.GetOutputPort("attractor"), executor.GetOutputPort("marker_forces")
     if isinstance(program, ExploreAttractor):
         agents = [Agent(name=a.name, joints=a.joints,
