@@ -189,10 +189,7 @@ class TestBattery(unittest.TestCase):
         robot.SetProblem(np.array([1.0, 1.0, 1.0]))  # far away
         self.assertEqual(robot.Transition(goal), goal)
         self.assertFalse(robot.FeltObject())
-        mobee = robot.simulation.mobee
-        palm = mobee.GetOutputPort("marker_positions").Eval(
-            mobee.GetMyContextFromRoot(robot.context)).reshape(-1, 3)[
-                mobee.marker_index("r_palm")]
+        palm = robot.MarkerPosition()
         self.assertEqual(robot.Transition(start), start)
         robot.SetProblem(palm)  # where the palm was at the goal: in the way
         robot.Transition(goal)
@@ -226,6 +223,7 @@ class TestBattery(unittest.TestCase):
 
     def test_reduced_battery(self):
         from mobee_drake.reaching.learner import STRATEGIES
+        from mobee_drake.reaching.targets import LoadTargetGrid
 
         results = [self.Run(s, self.Settings(s, 0, 12, [0, 12], 1, 5)) for s in STRATEGIES]
         for result in results:
@@ -239,8 +237,14 @@ class TestBattery(unittest.TestCase):
             self.assertTrue(np.all(np.isin(transitions[:, 6], [0.0, -10.0])))
             # A reach's state is where the robot was, and it stays there.
             np.testing.assert_array_equal(reaches[:, 2] - 432, reaches[:, 3])
-            # Least-tried problems first: 12 tries on 12 different problems.
-            self.assertEqual(len(np.unique(log[log[:, 2] >= 432][:, 1])), len(reaches))
+            if result["settings"]["strategy"] == "goal_babbling":
+                # Goals of its own, in the targets' box grown by their radius.
+                grid = LoadTargetGrid().Centres()
+                self.assertTrue(np.all((log[:, 7:] >= grid.min(axis=0) - 0.05)
+                                       & (log[:, 7:] <= grid.max(axis=0) + 0.05)))
+                self.assertFalse(np.any(np.all(np.isin(log[:, 7:], grid), axis=1)))
+            else:  # Least-tried problems first: 12 tries on 12 different problems.
+                self.assertEqual(len(np.unique(log[log[:, 2] >= 432][:, 1])), len(reaches))
             for evaluation in result["evaluations"].values():
                 self.assertEqual(sorted(t["problem"] for t in evaluation[0]), list(range(27)))
         # Fresh learners evaluate alike (same start, same greedy ties from the same seed).
@@ -249,6 +253,7 @@ class TestBattery(unittest.TestCase):
 
         report = Report(self.output, results)
         self.assertIn("| intrinsic |", report)
+        self.assertIn("| goal_babbling |", report)
         for figure in ("8.2_cumulative_reward.png", "8.7_problem_tries.png",
                        "8.8_failed_transitions.png", "8.4-8.6_reaches_greedy.png"):
             self.assertTrue((self.output / figure).is_file(), figure)

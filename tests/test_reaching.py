@@ -88,9 +88,12 @@ class FakeRobot:
     def FeltObject(self):
         return self.felt
 
+    def MarkerPosition(self):
+        return self.palms[self.state]
+
 
 def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10, predictor="weighted",
-             learn_mdp=False):
+             learn_mdp=False, goals=None):
     from mobee_drake.planning.state_space import Lattice
     from mobee_drake.reaching.learner import ReachLearner, ReachLearningConfig
     from mobee_drake.reaching.predictors import PredictorConfig
@@ -102,7 +105,8 @@ def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10, predictor=
         if targets is None else targets
     return space, ReachLearner(space, T, targets, ReachLearningConfig(
         strategy=strategy, seed=seed, max_actions=max_actions,
-        predictor=PredictorConfig(predictor), learn_mdp=learn_mdp))
+        predictor=PredictorConfig(predictor), learn_mdp=learn_mdp,
+        **({} if goals is None else dict(goals=goals))))
 
 
 PALMS = np.array([[0.3, 0, 0], [0.2, 0, 0], [0.1, 0, 0], [0.0, 0, 0]], dtype=float)
@@ -200,7 +204,8 @@ class TestReachLearner(unittest.TestCase):
         for strategy, predictor, learn_mdp in [
                 ("random", "weighted", False), ("greedy", "weighted", False),
                 ("intrinsic", "weighted", False), ("intrinsic", "gaussian_process", False),
-                ("random", "weighted", True), ("intrinsic", "weighted", True)]:
+                ("random", "weighted", True), ("intrinsic", "weighted", True),
+                ("goal_babbling", "weighted", False)]:
             space, whole = _Learner(strategy, seed=3, predictor=predictor, learn_mdp=learn_mdp)
 
             def Robot(space=space):
@@ -259,6 +264,45 @@ class TestReachLearner(unittest.TestCase):
         counts = learner.model.counts.copy()
         learner.Evaluate(FakeRobot(space, PALMS, blocked={(0, 1), (2, 3)}), seed=1)
         np.testing.assert_array_equal(learner.model.counts, counts)
+
+    def test_goal_babbling(self):
+        from mobee_drake.goal_babbling.competence import Competence
+        from mobee_drake.goal_babbling.config import InterestConfig
+        from mobee_drake.reaching.goals import ReachGoalsConfig
+
+        # Small regions so the goal space splits within the test (g_max 6, zeta 4).
+        interest = InterestConfig(max_region_goals=6, window=4, min_child_goals=2)
+        space, learner = _Learner("goal_babbling", seed=2, goals=ReachGoalsConfig(interest,
+                                                                                  margin=0.1))
+        robot = FakeRobot(space, PALMS, state=1)
+        starts = []
+        for _ in range(40):
+            starts.append(robot.MarkerPosition())
+            learner.Explore(robot)
+        babbler, log = learner.babbler, np.array(learner.log)
+        goals = np.array(babbler.goals)
+        # Goals in the targets' box grown by the margin; each counted on its nearest problem.
+        low, high = learner.targets.min(axis=0) - 0.1, learner.targets.max(axis=0) + 0.1
+        self.assertTrue(np.all((goals >= low) & (goals <= high)))
+        nearest = np.argmin(np.linalg.norm(goals[:, None] - learner.targets[None], axis=2), axis=1)
+        np.testing.assert_array_equal(learner.problem_tries, np.bincount(nearest, minlength=3))
+        # Every try is planned for its goal; its competence is eq. 7 clipped (Sec. II-D-1), with
+        # x_start the palm where the try began.
+        reaches = log[log[:, 2] >= learner.num_transitions]
+        self.assertEqual(len(reaches), 40)
+        np.testing.assert_array_equal(reaches[:, 7:], goals)
+        for goal, start, reach, competence in zip(goals, starts, reaches, babbler.competences):
+            final = PALMS[int(reach[3])]
+            cost = -np.linalg.norm(goal - final) / np.linalg.norm(goal - start)
+            self.assertAlmostEqual(competence, Competence(cost, -0.05, -1.0))
+        self.assertGreater(len(babbler.tree.leaves), 1)
+        # A try without a reach gets min_C.
+        _, timid = _Learner("goal_babbling", max_actions=1)
+        for _ in range(20):
+            timid.histories.Record(timid.Reach(0), np.zeros(3), 1.0, 0.01)
+        timid.babbler.Select = lambda rng: np.zeros(3)
+        self.assertIsNone(timid.Explore(FakeRobot(space, PALMS, state=0)).reward)
+        self.assertEqual(timid.babbler.competences, [-1.0])
 
     def test_bad_configuration(self):
         with self.assertRaisesRegex(ValueError, "unknown reach-learning strategy 'curious'"):

@@ -11,7 +11,9 @@ transitions predict eq. 8.1 (0 when untried); reaches predict by strategy (ch. 8
 
 - ``random``: 1 on one reaching state-action drawn at the start of the problem-try, 0 on the rest;
 - ``greedy`` (greedy optimistic): eq. 8.5;
-- ``intrinsic`` (intrinsically motivated): eq. 8.7, the expected error of eq. 8.5's prediction.
+- ``intrinsic`` (intrinsically motivated): eq. 8.7, the expected error of eq. 8.5's prediction;
+- ``goal_babbling`` (beyond the source, :mod:`mobee_drake.reaching.goals`): eq. 8.5 toward a goal
+  that SAGG-RIAC chose in the targets' workspace, instead of the least-tried problem.
 
 A *problem-try* (ch. 8.3.1): value iteration on the problem's rewards, the greedy state-action
 of the robot's state, recorded in its history with the prediction of eq. 8.1 or 8.5 made before
@@ -42,6 +44,7 @@ which its histories are rebuilt exactly (checkpoints, :meth:`ReachLearner.FromAr
 """
 
 import dataclasses as dc
+import json
 from typing import Protocol
 
 import numpy as np
@@ -49,6 +52,7 @@ import numpy as np
 from mobee_drake.planning.curiosity import TransitionCounts
 from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.planning.value_iteration import ValueIteration
+from mobee_drake.reaching.goals import GoalBabbler, ReachGoalsConfig
 from mobee_drake.reaching.predictors import (
     PredictorConfig,
     ReachReward,
@@ -56,7 +60,7 @@ from mobee_drake.reaching.predictors import (
     TransitionReward,
 )
 
-STRATEGIES = ("random", "greedy", "intrinsic")
+STRATEGIES = ("random", "greedy", "intrinsic", "goal_babbling")
 
 
 @dc.dataclass
@@ -73,9 +77,12 @@ class ReachLearningConfig:
     predictor: PredictorConfig = dc.field(default_factory=PredictorConfig)
     # Whether the MDP is learned with the reaches (ch. 9.4.1) or fixed (ch. 8.1).
     learn_mdp: bool = False
+    # The goal_babbling strategy's goal selection.
+    goals: ReachGoalsConfig = dc.field(default_factory=ReachGoalsConfig)
 
     def Validate(self) -> None:
         self.predictor.Validate()
+        self.goals.Validate()
         if self.strategy not in STRATEGIES:
             raise ValueError(f"unknown reach-learning strategy '{self.strategy}'; strategies "
                              "are " + ", ".join(STRATEGIES))
@@ -104,6 +111,9 @@ class Robot(Protocol):
         """Whether MoBeE's fields felt a workspace object (not the robot's own body) during the
         last action; asked only when the MDP is learned with the reaches."""
 
+    def MarkerPosition(self) -> np.ndarray:
+        """Where the reaching marker is now (asked by the goal_babbling strategy)."""
+
 
 @dc.dataclass
 class TryResult:
@@ -116,10 +126,12 @@ class TryResult:
     # The reaching state-action tried, or -1.
     reach: int
     failed_transitions: int
+    # Where the reach put the marker, or None when the try timed out.
+    reached: list[float] | None = None
 
 
-# Columns of the action log: problem-try, problem, state-action, state before, state after,
-# estimate, reward, target x, y, z.
+# Columns of the action log: problem-try, problem (goal_babbling: the problem nearest the goal),
+# state-action, state before, state after, estimate, reward, target (or goal) x, y, z.
 LOG_COLUMNS = ("try", "problem", "state_action", "state", "outcome", "estimate", "reward",
                "x", "y", "z")
 
@@ -155,6 +167,8 @@ class ReachLearner:
         self.problem_tries = np.zeros(len(self.targets), dtype=int)
         self.rng = np.random.default_rng(config.seed)
         self.log: list[tuple] = []
+        self.babbler = (GoalBabbler(self.targets, config.goals)
+                        if config.strategy == "goal_babbling" else None)
 
     @property
     def num_state_actions(self) -> int:
@@ -209,11 +223,10 @@ class ReachLearner:
         row = self.model.counts[state_action]
         self._T_sorted[self._rank[state_action]] = row / row.sum()
 
-    def _Try(self, robot: Robot, problem: int, reach_rewards: str, histories: RewardHistories,
-             rng, learn: bool) -> TryResult:
-        """One problem-try; ``learn`` says whether it is exploration (logged; with ``learn_mdp``
-        the model learns) or an evaluation (``histories`` a scratch copy)."""
-        target = self.targets[problem]
+    def _Try(self, robot: Robot, problem: int, target: np.ndarray, reach_rewards: str,
+             histories: RewardHistories, rng, learn: bool) -> TryResult:
+        """One problem-try for ``target``; ``learn`` says whether it is exploration (logged; with
+        ``learn_mdp`` the model learns) or an evaluation (``histories`` a scratch copy)."""
         robot.SetProblem(target)
         random_reach = (self.Reach(int(rng.integers(self.space.num_states)))
                         if reach_rewards == "random" else -1)
@@ -224,7 +237,8 @@ class ReachLearner:
             sa = self._Greedy(q, state, rng)
             estimate = histories.Predict(sa, target)  # eq. 8.1 or 8.5, before it runs
             if self.reaching[sa]:
-                reward, outcome = ReachReward(robot.Reach(target), target), state
+                reached = robot.Reach(target)
+                reward, outcome = ReachReward(reached, target), state
             else:
                 outcome = robot.Transition(int(self.space.action_goal[sa]))
                 reward = TransitionReward(v[state], v[outcome])
@@ -240,14 +254,27 @@ class ReachLearner:
                 self.log.append((int(self.problem_tries.sum()), problem, sa, state, outcome,
                                  estimate, reward, *target))
             if self.reaching[sa]:
-                return TryResult(problem, action, reward, sa, failed)
+                return TryResult(problem, action, reward, sa, failed,
+                                 [float(c) for c in reached])
         return TryResult(problem, self.config.max_actions, None, -1, failed)
 
     def Explore(self, robot: Robot) -> TryResult:
-        """One exploratory problem-try on the least-tried problem (ch. 8.3.2)."""
-        least = np.flatnonzero(self.problem_tries == self.problem_tries.min())
-        problem = int(self.rng.choice(least))
-        result = self._Try(robot, problem, self.config.strategy, self.histories, self.rng,
+        """One exploratory problem-try: on the least-tried problem (ch. 8.3.2), or, goal
+        babbling, toward a goal of SAGG-RIAC's (counted as a try of the problem nearest it)."""
+        if self.babbler is None:
+            least = np.flatnonzero(self.problem_tries == self.problem_tries.min())
+            problem = int(self.rng.choice(least))
+            return self._Explore(robot, problem, self.targets[problem], self.config.strategy)
+        goal = self.babbler.Select(self.rng)
+        start = robot.MarkerPosition()
+        problem = int(np.argmin(np.linalg.norm(self.targets - goal, axis=1)))
+        result = self._Explore(robot, problem, goal, "greedy")
+        self.babbler.Record(goal, start, result.reached)
+        return result
+
+    def _Explore(self, robot: Robot, problem: int, target: np.ndarray,
+                 reach_rewards: str) -> TryResult:
+        result = self._Try(robot, problem, target, reach_rewards, self.histories, self.rng,
                            learn=True)
         self.problem_tries[problem] += 1
         return result
@@ -265,8 +292,8 @@ class ReachLearner:
             if state == start:
                 break
             robot.Transition(int(self.space.action_goal[self._Greedy(q, state, rng)]))
-        return [self._Try(robot, int(problem), "greedy", self.histories.Copy(), rng,
-                          learn=False)
+        return [self._Try(robot, int(problem), self.targets[problem], "greedy",
+                          self.histories.Copy(), rng, learn=False)
                 for problem in rng.permutation(len(self.targets))]
 
     # ------------------------------------------------------------------------------------------
@@ -279,6 +306,8 @@ class ReachLearner:
                       problem_tries=self.problem_tries)
         if self.config.learn_mdp:
             arrays["transition_counts"] = self.model.counts
+        if self.babbler is not None:
+            arrays.update(self.babbler.ToArrays())
         return arrays, dict(config=dc.asdict(self.config),
                             generator=self.rng.bit_generator.state)
 
@@ -287,11 +316,11 @@ class ReachLearner:
         from the log, record by record; a learned MDP is restored from its counts."""
         if self.log:
             raise ValueError("load a saved state into a fresh learner only")
-        saved = ReachLearningConfig(**{**data["config"], "predictor": PredictorConfig(
-            **data["config"]["predictor"])})
-        if saved != self.config:
+        saved, mine = (json.loads(json.dumps(c)) for c in (data["config"],
+                                                            dc.asdict(self.config)))
+        if saved != mine:
             raise ValueError(f"the saved learner's configuration {saved} is not this one's "
-                             f"{self.config}")
+                             f"{mine}")
         for row in np.asarray(arrays["log"]):
             entry = (int(row[0]), int(row[1]), int(row[2]), int(row[3]), int(row[4]),
                      float(row[5]), float(row[6]), *map(float, row[7:]))
@@ -301,4 +330,6 @@ class ReachLearner:
         if self.config.learn_mdp:
             self.model.counts[...] = arrays["transition_counts"]
             self._T_sorted[self._rank[:self.num_transitions]] = self.model.Probabilities()
+        if self.babbler is not None:
+            self.babbler.LoadArrays(arrays)
         self.rng.bit_generator.state = data["generator"]

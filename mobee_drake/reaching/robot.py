@@ -51,6 +51,7 @@ class SimulatedRobot:
         plant = simulation.plant
         marker = scenario.attractor.forcing.marker
         hand = [m.body_name for m in simulation.robot.markers if m.name == marker][0]
+        self._marker = mobee.marker_index(marker)
         # The current problem's target (None before the first problem).
         self.target: np.ndarray | None = None
         self._hand = [g for g, frame in simulation.robot.geometry_frames.items()
@@ -99,6 +100,13 @@ class SimulatedRobot:
 
     def FeltObject(self) -> bool:
         return self.executor.FeltObject(self._executor_context)
+
+    def MarkerPosition(self) -> np.ndarray:
+        """Where the reaching marker (the palm) is now (world, m)."""
+        mobee = self.simulation.mobee
+        positions = mobee.GetOutputPort("marker_positions").Eval(
+            mobee.GetMyContextFromRoot(self.context))
+        return positions[3 * self._marker:3 * self._marker + 3].copy()
 
     @property
     def simulated_seconds(self) -> float:
