@@ -40,7 +40,7 @@ records 0 and does not update the model either (the object disturbed it, so its 
 nothing about the robot alone).
 
 The learner draws from its own seeded generator and keeps a log of every action it took, from
-which its histories are rebuilt exactly (checkpoints, :meth:`ReachLearner.FromArrays`).
+which its histories are rebuilt exactly (checkpoints, :meth:`ReachLearner.LoadArrays`).
 """
 
 import dataclasses as dc
@@ -242,12 +242,10 @@ class ReachLearner:
             else:
                 outcome = robot.Transition(int(self.space.action_goal[sa]))
                 reward = TransitionReward(v[state], v[outcome])
-                if self.config.learn_mdp:  # ch. 9.4.1: the problem's penalty or the model's
-                    felt = robot.FeltObject()
-                    if not felt:
-                        reward = 0.0
-                        if learn:
-                            self._Observe(sa, outcome)
+                if self.config.learn_mdp and not robot.FeltObject():  # ch. 9.4.1: the model's
+                    reward = 0.0
+                    if learn:
+                        self._Observe(sa, outcome)
                 failed += reward < 0
             histories.Record(sa, target, estimate, reward)
             if learn:
