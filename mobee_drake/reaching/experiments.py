@@ -176,7 +176,7 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
         np.savez(run_dir / "mdp.npz", counts=counts)
         # The state-actions the model learned about, and their learned chance of success.
         updated = np.flatnonzero(np.any(counts != model.transitions.counts, axis=1))
-        success = counts[updated, model.space.action_goal[updated]] / counts[updated].sum(axis=1)
+        success = learner.model.Probabilities()[updated, model.space.action_goal[updated]]
         extra = dict(mdp=dict(updated_state_actions=len(updated),
                               success_probability=float(success.mean()) if len(updated) else None))
     result = dict(settings=dc.asdict(settings), evaluations=data["evaluations"],

@@ -162,7 +162,8 @@ class ReachLearner:
         # each state-action went.
         self._order = np.argsort(self.action_state, kind="stable")
         self._rank = np.argsort(self._order)
-        self._T_sorted = np.vstack([self.model.Probabilities(), np.zeros((m, m))])[self._order]
+        self._T_sorted = np.zeros((k + m, m))
+        self._RefreshT()
         self.histories = RewardHistories(self.reaching, config.predictor)
         self.problem_tries = np.zeros(len(self.targets), dtype=int)
         self.rng = np.random.default_rng(config.seed)
@@ -217,11 +218,9 @@ class ReachLearner:
     # ------------------------------------------------------------------------------------------
     # Acting.
 
-    def _Observe(self, state_action: int, outcome: int) -> None:
-        """A model update (``learn_mdp``): adds the outcome to the counts and to T."""
-        self.model.Observe(state_action, outcome)
-        row = self.model.counts[state_action]
-        self._T_sorted[self._rank[state_action]] = row / row.sum()
+    def _RefreshT(self) -> None:
+        """T of the transitions from the model's counts, in value iteration's order."""
+        self._T_sorted[self._rank[:self.num_transitions]] = self.model.Probabilities()
 
     def _Try(self, robot: Robot, problem: int, target: np.ndarray, reach_rewards: str,
              histories: RewardHistories, rng, learn: bool) -> TryResult:
@@ -245,7 +244,8 @@ class ReachLearner:
                 if self.config.learn_mdp and not robot.FeltObject():  # ch. 9.4.1: the model's
                     reward = 0.0
                     if learn:
-                        self._Observe(sa, outcome)
+                        self.model.Observe(sa, outcome)
+                        self._RefreshT()
                 failed += reward < 0
             histories.Record(sa, target, estimate, reward)
             if learn:
@@ -327,7 +327,7 @@ class ReachLearner:
         self.problem_tries[...] = arrays["problem_tries"]
         if self.config.learn_mdp:
             self.model.counts[...] = arrays["transition_counts"]
-            self._T_sorted[self._rank[:self.num_transitions]] = self.model.Probabilities()
+            self._RefreshT()
         if self.babbler is not None:
             self.babbler.LoadArrays(arrays)
         self.rng.bit_generator.state = data["generator"]
