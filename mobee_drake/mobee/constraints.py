@@ -100,6 +100,13 @@ class ClauseSet:
         """Which clauses have their forces switched on: all of their literals within ``delta``."""
         return self._Active(self.Clearances(q) < delta)
 
+    def Violation(self, q: np.ndarray) -> float:
+        """How far (rad) ``q`` is from satisfying every clause: the sum over the violated clauses
+        of their least violated literal's depth."""
+        depth = np.maximum(-self.Clearances(q), 0.0)
+        per_clause = np.where(self._C > 0, depth[None, :], np.inf).min(axis=1, initial=np.inf)
+        return float(np.sum(per_clause[np.isfinite(per_clause)]))
+
     def _Active(self, inside: np.ndarray) -> np.ndarray:
         return self._C @ (~inside) == 0
 

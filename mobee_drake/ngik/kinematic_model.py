@@ -1,0 +1,119 @@
+"""The kinematic model NGIK and the roadmaps query (dissertation ch. 2, eq. 3.3).
+
+For a robot pose ``q`` and the world's obstacles ``B`` it computes what the cost and task
+functions are written in: the *marker states* ``X(q, B)`` (each marker's position and unit direction
+in world) and the *collision pairs* ``K(q, B)`` (the pairs of solids that interpenetrate: the robot
+against itself, where the overlay does not exclude the pair, and against obstacles).
+
+The model is a MultibodyPlant and a SceneGraph without any system that moves them: a pose is set
+in the plant's Context and the geometry queried, so one evaluation costs one forward-kinematics
+pass and one signed-distance query over the overlay's primitives.
+"""
+
+import dataclasses as dc
+
+import numpy as np
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+from pydrake.systems.framework import DiagramBuilder
+
+from mobee_drake.mobee.constraints import ClauseSet
+from mobee_drake.robots.scenario_robot import AddScenarioRobot, RobotConfig
+from mobee_drake.simulation.scenario import SceneObject
+from mobee_drake.simulation.world import LiveWorld
+
+
+@dc.dataclass(frozen=True)
+class PoseEvaluation:
+    """What the kinematic model reports for one pose."""
+
+    q: np.ndarray  # (n,) the controlled joints' positions (rad)
+    marker_positions: np.ndarray  # (m, 3) x_i in world
+    marker_directions: np.ndarray  # (m, 3) unit u_i in world
+    # The colliding pairs K(q, B), as pairs of geometry names.
+    collision_pairs: tuple[tuple[str, str], ...]
+
+
+class KinematicModel:
+    """Forward kinematics and collision pairs of one robot among fixed objects.
+
+    Args:
+        robot: the robot, as in a scenario file.
+        objects: the world's objects; only obstacles take part in collisions (targets and ghosts
+            are drawn but not felt, as in the simulation).
+        clearance: solids closer than this (m) count as colliding (0: only interpenetration).
+    """
+
+    def __init__(self, robot: RobotConfig, objects: list[SceneObject] = (), *,
+                 clearance: float = 0.0):
+        builder = DiagramBuilder()
+        plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
+        self._overlay, self.joints = AddScenarioRobot(plant, scene_graph, robot)
+        self.world = LiveWorld(plant, scene_graph)
+        for obj in objects:
+            self.world.Register(obj)
+        plant.Finalize()
+        self.diagram = builder.Build()
+        self.plant, self.scene_graph = plant, scene_graph
+        self.context = self.diagram.CreateDefaultContext()
+        self._plant_context = plant.GetMyMutableContextFromRoot(self.context)
+        self._scene_graph_context = scene_graph.GetMyContextFromRoot(self.context)
+        instance = self._overlay.instance
+        joints = [plant.GetJointByName(name, instance) for name in self.joints]
+        self._position_index = np.array([j.position_start() for j in joints])
+        self.lower = np.array([j.position_lower_limits()[0] for j in joints])
+        self.upper = np.array([j.position_upper_limits()[0] for j in joints])
+        self.home = plant.GetPositions(self._plant_context)[self._position_index]
+        self.clauses = ClauseSet(self._overlay.overlay.clauses, self.joints,
+                                 self._overlay.frozen_joints)
+        self.marker_names = [m.name for m in self._overlay.markers]
+        self._marker_bodies = [plant.GetBodyByName(m.body_name, instance)
+                               for m in self._overlay.markers]
+        self._p_BM = np.array([m.p_BM for m in self._overlay.markers]).reshape(-1, 3)
+        self._u_B = np.array([m.u_B for m in self._overlay.markers]).reshape(-1, 3)
+        self.clearance = clearance
+        inspector = scene_graph.model_inspector()
+        self._names = {g: inspector.GetName(g) for g in inspector.GetAllGeometryIds()}
+        self._names.update(self._overlay.geometry_names)
+
+    def JointIndex(self, name: str) -> int:
+        if name not in self.joints:
+            raise ValueError(f"unknown joint '{name}'; the model's joints are: "
+                             + ", ".join(self.joints))
+        return self.joints.index(name)
+
+    def MarkerIndex(self, name: str) -> int:
+        if name not in self.marker_names:
+            raise ValueError(f"unknown marker '{name}'; the model's markers are: "
+                             + ", ".join(self.marker_names))
+        return self.marker_names.index(name)
+
+    def SetPose(self, q: np.ndarray) -> None:
+        """Puts the model in pose ``q`` (the controlled joints, rad)."""
+        positions = self.plant.GetPositions(self._plant_context)
+        positions[self._position_index] = q
+        self.plant.SetPositions(self._plant_context, positions)
+
+    def Evaluate(self, q: np.ndarray) -> PoseEvaluation:
+        """Marker states and collision pairs of pose ``q``."""
+        q = np.asarray(q, dtype=float)
+        self.SetPose(q)
+        positions = np.empty_like(self._p_BM)
+        directions = np.empty_like(self._u_B)
+        for i, body in enumerate(self._marker_bodies):
+            X_WB = self.plant.EvalBodyPoseInWorld(self._plant_context, body)
+            positions[i] = X_WB @ self._p_BM[i]
+            directions[i] = X_WB.rotation() @ self._u_B[i]
+        return PoseEvaluation(q=q.copy(), marker_positions=positions,
+                              marker_directions=directions,
+                              collision_pairs=self._CollisionPairs())
+
+    def _CollisionPairs(self) -> tuple[tuple[str, str], ...]:
+        query = self.scene_graph.get_query_output_port().Eval(self._scene_graph_context)
+        pairs = query.ComputeSignedDistancePairwiseClosestPoints(self.clearance)
+        return tuple((self._names[p.id_A], self._names[p.id_B]) for p in pairs
+                     if p.distance < self.clearance)
+
+    def IsValid(self, q: np.ndarray) -> bool:
+        """Within the joint limits and every constraint clause satisfied (Alg. 4's IS_VALID)."""
+        return bool(np.all(q >= self.lower) and np.all(q <= self.upper)
+                    and not self.clauses.ActiveClauses(q, 0.0).any())
