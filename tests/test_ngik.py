@@ -125,7 +125,7 @@ class IcubIkTest(unittest.TestCase):
         hand = plant.GetBodyByName("r_hand")
         context = plant.GetMyContextFromRoot(model.context)
         X_WH = plant.EvalBodyPoseInWorld(context, hand)
-        marker = model._overlay.markers[self.palm]
+        marker = model.markers[self.palm]
         np.testing.assert_allclose(e.marker_positions[self.palm], X_WH @ marker.p_BM, atol=1e-12)
         self.assertAlmostEqual(np.linalg.norm(e.marker_directions[self.palm]), 1.0)
 

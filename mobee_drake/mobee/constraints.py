@@ -100,6 +100,12 @@ class ClauseSet:
         """Which clauses have their forces switched on: all of their literals within ``delta``."""
         return self._Active(self.Clearances(q) < delta)
 
+    def SingleLiterals(self) -> tuple[np.ndarray, np.ndarray]:
+        """The clauses of one literal as linear constraints ``normals @ q + offsets >= 0``."""
+        single = self._C.sum(axis=1) == 1
+        rows = np.flatnonzero(self._C[single].sum(axis=0))
+        return self._normals[rows], self._offsets[rows]
+
     def Violation(self, q: np.ndarray) -> float:
         """How far (rad) ``q`` is from satisfying every clause: the sum over the violated clauses
         of their least violated literal's depth."""

@@ -59,17 +59,18 @@ class KinematicModel:
         self._scene_graph_context = scene_graph.GetMyContextFromRoot(self.context)
         instance = self._overlay.instance
         joints = [plant.GetJointByName(name, instance) for name in self.joints]
-        self._position_index = np.array([j.position_start() for j in joints])
+        # Where each controlled joint's position is in the plant's positions.
+        self.position_index = np.array([j.position_start() for j in joints])
         self.lower = np.array([j.position_lower_limits()[0] for j in joints])
         self.upper = np.array([j.position_upper_limits()[0] for j in joints])
-        self.home = plant.GetPositions(self._plant_context)[self._position_index]
+        self.home = plant.GetPositions(self._plant_context)[self.position_index]
         self.clauses = ClauseSet(self._overlay.overlay.clauses, self.joints,
                                  self._overlay.frozen_joints)
-        self.marker_names = [m.name for m in self._overlay.markers]
-        self._marker_bodies = [plant.GetBodyByName(m.body_name, instance)
-                               for m in self._overlay.markers]
-        self._p_BM = np.array([m.p_BM for m in self._overlay.markers]).reshape(-1, 3)
-        self._u_B = np.array([m.u_B for m in self._overlay.markers]).reshape(-1, 3)
+        self.markers = self._overlay.markers
+        self.marker_names = [m.name for m in self.markers]
+        self._marker_bodies = [plant.GetBodyByName(m.body_name, instance) for m in self.markers]
+        self._p_BM = np.array([m.p_BM for m in self.markers]).reshape(-1, 3)
+        self._u_B = np.array([m.u_B for m in self.markers]).reshape(-1, 3)
         self.clearance = clearance
         inspector = scene_graph.model_inspector()
         self._names = {g: inspector.GetName(g) for g in inspector.GetAllGeometryIds()}
@@ -90,7 +91,7 @@ class KinematicModel:
     def SetPose(self, q: np.ndarray) -> None:
         """Puts the model in pose ``q`` (the controlled joints, rad)."""
         positions = self.plant.GetPositions(self._plant_context)
-        positions[self._position_index] = q
+        positions[self.position_index] = q
         self.plant.SetPositions(self._plant_context, positions)
 
     def Evaluate(self, q: np.ndarray) -> PoseEvaluation:
