@@ -36,7 +36,8 @@ from mobee_drake.robots.icub import RIGHT_ARM_JOINTS, TORSO_JOINTS, IcubConfig
 from mobee_drake.simulation.scenario import Box, SceneObject, Sphere
 
 JOINTS = list(TORSO_JOINTS + RIGHT_ARM_JOINTS)
-OBJECTS = [SceneObject(name="table", shape=Box(size=[0.5, 0.9, 0.04]), position=[-0.38, 0.0, -0.17]),
+OBJECTS = [SceneObject(name="table", shape=Box(size=[0.5, 0.9, 0.04]),
+                       position=[-0.38, 0.0, -0.17]),
            SceneObject(name="ball", shape=Sphere(radius=0.06), position=[-0.32, 0.12, 0.05])]
 SIGMA = 0.3  # initial spread (rad) of the sampling solvers
 BUDGET = 6000  # cost evaluations per solve
@@ -165,7 +166,8 @@ def Format(rows: list[dict], problems: int) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(prog="mobee-drake bench ik", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(prog="mobee-drake bench ik",
+                                     description=__doc__.split("\n")[0])
     parser.add_argument("--problems", type=int, default=50)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
