@@ -33,6 +33,15 @@ class NesTest(unittest.TestCase):
                              int(np.sum(np.arange(1, n + 1) < n / 2 + 1)))
         self.assertEqual(DefaultPopulation(10), 4 + int(3 * math.log(10)))
 
+    def test_symmetric_exponential(self):
+        from scipy.linalg import expm
+
+        from mobee_drake.ngik.nes import _SymmetricExp
+
+        A = np.random.default_rng(0).standard_normal((5, 5))
+        S = (A + A.T) / 4
+        np.testing.assert_allclose(_SymmetricExp(S), expm(S), atol=1e-12)
+
     def test_minimises_a_shifted_quadratic(self):
         center = np.array([3.0, -1.0, 0.5, 2.0])
         for variant in ("xnes", "snes"):

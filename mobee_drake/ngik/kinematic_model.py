@@ -13,6 +13,7 @@ pass and one signed-distance query over the overlay's primitives.
 import dataclasses as dc
 
 import numpy as np
+from pydrake.geometry import Meshcat, MeshcatVisualizer
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
@@ -41,10 +42,11 @@ class KinematicModel:
         objects: the world's objects; only obstacles take part in collisions (targets and ghosts
             are drawn but not felt, as in the simulation).
         clearance: solids closer than this (m) count as colliding (0: only interpenetration).
+        meshcat: if given, the model is drawn there (see :meth:`Publish`).
     """
 
     def __init__(self, robot: RobotConfig, objects: list[SceneObject] = (), *,
-                 clearance: float = 0.0):
+                 clearance: float = 0.0, meshcat: Meshcat | None = None):
         builder = DiagramBuilder()
         plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
         self._overlay, self.joints = AddScenarioRobot(plant, scene_graph, robot)
@@ -52,6 +54,9 @@ class KinematicModel:
         for obj in objects:
             self.world.Register(obj)
         plant.Finalize()
+        self.visualizer = None
+        if meshcat is not None:
+            self.visualizer = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat)
         self.diagram = builder.Build()
         self.plant, self.scene_graph = plant, scene_graph
         self.context = self.diagram.CreateDefaultContext()
@@ -113,6 +118,12 @@ class KinematicModel:
         pairs = query.ComputeSignedDistancePairwiseClosestPoints(self.clearance)
         return tuple((self._names[p.id_A], self._names[p.id_B]) for p in pairs
                      if p.distance < self.clearance)
+
+    def Publish(self, q: np.ndarray, time: float = 0.0) -> None:
+        """Draws pose ``q`` in Meshcat (at ``time`` of a recording, if one is running)."""
+        self.SetPose(q)
+        self.context.SetTime(time)
+        self.visualizer.ForcedPublish(self.visualizer.GetMyContextFromRoot(self.context))
 
     def IsValid(self, q: np.ndarray) -> bool:
         """Within the joint limits and every constraint clause satisfied (Alg. 4's IS_VALID)."""

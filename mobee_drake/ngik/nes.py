@@ -16,7 +16,6 @@ import dataclasses as dc
 import math
 
 import numpy as np
-from scipy.linalg import expm
 
 NES_VARIANTS = ("xnes", "snes")
 
@@ -66,6 +65,12 @@ def DefaultPopulation(dimension: int) -> int:
     return 4 + int(math.floor(3 * math.log(dimension)))
 
 
+def _SymmetricExp(S: np.ndarray) -> np.ndarray:
+    """The matrix exponential of a symmetric matrix, by its eigendecomposition."""
+    values, vectors = np.linalg.eigh(S)
+    return (vectors * np.exp(values)) @ vectors.T
+
+
 def Minimize(cost: Callable[[np.ndarray], float], mean: np.ndarray, sigma: float | np.ndarray,
              config: NesConfig, rng: np.random.Generator) -> NesResult:
     """Minimises ``cost`` from the distribution N(mean, sigma^2 I) (``sigma`` scalar or per
@@ -110,7 +115,7 @@ def Minimize(cost: Callable[[np.ndarray], float], mean: np.ndarray, sigma: float
             grad_B = grad_M - grad_sigma * np.eye(d)
             mu = mu + scale * B @ grad_delta  # eta_mu = 1
             scale *= math.exp(eta_sigma / 2 * grad_sigma)
-            B = B @ expm(eta_B / 2 * grad_B)
+            B = B @ _SymmetricExp(eta_B / 2 * grad_B)
             spread = scale * np.sqrt(np.max(np.sum(B * B, axis=1)))
         else:
             mu = mu + sigmas * grad_delta

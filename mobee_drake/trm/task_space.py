@@ -1,0 +1,72 @@
+"""Task spaces (dissertation eq. 3.4-3.5, Table 3.2): what a roadmap's poses should spread over.
+
+A task space maps a pose's evaluation (``q``, marker states, collision pairs) to a point ``y`` of
+R^n; it concatenates task functions, each giving one or more coordinates:
+
+- :class:`MarkerCoordinates`: some coordinates of a marker's position ("move the hand in all three
+  workspace dimensions", or a plane of them);
+- :class:`MarkerAlong`: a marker's position along one direction ("move the hand back and forth",
+  Table 3.2's ``x_1 + x_2 + x_3`` is the direction (1, 1, 1) unnormalised);
+- :class:`JointCoordinates`: some joint positions ("move in the null space of the cost").
+"""
+
+import dataclasses as dc
+
+import numpy as np
+
+from mobee_drake.ngik.kinematic_model import PoseEvaluation
+
+
+@dc.dataclass(frozen=True)
+class MarkerCoordinates:
+    marker: int
+    axes: tuple[int, ...] = (0, 1, 2)
+
+    @property
+    def size(self) -> int:
+        return len(self.axes)
+
+    def __call__(self, evaluation: PoseEvaluation) -> np.ndarray:
+        return evaluation.marker_positions[self.marker, list(self.axes)]
+
+
+@dc.dataclass(frozen=True)
+class MarkerAlong:
+    marker: int
+    direction: tuple[float, float, float]
+
+    @property
+    def size(self) -> int:
+        return 1
+
+    def __call__(self, evaluation: PoseEvaluation) -> np.ndarray:
+        return np.array([evaluation.marker_positions[self.marker] @ np.asarray(self.direction)])
+
+
+@dc.dataclass(frozen=True)
+class JointCoordinates:
+    joints: tuple[int, ...]  # indices into the model's joints
+
+    @property
+    def size(self) -> int:
+        return len(self.joints)
+
+    def __call__(self, evaluation: PoseEvaluation) -> np.ndarray:
+        return evaluation.q[list(self.joints)]
+
+
+TaskFunction = MarkerCoordinates | MarkerAlong | JointCoordinates
+
+
+@dc.dataclass(frozen=True)
+class TaskSpace:
+    """Y = (y_1, ..., y_n) (eq. 3.4): the task functions' coordinates, concatenated."""
+
+    functions: tuple[TaskFunction, ...]
+
+    @property
+    def dimension(self) -> int:
+        return sum(f.size for f in self.functions)
+
+    def __call__(self, evaluation: PoseEvaluation) -> np.ndarray:
+        return np.concatenate([f(evaluation) for f in self.functions])
