@@ -68,7 +68,8 @@ def _Dispatch(prog: str, args: list[str], modules: dict[str, str]) -> None:
 
 def _Bench(args: list[str]) -> None:
     """Benchmarks that print their figures."""
-    _Dispatch("mobee-drake bench", args, {"forces": "mobee_drake.bench.forces",
+    _Dispatch("mobee-drake bench", args, {"babbling": "mobee_drake.bench.babbling",
+                                          "forces": "mobee_drake.bench.forces",
                                           "ik": "mobee_drake.bench.ik",
                                           "simulation": "mobee_drake.bench.simulation"})
 

@@ -49,6 +49,7 @@ from mobee_drake.planning.explorers import LoadAgentModel
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
 from mobee_drake.reaching.executor import StateActionExecutor
+from mobee_drake.reflex.controller import ReflexController, ReflexParams
 from mobee_drake.robots.assembly import JointStateSelector
 from mobee_drake.robots.overlay import RobotOverlay
 from mobee_drake.robots.scenario_robot import AddScenarioRobot
@@ -145,22 +146,30 @@ def _AttractorSource(builder: DiagramBuilder, program, seed: int, mobee: Mobee,
 
 
 def _AddMobee(builder: DiagramBuilder, plant: MultibodyPlant, scene_graph: SceneGraph,
-              robot: RobotOverlay, joints: list[str], params, time_step: float, prefix: str = ""):
-    """One robot's MoBeE, its virtual dynamics (eq. 5.7) and the map of their state into the
-    plant's; returns MoBeE, the virtual dynamics, the selector matrix and its gain system."""
+              robot: RobotOverlay, joints: list[str], params, time_step: float, prefix: str = "",
+              reflex: ReflexParams | None = None):
+    """One robot's MoBeE, what moves the robot (its virtual dynamics, eq. 5.7, or with ``reflex``
+    MoBeE 1.0's reflex controller, whose command input the caller connects) and the map of its
+    state into the plant's; returns MoBeE, the mover, the selector matrix and its gain system."""
     mobee = builder.AddNamedSystem(f"{prefix}mobee", Mobee(plant, robot, joints=joints,
                                                            params=params))
     builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
-    _, damping, _ = params.PerJoint(joints)
-    virtual = builder.AddNamedSystem(f"{prefix}virtual_dynamics", VirtualDynamics(
-        mass=mobee.mass, damping=np.array(damping), period=time_step,
-        initial_positions=mobee.home))
-    builder.Connect(mobee.GetOutputPort("total"), virtual.GetInputPort("total"))
-    builder.Connect(mobee.GetOutputPort("damping"), virtual.GetInputPort("damping"))
+    if reflex is None:
+        _, damping, _ = params.PerJoint(joints)
+        mover = builder.AddNamedSystem(f"{prefix}virtual_dynamics", VirtualDynamics(
+            mass=mobee.mass, damping=np.array(damping), period=time_step,
+            initial_positions=mobee.home))
+        builder.Connect(mobee.GetOutputPort("total"), mover.GetInputPort("total"))
+        builder.Connect(mobee.GetOutputPort("damping"), mover.GetInputPort("damping"))
+    else:
+        mover = builder.AddNamedSystem(f"{prefix}reflex", ReflexController(
+            initial_positions=mobee.home, period=time_step, params=reflex,
+            clauses=mobee.clauses))
+        builder.Connect(mobee.GetOutputPort("field_pairs"), mover.GetInputPort("field_pairs"))
     selector = JointStateSelector(plant, mobee.joints, robot.instance)
     to_plant = builder.AddNamedSystem(f"{prefix}to_plant_state", MatrixGain(selector))
-    builder.Connect(virtual.get_output_port(), to_plant.get_input_port())
-    return mobee, virtual, selector, to_plant
+    builder.Connect(mover.GetOutputPort("state"), to_plant.get_input_port())
+    return mobee, mover, selector, to_plant
 
 
 @dc.dataclass
@@ -202,21 +211,23 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None, *,
         world.Register(obj)
     plant.Finalize()
 
-    mobee, virtual, selector, to_plant = _AddMobee(builder, plant, scene_graph, robot, joints,
-                                                   scenario.mobee, scenario.time_step)
+    reflex = scenario.reflex if scenario.controller == "reflex" else None
+    mobee, mover, selector, to_plant = _AddMobee(builder, plant, scene_graph, robot, joints,
+                                                   scenario.mobee, scenario.time_step,
+                                                   reflex=reflex)
     # The client's forces (eq. 5.9-5.10) are inputs of the diagram, for scripts and supervisors
     # (unfixed, they are zero), unless the attractor program sets the marker forces.
     builder.ExportInput(mobee.GetInputPort("config_force"), "config_force")
     companion_positions = []
     for i, (companion, (overlay, companion_joints)) in enumerate(zip(scenario.companions,
                                                                      companions)):
-        other, other_virtual, _, other_to_plant = _AddMobee(
+        other, other_mover, _, other_to_plant = _AddMobee(
             builder, plant, scene_graph, overlay, companion_joints, companion.mobee,
             scenario.time_step, prefix=f"{companion.name}_")
-        builder.Connect(other_virtual.get_output_port(), other.GetInputPort("state"))
+        builder.Connect(other_mover.GetOutputPort("state"), other.GetInputPort("state"))
         builder.Connect(_AttractorSource(builder, companion.attractor,
                                          scenario.random_seed + 1 + i,  # its own draws
-                                         other, other_virtual.get_output_port(), None,
+                                         other, other_mover.GetOutputPort("state"), None,
                                          name=f"{companion.name}_attractor")[0],
                         other.GetInputPort("attractor"))
         companion_positions.append(other_to_plant.get_output_port())
@@ -236,8 +247,8 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None, *,
         builder.Connect(plant_state, to_pose.get_input_port())
         builder.Connect(to_pose.get_output_port(),
                         scene_graph.get_source_pose_port(plant.get_source_id()))
-        builder.Connect(virtual.get_output_port(), mobee.GetInputPort("state"))
-        robot_state = virtual.get_output_port()
+        builder.Connect(mover.GetOutputPort("state"), mobee.GetInputPort("state"))
+        robot_state = mover.GetOutputPort("state")
     else:
         from_plant = builder.AddNamedSystem(
             "from_plant_state", MatrixGain(selector.T))
@@ -272,6 +283,8 @@ def BuildSimulation(scenario: Scenario, meshcat: Meshcat | None = None, *,
     attractor, marker_forces = _AttractorSource(builder, scenario.attractor,
                                                 scenario.random_seed, mobee, robot_state, meshcat)
     builder.Connect(attractor, mobee.GetInputPort("attractor"))
+    if reflex is not None:  # MoBeE 1.0: the attractor is the position move command
+        builder.Connect(attractor, mover.GetInputPort("command"))
     if marker_forces is None:
         builder.ExportInput(mobee.GetInputPort("marker_forces"), "marker_forces")
     else:

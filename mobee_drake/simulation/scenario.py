@@ -13,11 +13,15 @@ from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.planning.explorers import ExplorerConfig
 from mobee_drake.planning.supervisor import ActionTiming
 from mobee_drake.reaching.executor import ReachForcing
+from mobee_drake.reflex.controller import ReflexParams
 from mobee_drake.robots.icub import IcubConfig
 from mobee_drake.robots.zero_position import ZeroPositionConfig
 from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
 
 ROBOT_MODELS = ("kinematic", "dynamic")
+# "mobee2": MoBeE's forces move the robot (ch. 5); "reflex": MoBeE 1.0's position moves with the
+# rewinding reflex (ch. 4.1).
+CONTROLLERS = ("mobee2", "reflex")
 CONTROL_MODALITIES = ("position", "velocity", "force")
 OBJECT_ROLES = ("obstacle", "target", "ghost")
 
@@ -168,6 +172,9 @@ class Scenario:
     robot_model: str = "kinematic"
     # With the dynamic robot: "position", "velocity" or "force" (ch. 5.2).
     control: str = "position"
+    # What moves the (kinematic) robot: MoBeE 2.0's forces or MoBeE 1.0's reflex (CONTROLLERS).
+    controller: str = "mobee2"
+    reflex: ReflexParams = dc.field(default_factory=ReflexParams)
     # MoBeE's period (s): the kinematic robot's integration step, the dynamic robot's control rate.
     time_step: float = 0.01
     # The dynamic robot's plant step (s).
@@ -189,6 +196,13 @@ def ValidateScenario(scenario: Scenario, source: str = "scenario") -> None:
     """Checks the choices and numbers that the schema's types cannot."""
     _Check(scenario.robot_model in ROBOT_MODELS, source,
            f"robot_model must be one of {ROBOT_MODELS}, got '{scenario.robot_model}'")
+    _Check(scenario.controller in CONTROLLERS, source,
+           f"controller must be one of {CONTROLLERS}, got '{scenario.controller}'")
+    _Check(scenario.controller == "mobee2" or scenario.robot_model == "kinematic", source,
+           "the reflex controller (MoBeE 1.0) moves the kinematic robot only")
+    _Check(scenario.reflex.speed_deg > 0 and scenario.reflex.history >= 2
+           and scenario.reflex.tolerance_deg > 0, source,
+           "reflex: speed_deg and tolerance_deg must be > 0 and history >= 2")
     _Check(scenario.control in CONTROL_MODALITIES, source,
            f"control must be one of {CONTROL_MODALITIES}, got '{scenario.control}'")
     for key in ("time_step", "plant_time_step", "duration"):
