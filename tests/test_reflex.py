@@ -1,0 +1,122 @@
+"""MoBeE 1.0: the reflex controller with fixed input ports, and on the iCub."""
+
+import math
+import unittest
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.systems.analysis import Simulator
+
+from mobee_drake.mobee.constraints import ClauseSet
+from mobee_drake.mobee.fields import NO_FIELD_PAIRS, FieldPairs
+from mobee_drake.reflex.controller import (
+    COMMANDS,
+    COMPLETED,
+    HOLDING,
+    MODE,
+    REFLEXES,
+    STUCK,
+    STUCK_COUNT,
+    ReflexController,
+    ReflexParams,
+)
+from mobee_drake.robots.overlay import Clause, Literal
+
+H = 0.02
+# One pair inside its field (the controller only asks whether there is any).
+ONE_PAIR = FieldPairs([None], [None], np.zeros(1), np.full(1, 0.05), np.zeros((1, 3)),
+                      np.zeros((1, 3)), np.zeros((1, 3)), np.ones(1, dtype=bool))
+
+
+class ReflexControllerTest(unittest.TestCase):
+    def Make(self, *, history=100, clauses=()):
+        controller = ReflexController(
+            initial_positions=np.zeros(2), period=H,
+            params=ReflexParams(speed_deg=10.0, history=history, tolerance_deg=0.01),
+            clauses=ClauseSet(list(clauses), ["a", "b"]))
+        simulator = Simulator(controller)
+        context = simulator.get_mutable_context()
+        controller.GetInputPort("field_pairs").FixValue(context, AbstractValue.Make(
+            NO_FIELD_PAIRS))
+        return controller, simulator, context
+
+    def Q(self, controller, context):
+        return controller.GetOutputPort("state").Eval(context)[:2].copy()
+
+    def Status(self, controller, context):
+        return controller.GetOutputPort("status").Eval(context)
+
+    def test_a_free_move_goes_straight_at_its_speed(self):
+        controller, simulator, context = self.Make()
+        command = np.radians([3.0, -1.5])
+        controller.GetInputPort("command").FixValue(context, command)
+        step = math.radians(10.0) * H  # the largest joint moves 0.2 deg per period
+        steps = math.ceil(math.radians(3.0) / step)  # 15
+        simulator.AdvanceTo(5 * H + 1e-9)
+        q = self.Q(controller, context)
+        # Five periods along the straight line (the first update is at t = 0).
+        np.testing.assert_allclose(q, command * 6 * step / math.radians(3.0), atol=1e-12)
+        simulator.AdvanceTo((steps + 2) * H)
+        np.testing.assert_allclose(self.Q(controller, context), command, atol=1e-12)
+        status = self.Status(controller, context)
+        self.assertEqual((status[MODE], status[COMMANDS], status[COMPLETED], status[REFLEXES]),
+                         (HOLDING, 1, 1, 0))
+
+    def test_the_reflex_retraces_the_move_back_to_its_waypoint(self):
+        controller, simulator, context = self.Make()
+        first = np.radians([2.0, 0.0])
+        controller.GetInputPort("command").FixValue(context, first)
+        simulator.AdvanceTo(1.0)
+        np.testing.assert_allclose(self.Q(controller, context), first)
+        # The second move runs for a while, then MoBeE reports trouble.
+        controller.GetInputPort("command").FixValue(context, np.radians([2.0, 5.0]))
+        path = []
+        for k in range(1, 8):
+            simulator.AdvanceTo(1.0 + k * H)
+            path.append(self.Q(controller, context))
+        controller.GetInputPort("field_pairs").FixValue(context, AbstractValue.Make(ONE_PAIR))
+        back = []
+        for k in range(8, 16):
+            simulator.AdvanceTo(1.0 + k * H)
+            back.append(self.Q(controller, context))
+            # A new command during the rewind is suppressed.
+            controller.GetInputPort("command").FixValue(context, np.radians([0.0, 0.0]))
+        # The poses of the way out, in reverse order, ending at the waypoint.
+        expected = path[-2::-1] + [first]
+        np.testing.assert_allclose(np.array(back[:len(expected)]), np.array(expected),
+                                   atol=1e-12)
+        status = self.Status(controller, context)
+        self.assertEqual((status[COMMANDS], status[COMPLETED], status[REFLEXES]), (2, 1, 1))
+        # Trouble gone: the suppressed command now runs.
+        controller.GetInputPort("field_pairs").FixValue(context, AbstractValue.Make(
+            NO_FIELD_PAIRS))
+        simulator.AdvanceTo(3.0)
+        np.testing.assert_allclose(self.Q(controller, context), np.zeros(2), atol=1e-12)
+        self.assertEqual(self.Status(controller, context)[COMMANDS], 3)
+
+    def test_a_short_history_gets_stuck(self):
+        controller, simulator, context = self.Make(history=3)
+        controller.GetInputPort("command").FixValue(context, np.radians([5.0, 0.0]))
+        simulator.AdvanceTo(10 * H)
+        controller.GetInputPort("field_pairs").FixValue(context, AbstractValue.Make(ONE_PAIR))
+        simulator.AdvanceTo(20 * H)
+        status = self.Status(controller, context)
+        self.assertEqual((status[MODE], status[STUCK_COUNT]), (STUCK, 1))
+        # Ten moves of 0.2 deg (the updates at 0 ... 9 H), then back as far as the history
+        # allowed (two poses before the current one), and it stays there.
+        np.testing.assert_allclose(self.Q(controller, context),
+                                   np.radians([10 * 0.2 - 2 * 0.2, 0.0]), atol=1e-12)
+
+    def test_a_violated_clause_triggers_the_reflex(self):
+        # b <= 1 deg.
+        clause = Clause(name="b_low", literals=[Literal(coefficients={"b": -1.0}, offset=1.0)])
+        controller, simulator, context = self.Make(clauses=[clause])
+        controller.GetInputPort("command").FixValue(context, np.radians([0.0, 3.0]))
+        simulator.AdvanceTo(1.0)
+        status = self.Status(controller, context)
+        self.assertEqual((status[MODE], status[REFLEXES], status[COMPLETED]), (HOLDING, 1, 0))
+        np.testing.assert_allclose(self.Q(controller, context), np.zeros(2), atol=1e-12)
+
+
+if __name__ == "__main__":
+    unittest.main()
