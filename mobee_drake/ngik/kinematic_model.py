@@ -18,6 +18,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake.mobee.constraints import ClauseSet
+from mobee_drake.mobee.fields import FindFieldPairs
 from mobee_drake.robots.scenario_robot import AddScenarioRobot, RobotConfig
 from mobee_drake.simulation.scenario import SceneObject
 from mobee_drake.simulation.world import LiveWorld
@@ -42,11 +43,14 @@ class KinematicModel:
         objects: the world's objects; only obstacles take part in collisions (targets and ghosts
             are drawn but not felt, as in the simulation).
         clearance: solids closer than this (m) count as colliding (0: only interpenetration).
+        inside_fields: count the pairs inside MoBeE's fields instead (each pair closer than its
+            field margin, as MoBeE 1.0's reflex sees them); ``clearance`` is then unused.
         meshcat: if given, the model is drawn there (see :meth:`Publish`).
     """
 
     def __init__(self, robot: RobotConfig, objects: list[SceneObject] = (), *,
-                 clearance: float = 0.0, meshcat: Meshcat | None = None):
+                 clearance: float = 0.0, inside_fields: bool = False,
+                 meshcat: Meshcat | None = None):
         builder = DiagramBuilder()
         plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
         self._overlay, self.joints = AddScenarioRobot(plant, scene_graph, robot)
@@ -77,6 +81,8 @@ class KinematicModel:
         self._p_BM = np.array([m.p_BM for m in self.markers]).reshape(-1, 3)
         self._u_B = np.array([m.u_B for m in self.markers]).reshape(-1, 3)
         self.clearance = clearance
+        self._field_margins = self._overlay.field_margins if inside_fields else None
+        self._max_margin = max(self._overlay.field_margins.values(), default=0.0)
         inspector = scene_graph.model_inspector()
         self._names = {g: inspector.GetName(g) for g in inspector.GetAllGeometryIds()}
         self._names.update(self._overlay.geometry_names)
@@ -115,6 +121,10 @@ class KinematicModel:
 
     def _CollisionPairs(self) -> tuple[tuple[str, str], ...]:
         query = self.scene_graph.get_query_output_port().Eval(self._scene_graph_context)
+        if self._field_margins is not None:
+            fields = FindFieldPairs(query, self._field_margins, self._max_margin)
+            return tuple((self._names[a], self._names[b])
+                         for a, b in zip(fields.geometry_A, fields.geometry_B))
         pairs = query.ComputeSignedDistancePairwiseClosestPoints(self.clearance)
         return tuple((self._names[p.id_A], self._names[p.id_B]) for p in pairs
                      if p.distance < self.clearance)
