@@ -77,10 +77,12 @@ def _Bench(args: list[str]) -> None:
 def _Experiment(args: list[str]) -> None:
     """Batteries of experiments that write data, plots and a report: ch7 (the model-learning
     experiments of the dissertation's ch. 7), ch8 (learning to reach, ch. 8), saggriac (SAGG-RIAC
-    on the 15-joint arm), trm (task-relevant roadmaps, ch. 3)."""
+    on the 15-joint arm), trm (task-relevant roadmaps, ch. 3), roadmaps (adaptive roadmap
+    planning on MoBeE 1.0, ch. 4.3)."""
     _Dispatch("mobee-drake experiment", args, {"ch7": "mobee_drake.planning.experiments",
                                                "ch8": "mobee_drake.reaching.experiments",
                                                "saggriac": "mobee_drake.goal_babbling.experiments",
+                                               "roadmaps": "mobee_drake.reflex.demos",
                                                "trm": "mobee_drake.trm.experiments"})
 
 

@@ -1,10 +1,12 @@
 """The demonstrations of adaptive roadmap planning (dissertation ch. 4.3.1-4.3.2) in simulation.
 
-- **Roadmap from scratch**: the home pose and 20 random valid poses of the torso and right arm
+- **Roadmap from scratch**: the home pose and 20 random poses of the torso and right arm
   (10 joints; the others at home), each joined both ways to its 10 nearest in joint space, no edge
   checked; the robot, under MoBeE 1.0, explores until every edge out of every vertex it can reach
   is known (a table in front of it, as in the motor babbling scenario). We add the home pose as
-  the start vertex, since the robot has to begin somewhere.
+  the start vertex, since the robot has to begin somewhere, and draw the random poses among the
+  valid ones with nothing inside MoBeE's fields (a vertex the reflex forbids could never be
+  reached; checking 20 poses is cheap, it is the edges that go unchecked).
 - **Adaptive re-planning**: a small graph built on purpose around a ball in front of the right
   hand: poses A and B put the palm on either side of the ball, D and E above A and B; the edge
   A-B is the short way (the hand passes through the ball), A-D-E-B the long way over it. With the
@@ -78,11 +80,12 @@ def RoadmapFromScratch(seed: int = 0, *, samples: int = 20, k: int = 10,
     mobee = robot.simulation.mobee
     lower, upper = mobee.position_limits
     columns = [mobee.joint_index(j) for j in TORSO_JOINTS + RIGHT_ARM_JOINTS]
+    model = KinematicModel(IcubConfig(), [TABLE], inside_fields=True)
     poses = [mobee.home]
     while len(poses) < samples + 1:
         q = mobee.home.copy()
         q[columns] = rng.uniform(lower[columns], upper[columns])
-        if not mobee.clauses.ActiveClauses(q, 0.0).any():
+        if model.IsValid(q) and not model.Evaluate(q).collision_pairs:
             poses.append(q)
     roadmap = AdaptiveRoadmap.KNearest(np.array(poses), k)
     began = time.perf_counter()
