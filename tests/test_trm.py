@@ -29,6 +29,18 @@ class TaskSpaceTest(unittest.TestCase):
         np.testing.assert_allclose(space(e), [4, 5, 6, 6, 0.3, 0.1, 3])
 
 
+class GraphStateSpaceTest(unittest.TestCase):
+    def test_edges_become_actions_both_ways(self):
+        from mobee_drake.planning.state_space import FromGraph
+
+        space = FromGraph(np.array([[0.1], [0.5], [0.9]]), np.array([[0, 1], [2, 1]]))
+        np.testing.assert_array_equal(space.action_state, [0, 1, 1, 2])
+        np.testing.assert_array_equal(space.action_goal, [1, 0, 2, 1])
+        self.assertEqual(space.StateOf(np.array([0.8])), 2)
+        with self.assertRaisesRegex(ValueError, "join states 0..2"):
+            FromGraph(np.zeros((3, 1)), np.array([[0, 3]]))
+
+
 class CoveredRegionTest(unittest.TestCase):
     def test_simplex_membership(self):
         region = CoveredRegion(2)
@@ -110,6 +122,33 @@ class IcubTrmTest(unittest.TestCase):
         with tempfile.TemporaryDirectory() as folder, self.assertRaisesRegex(FileNotFoundError,
                                                                              "roadmap.npz"):
             TaskRelevantRoadmap.Load(folder)
+
+    def test_a_roadmap_as_the_mdp_state_space(self):
+        from pydrake.systems.analysis import Simulator
+
+        from mobee_drake.simulation.builder import BuildSimulation
+        from mobee_drake.simulation.scenario import (
+            ExploreAttractor,
+            ExploringAgent,
+            Scenario,
+            Visualization,
+        )
+
+        r = self.roadmap
+        with tempfile.TemporaryDirectory() as folder:
+            r.Save(folder)
+            scenario = Scenario(attractor=ExploreAttractor(agents=[ExploringAgent(
+                joints=JOINTS, roadmap=folder)]), time_step=0.02,
+                visualization=Visualization(meshcat=False))
+            simulation = BuildSimulation(scenario)
+        space = simulation.diagram.GetSubsystemByName("attractor").agents[0].space
+        self.assertEqual(space.num_states, r.num_vertices)
+        self.assertEqual(space.num_state_actions, 2 * len(r.edges))
+        simulator = Simulator(simulation.diagram)
+        simulator.AdvanceTo(2.0)
+        # The agent's first action sets the attractor to one of the roadmap's poses.
+        q_star = simulation.attractor.Eval(simulator.get_context())
+        self.assertLess(np.min(np.abs(r.q - q_star).max(axis=1)), 1e-9)
 
     def test_unreachable_task_fails_clearly(self):
         far = MarkerInBox(self.palm, np.array([2.0, 2.0, 2.0]), np.array([2.1, 2.1, 2.1]))

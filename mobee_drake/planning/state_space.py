@@ -93,6 +93,23 @@ def Lattice(levels, dimension: int, *, k: int | None = None) -> StateActionSpace
     return _Connect(centres, k=k)
 
 
+def FromGraph(centres: np.ndarray, edges: np.ndarray) -> StateActionSpace:
+    """States at ``centres`` (fractions of range) with an action both ways along each of the
+    undirected ``edges`` (pairs of state indices), e.g. a task-relevant roadmap's (ch. 9.4.5)."""
+    centres = np.asarray(centres, dtype=float)
+    edges = np.asarray(edges, dtype=int).reshape(-1, 2)
+    if centres.ndim != 2 or len(centres) < 2 or not np.all(np.isfinite(centres)):
+        raise ValueError(f"centres must be a finite (m >= 2, d) array, got shape {centres.shape}")
+    if len(edges) and (edges.min() < 0 or edges.max() >= len(centres)):
+        raise ValueError(f"edges must join states 0..{len(centres) - 1}")
+    pairs = sorted({(int(a), int(b)) for a, b in edges if a != b}
+                   | {(int(b), int(a)) for a, b in edges if a != b})
+    if not pairs:
+        raise ValueError("a state-action space needs at least one edge")
+    states, goals = np.array(pairs).T
+    return StateActionSpace(centres, states, goals)
+
+
 def FromSamples(samples: np.ndarray, *, k: int | None = None) -> StateActionSpace:
     """A state-action space over arbitrary sample configurations (fractions of range)."""
     samples = np.asarray(samples, dtype=float)

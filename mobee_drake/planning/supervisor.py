@@ -219,3 +219,7 @@ class ExplorationSupervisor(LeafSystem):
     @property
     def agent_names(self) -> list[str]:
         return [agent.name for agent in self._agents]
+
+    @property
+    def agents(self) -> tuple[Agent, ...]:
+        return tuple(self._agents)

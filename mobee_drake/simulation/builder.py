@@ -46,7 +46,7 @@ from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.planning.explorers import LoadAgentModel
-from mobee_drake.planning.state_space import Lattice
+from mobee_drake.planning.state_space import FromGraph, Lattice, StateActionSpace
 from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
 from mobee_drake.reaching.executor import StateActionExecutor
 from mobee_drake.reflex.controller import ReflexController, ReflexParams
@@ -95,6 +95,21 @@ class Simulation:
     applied_requests: dict = dc.field(default_factory=dict)
 
 
+def RoadmapStateSpace(folder: str, mobee: Mobee, joints: list[str]) -> StateActionSpace:
+    """The state-action space of a saved task-relevant roadmap over an agent's ``joints``."""
+    from mobee_drake.trm.roadmap import TaskRelevantRoadmap
+
+    roadmap = TaskRelevantRoadmap.Load(folder)
+    missing = [j for j in joints if j not in roadmap.joints]
+    if missing:
+        raise ValueError(f"{folder}: the roadmap has no joint(s) {', '.join(missing)}")
+    lower, upper = mobee.position_limits
+    mine = [mobee.joint_index(j) for j in joints]
+    theirs = [roadmap.joints.index(j) for j in joints]
+    centres = (roadmap.q[:, theirs] - lower[mine]) / (upper[mine] - lower[mine])
+    return FromGraph(centres, roadmap.edges)
+
+
 def _AttractorSource(builder: DiagramBuilder, program, seed: int, mobee: Mobee,
                      robot_state: OutputPort, meshcat: Meshcat | None,
                      name: str = "attractor") -> tuple[OutputPort, OutputPort | None]:
@@ -113,7 +128,8 @@ def _AttractorSource(builder: DiagramBuilder, program, seed: int, mobee: Mobee,
         return executor.GetOutputPort("attractor"), executor.GetOutputPort("marker_forces")
     if isinstance(program, ExploreAttractor):
         agents = [Agent(name=a.name, joints=a.joints,
-                        space=Lattice(a.levels, len(a.joints), k=a.nearest or None),
+                        space=(RoadmapStateSpace(a.roadmap, mobee, a.joints) if a.roadmap
+                               else Lattice(a.levels, len(a.joints), k=a.nearest or None)),
                         explorer=a.explorer,
                         model=LoadAgentModel(a.model, a.name, a.explorer) if a.model else None)
                   for a in program.agents]

@@ -92,6 +92,9 @@ class ExploringAgent:
     joints: list[str] = dc.field(default_factory=list)
     # The lattice's levels, in fractions of each joint's range (e.g. [0.25, 0.75]: a hypercube).
     levels: list[float] = dc.field(default_factory=lambda: [0.25, 0.75])
+    # Instead of the lattice: a task-relevant roadmap saved by ``mobee-drake experiment trm`` (its
+    # folder); its vertices become the states and its edges the actions (ch. 9.4.5).
+    roadmap: str = ""
     # Actions to the k nearest states; 0: to the nearest equidistant ones.
     nearest: int = 0
     explorer: ExplorerConfig = dc.field(default_factory=ExplorerConfig)
