@@ -16,9 +16,8 @@ import dataclasses as dc
 
 import numpy as np
 from pydrake.systems.analysis import Simulator
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import dijkstra
 
+from mobee_drake.planning.graph_paths import JointSpaceDistances, ShortestPath
 from mobee_drake.reflex.controller import COMPLETED, MODE, MOVING, REFLEXES, REWINDING, STUCK
 from mobee_drake.simulation.builder import BuildSimulation
 from mobee_drake.simulation.scenario import FixedAttractor, Scenario
@@ -63,22 +62,11 @@ class AdaptiveRoadmap:
     def Distances(self, start: int) -> tuple[np.ndarray, np.ndarray]:
         """Shortest joint-space distances from ``start`` over the edges not known infeasible, and
         the predecessors on those paths."""
-        usable = self.status != INFEASIBLE
-        a, b = self.edges[usable].T
-        n = len(self.poses)
-        lengths = np.linalg.norm(self.poses[a] - self.poses[b], axis=1)
-        graph = coo_matrix((lengths, (a, b)), shape=(n, n)).tocsr()
-        return dijkstra(graph, indices=start, return_predecessors=True)
+        return JointSpaceDistances(self.poses, self.edges[self.status != INFEASIBLE], start)
 
     def Plan(self, start: int, goal: int) -> list[int]:
         """The shortest path in joint space over the edges not known infeasible ([] if none)."""
-        _, predecessors = self.Distances(start)
-        if goal != start and predecessors[goal] < 0:
-            return []
-        path = [goal]
-        while path[-1] != start:
-            path.append(int(predecessors[path[-1]]))
-        return path[::-1]
+        return ShortestPath(self.poses, self.edges[self.status != INFEASIBLE], start, goal)
 
     def Reachable(self, start: int) -> np.ndarray:
         """Which vertices a path of edges not known infeasible reaches from ``start``."""

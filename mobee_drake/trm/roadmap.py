@@ -28,11 +28,10 @@ import pathlib
 import time
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import dijkstra
 
 from mobee_drake.ngik.nes import Minimize, NesConfig
 from mobee_drake.ngik.solver import IkProblem
+from mobee_drake.planning.graph_paths import ShortestPath
 from mobee_drake.simulation.checkpoint import WriteFolderAtomically
 from mobee_drake.trm.task_space import TaskSpace
 
@@ -103,17 +102,7 @@ class TaskRelevantRoadmap:
 
     def Path(self, start: int, goal: int) -> list[int]:
         """The shortest path in configuration space along the edges (empty if none)."""
-        n = self.num_vertices
-        a, b = self.edges.T
-        lengths = np.linalg.norm(self.q[a] - self.q[b], axis=1)
-        graph = coo_matrix((np.r_[lengths, lengths], (np.r_[a, b], np.r_[b, a])), shape=(n, n))
-        _, predecessors = dijkstra(graph.tocsr(), indices=start, return_predecessors=True)
-        if goal != start and predecessors[goal] < 0:
-            return []
-        path = [goal]
-        while path[-1] != start:
-            path.append(int(predecessors[path[-1]]))
-        return path[::-1]
+        return ShortestPath(self.q, np.vstack([self.edges, self.edges[:, ::-1]]), start, goal)
 
     def Save(self, folder: str | pathlib.Path) -> None:
         """Writes ``roadmap.npz`` and ``roadmap.json`` into ``folder`` atomically."""
