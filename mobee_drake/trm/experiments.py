@@ -52,12 +52,13 @@ def Plot(points: np.ndarray, roadmap: TaskRelevantRoadmap, title: str, path: pat
     for a, b in roadmap.edges:
         axes.plot(*points[[a, b]].T, color="0.75", linewidth=0.4)
     axes.scatter(*points.T, s=6, color="tab:blue")
-    if boxes:
+    if boxes:  # the open box's walls and floor as wireframes
+        signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).T.reshape(-1, 3)
         for obj in OpenBox():
-            centre, size = np.array(obj.position), np.array(obj.shape.size)
-            corners = centre + (np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).T.reshape(-1, 3)
-                                * size / 2)
-            axes.scatter(*corners.T, s=2, color="tab:brown")
+            corners = np.array(obj.position) + signs * np.array(obj.shape.size) / 2
+            for i, j in zip(*np.triu_indices(8, 1)):
+                if np.sum(signs[i] != signs[j]) == 1:
+                    axes.plot(*corners[[i, j]].T, color="tab:brown", linewidth=0.6)
     axes.set_xlabel("x (m, back)")
     axes.set_ylabel("y (m, right)")
     axes.set_zlabel("z (m, up)")
