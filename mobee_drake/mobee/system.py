@@ -19,7 +19,7 @@ from mobee_drake.mobee.joint_limits import JointLimits
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.mobee.projection import PointForceProjector
 from mobee_drake.mobee.squash import Squash
-from mobee_drake.robots.overlay import RobotOverlay
+from mobee_drake.robots.overlay import MarkerStates, RobotOverlay
 
 # The force terms of eq. 5.7, in the order of the rows of the force cache; "total" is their sum.
 FORCE_TERMS = ("spring", "damping", "f_lim", "f_cst", "f_coll", "f_config", "f_work")
@@ -361,12 +361,8 @@ class Mobee(LeafSystem):
                 terms[6] = Squash(generalized[self._v_index], p.work_squash.m, p.work_squash.k)
 
     def _CalcMarkerPoses(self, context, value) -> None:
-        plant_context = self._plant_context_entry.Eval(context)
-        poses = value.get_mutable_value()
-        for i, (marker, body) in enumerate(zip(self._markers, self._marker_bodies)):
-            X_WB = body.EvalPoseInWorld(plant_context)
-            poses[0, i] = X_WB @ marker.p_BM
-            poses[1, i] = X_WB.rotation() @ marker.u_B
+        MarkerStates(self._markers, self._marker_bodies, self._plant_context_entry.Eval(context),
+                     out=value.get_mutable_value())
 
     def _CalcMarkerJacobians(self, context, output) -> None:
         plant_context = self._plant_context_entry.Eval(context)

@@ -19,6 +19,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake.mobee.constraints import ClauseSet
 from mobee_drake.mobee.fields import FindFieldPairs
+from mobee_drake.robots.overlay import MarkerStates
 from mobee_drake.robots.scenario_robot import AddScenarioRobot, RobotConfig
 from mobee_drake.simulation.scenario import SceneObject
 from mobee_drake.simulation.world import LiveWorld
@@ -78,8 +79,6 @@ class KinematicModel:
         self.markers = self._overlay.markers
         self.marker_names = [m.name for m in self.markers]
         self._marker_bodies = [plant.GetBodyByName(m.body_name, instance) for m in self.markers]
-        self._p_BM = np.array([m.p_BM for m in self.markers]).reshape(-1, 3)
-        self._u_B = np.array([m.u_B for m in self.markers]).reshape(-1, 3)
         self.clearance = clearance
         self._field_margins = self._overlay.field_margins if inside_fields else None
         self._max_margin = max(self._overlay.field_margins.values(), default=0.0)
@@ -109,12 +108,8 @@ class KinematicModel:
         """Marker states and collision pairs of pose ``q``."""
         q = np.asarray(q, dtype=float)
         self.SetPose(q)
-        positions = np.empty_like(self._p_BM)
-        directions = np.empty_like(self._u_B)
-        for i, body in enumerate(self._marker_bodies):
-            X_WB = self.plant.EvalBodyPoseInWorld(self._plant_context, body)
-            positions[i] = X_WB @ self._p_BM[i]
-            directions[i] = X_WB.rotation() @ self._u_B[i]
+        positions, directions = MarkerStates(self.markers, self._marker_bodies,
+                                             self._plant_context)
         return PoseEvaluation(q=q.copy(), marker_positions=positions,
                               marker_directions=directions,
                               collision_pairs=self._CollisionPairs())

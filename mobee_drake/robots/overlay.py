@@ -226,6 +226,17 @@ class BodyMarker:
     u_B: np.ndarray
 
 
+def MarkerStates(markers, bodies, plant_context, out: np.ndarray | None = None) -> np.ndarray:
+    """(2, m, 3): each marker's position and unit direction in world, for markers fixed on
+    ``bodies`` (one per marker) of the plant whose ``plant_context`` is given."""
+    out = np.empty((2, len(markers), 3)) if out is None else out
+    for i, (marker, body) in enumerate(zip(markers, bodies)):
+        X_WB = body.EvalPoseInWorld(plant_context)
+        out[0, i] = X_WB @ marker.p_BM
+        out[1, i] = X_WB.rotation() @ marker.u_B
+    return out
+
+
 @dc.dataclass(frozen=True)
 class RobotOverlay:
     """An overlay applied to one robot of a plant."""
