@@ -61,7 +61,7 @@ class ReflexController(LeafSystem):
     commands received, commands completed, reflexes, times stuck).
 
     State: (q, v); the history ring buffer; and the bookkeeping vector (ring head, poses held,
-    poses back to the waypoint, mode, the four counters, then the last command).
+    poses back to the waypoint, then the status, then the last command).
     """
 
     def __init__(self, *, initial_positions: np.ndarray, period: float, params: ReflexParams,
@@ -80,9 +80,9 @@ class ReflexController(LeafSystem):
         history = np.zeros(self._size * n)
         history[:n] = q0
         self._history = self.DeclareDiscreteState(BasicVector(history))
-        # head = 0 holds q0; one pose held; waypoint 0 poses back; holding; counters 0.
+        # head = 0 holds q0; one pose held; waypoint 0 poses back; status: holding, counters 0.
         self._book = self.DeclareDiscreteState(BasicVector(np.concatenate(
-            [[0, 1, 0, HOLDING, 0, 0, 0, 0], q0])))
+            [[0, 1, 0], [HOLDING, 0, 0, 0, 0], q0])))
         self.DeclareStateOutputPort("state", self._motion)
         self.DeclareVectorOutputPort("status", 5, self._CalcStatus,
                                      prerequisites_of_calc={self.discrete_state_ticket(
@@ -99,24 +99,25 @@ class ReflexController(LeafSystem):
         q = context.get_discrete_state(self._motion).value()[:n].copy()
         history = context.get_discrete_state(self._history).value()
         book = context.get_discrete_state(self._book).value().copy()
-        head, held, back, mode = (int(v) for v in book[:4])
-        counters, last = book[4:8], book[8:]
+        head, held, back = (int(v) for v in book[:3])
+        status, last = book[3:8], book[8:]  # views: written back with the book
+        mode = int(status[MODE])
         command = self._command_port.Eval(context)
         # The planner's commands are suppressed while the reflex acts (then the latest one runs).
         if mode in (HOLDING, MOVING) and not np.array_equal(command, last):
             last[:] = command  # a new position move: the current pose is its waypoint
-            counters[COMMANDS - 1] += 1
+            status[COMMANDS] += 1
             back, mode = 0, MOVING
         if mode == MOVING and self._Trouble(context, q):
             mode = REWINDING
-            counters[REFLEXES - 1] += 1
+            status[REFLEXES] += 1
         q_next = q
         if mode == REWINDING:
             if back == 0:  # back at the waypoint: the command failed
                 mode = HOLDING
             elif held <= 1:  # the history ran out before the waypoint
                 mode = STUCK
-                counters[STUCK_COUNT - 1] += 1
+                status[STUCK_COUNT] += 1
             else:
                 head, held, back = (head - 1) % self._size, held - 1, back - 1
                 q_next = history[head * n:(head + 1) * n].copy()
@@ -125,7 +126,7 @@ class ReflexController(LeafSystem):
             largest = np.max(np.abs(error))
             if largest <= self._tolerance:
                 mode = HOLDING
-                counters[COMPLETED - 1] += 1
+                status[COMPLETED] += 1
             else:
                 q_next = q + error * min(1.0, self._step / largest)
                 head = (head + 1) % self._size
@@ -133,12 +134,12 @@ class ReflexController(LeafSystem):
                 discrete_state.get_mutable_vector(self._history).get_mutable_value()[
                     head * n:(head + 1) * n] = q_next
                 held, back = min(held + 1, self._size), min(back + 1, self._size)
-        book[:4] = head, held, back, mode
-        book[4:8], book[8:] = counters, last
+        book[:3] = head, held, back
+        status[MODE] = mode
         discrete_state.get_mutable_vector(self._motion).SetFromVector(
             np.concatenate([q_next, (q_next - q) / self._period]))
         discrete_state.get_mutable_vector(self._book).SetFromVector(book)
 
     def _CalcStatus(self, context, output) -> None:
         book = context.get_discrete_state(self._book).value()
-        output.SetFromVector(np.concatenate([book[3:4], book[4:8]]))
+        output.SetFromVector(book[3:8])
