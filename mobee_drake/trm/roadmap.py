@@ -138,24 +138,23 @@ def BuildTrm(problem: IkProblem, task_space: TaskSpace, q_init: np.ndarray, conf
     n = task_space.dimension
     model = problem.model
     region = CoveredRegion(n)
-    qs, ys, weights, edges = [], [], [], []
+    qs, weights, edges = [], [], []
+    ys = np.zeros((0, n))  # the vertices' task points, grown once per vertex
     began = time.perf_counter()
     searches = 0
 
-    def Nearest(y: np.ndarray) -> np.ndarray:  # Alg. 2
-        if not ys:
-            return np.zeros(0, dtype=int)
-        distances = np.linalg.norm(np.asarray(ys) - y, axis=1)
-        return np.argsort(distances, kind="stable")[:n]
+    def Nearest(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # Alg. 2
+        """The (up to) n vertices nearest to y, nearest first, and their distances."""
+        distances = np.linalg.norm(ys - y, axis=1)
+        nearest = (np.argpartition(distances, n)[:n] if len(distances) > n
+                   else np.arange(len(distances)))
+        nearest = nearest[np.argsort(distances[nearest], kind="stable")]
+        return nearest, distances[nearest]
 
     def Cost(x: np.ndarray) -> float:  # Alg. 3
         evaluation, cost = problem.Evaluate(x)
-        y = task_space(evaluation)
-        neighbours = Nearest(y)
-        if len(neighbours):
-            distances = np.linalg.norm(np.asarray(ys)[neighbours] - y, axis=1)
-            cost += float(np.sum(np.abs(distances - config.spacing)))
-        return cost
+        _, distances = Nearest(task_space(evaluation))
+        return cost + float(np.sum(np.abs(distances - config.spacing)))
 
     start, expanding = np.asarray(q_init, dtype=float), None
     while len(qs) < config.max_vertices:
@@ -163,17 +162,16 @@ def BuildTrm(problem: IkProblem, task_space: TaskSpace, q_init: np.ndarray, conf
         result = Minimize(Cost, problem.SearchVector(start), config.sigma, config.nes, rng)
         evaluation, _ = problem.Evaluate(result.x)
         y = task_space(evaluation)
-        neighbours = Nearest(y)
-        far_enough = not len(neighbours) or (
-            np.linalg.norm(ys[neighbours[0]] - y) >= config.spacing / 2)
+        neighbours, distances = Nearest(y)
+        far_enough = not len(neighbours) or distances[0] >= config.spacing / 2
         if (problem.IsSolved(evaluation) and not evaluation.collision_pairs and far_enough
                 and not region.Contains(y)):
             new = len(qs)
             qs.append(evaluation.q)
-            ys.append(y)
+            ys = np.vstack([ys, y])
             weights.append(1.0)
             edges += [(int(i), new) for i in neighbours]
-            region.Add((new, *neighbours), np.asarray(ys)[[new, *neighbours]])
+            region.Add((new, *neighbours), ys[[new, *neighbours]])
         elif expanding is not None:
             weights[expanding] = max(0.0, weights[expanding] - config.delta)
         else:
@@ -187,7 +185,7 @@ def BuildTrm(problem: IkProblem, task_space: TaskSpace, q_init: np.ndarray, conf
         expanding = len(w) - 1 - int(np.argmax(w[::-1]))  # the newest of the heaviest
         start = qs[expanding]
     return TaskRelevantRoadmap(
-        joints=list(model.joints), q=np.asarray(qs), y=np.asarray(ys),
+        joints=list(model.joints), q=np.asarray(qs), y=ys,
         weights=np.asarray(weights), edges=np.asarray(edges, dtype=int).reshape(-1, 2),
         simplices=list(region.simplices), build_seconds=time.perf_counter() - began,
         searches=searches)
