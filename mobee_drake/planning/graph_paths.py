@@ -18,7 +18,11 @@ def JointSpaceDistances(poses: np.ndarray, edges: np.ndarray,
 
 def ShortestPath(poses: np.ndarray, edges: np.ndarray, start: int, goal: int) -> list[int]:
     """The vertices of the shortest path from ``start`` to ``goal`` ([] if there is none)."""
-    _, predecessors = JointSpaceDistances(poses, edges, start)
+    return PathFromPredecessors(JointSpaceDistances(poses, edges, start)[1], start, goal)
+
+
+def PathFromPredecessors(predecessors: np.ndarray, start: int, goal: int) -> list[int]:
+    """The path to ``goal`` in the predecessors of a search from ``start`` ([] if none)."""
     if goal != start and predecessors[goal] < 0:
         return []
     path = [goal]

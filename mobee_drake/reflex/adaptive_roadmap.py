@@ -17,7 +17,11 @@ import dataclasses as dc
 import numpy as np
 from pydrake.systems.analysis import Simulator
 
-from mobee_drake.planning.graph_paths import JointSpaceDistances, ShortestPath
+from mobee_drake.planning.graph_paths import (
+    JointSpaceDistances,
+    PathFromPredecessors,
+    ShortestPath,
+)
 from mobee_drake.reflex.controller import COMPLETED, MODE, MOVING, REFLEXES, REWINDING, STUCK
 from mobee_drake.simulation.builder import BuildSimulation
 from mobee_drake.simulation.scenario import FixedAttractor, Scenario
@@ -150,12 +154,13 @@ def ExploreRoadmap(roadmap: AdaptiveRoadmap, robot: ReflexRobot, start: int,
             goal = int(roadmap.edges[rng.choice(untried), 1])
             step = [here, goal]
         else:
-            distances, _ = roadmap.Distances(here)
+            distances, predecessors = roadmap.Distances(here)
             open_vertices = np.unique(roadmap.edges[roadmap.status == UNTRIED, 0])
             open_vertices = open_vertices[np.isfinite(distances[open_vertices])]
             if not len(open_vertices):
                 return record
-            step = roadmap.Plan(here, int(open_vertices[np.argmin(distances[open_vertices])]))
+            nearest_open = int(open_vertices[np.argmin(distances[open_vertices])])
+            step = PathFromPredecessors(predecessors, here, nearest_open)
         a, b = step[0], step[1]
         arrived = robot.Command(roadmap.poses[b])
         roadmap.Record(a, b, arrived)
