@@ -195,6 +195,21 @@ class TestBattery(unittest.TestCase):
         robot.Transition(goal)
         self.assertTrue(robot.FeltObject())
 
+    def test_weaker_reach_stops_farther(self):
+        from mobee_drake.reaching.experiments import RIGHT_ARM, ReachScenario
+        from mobee_drake.reaching.robot import SimulatedRobot
+
+        target = np.array([-0.23, 0.22, 0.19])
+        misses = {}
+        for force in (300.0, 30.0):
+            robot = SimulatedRobot(ReachScenario(force), RIGHT_ARM, self.model.space, 0.05)
+            robot.SetProblem(target)
+            misses[force] = np.linalg.norm(robot.Reach(target) - target)
+        # MoBeE's attractor spring holds a weaker push back farther from the target.
+        self.assertGreater(misses[30.0], misses[300.0] + 0.02)
+        with self.assertRaisesRegex(ValueError, "force and softening must be > 0"):
+            SimulatedRobot(ReachScenario(-1.0), RIGHT_ARM, self.model.space, 0.05)
+
     def test_mdp_learned_with_the_reaches(self):
         from mobee_drake.planning.explorers import Explorer
         from mobee_drake.planning.state_space import Lattice

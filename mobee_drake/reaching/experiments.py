@@ -20,6 +20,7 @@ Beyond the source (ch. 9.4.1), ``--mdp simultaneous``: no MDP is learned first; 
 from the optimistic initialisation of ch. 6 and learns the MDP with the reaches, telling a model
 update from a penalty by whether MoBeE's fields felt the target (see
 :mod:`mobee_drake.reaching.learner`); each run keeps its final counts in ``mdp.npz``.
+``--reach-force`` sets the reach's force on the palm (the source gives none; 300 N by default).
 
 Run: ``mobee-drake experiment ch8 --output results/ch8`` (the whole battery), or a reduced one:
 ``mobee-drake experiment ch8 --problem-tries 400 --seeds 2``; watch one run in Meshcat:
@@ -45,6 +46,7 @@ from mobee_drake.planning.experiments import (
 )
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig, LoadAgentModel
 from mobee_drake.planning.state_space import Lattice
+from mobee_drake.reaching.executor import ReachForcing
 from mobee_drake.reaching.learner import (
     LOG_COLUMNS,
     STRATEGIES,
@@ -94,13 +96,18 @@ class RunSettings:
     predictor: str = "weighted"
     # One of MDPS.
     mdp: str = "learned_first"
+    # The reach's force on the palm (N; ch. 8.2 gives none). Weaker reaches leave the palm
+    # farther from targets it starts far from, so the pre-reach state matters more.
+    reach_force: float = ReachForcing().force
 
 
-def ReachScenario() -> Scenario:
-    """The reach learner's headless kinematic iCub: MoBeE on the right shoulder and elbow."""
+def ReachScenario(reach_force: float = ReachForcing().force) -> Scenario:
+    """The reach learner's headless kinematic iCub: MoBeE on the right shoulder and elbow,
+    reaching with ``reach_force`` on the palm."""
     scenario = Scenario()
     scenario.robot = _Robot()
     scenario.attractor = StateActionAttractor()
+    scenario.attractor.forcing.force = reach_force
     scenario.time_step = 0.02
     scenario.visualization.meshcat = False
     return scenario
@@ -136,8 +143,8 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
                            ReachLearningConfig(strategy=settings.strategy, seed=settings.seed,
                                                predictor=PredictorConfig(settings.predictor),
                                                learn_mdp=simultaneous))
-    robot = SimulatedRobot(ReachScenario(), RIGHT_ARM, model.space, grid.radius,
-                           meshcat=meshcat)
+    robot = SimulatedRobot(ReachScenario(settings.reach_force), RIGHT_ARM, model.space,
+                           grid.radius, meshcat=meshcat)
     checkpoint = run_dir / "checkpoint"
     data = dict(evaluations={}, wall_seconds=0.0, target=None)
     if checkpoint.is_dir():
@@ -413,6 +420,8 @@ def main(argv=None) -> None:
     parser.add_argument("--mdp", choices=MDPS, default="learned_first",
                         help="learn the MDP first and keep it (ch. 8), or learn it with the "
                              "reaches (ch. 9.4.1; use another --output)")
+    parser.add_argument("--reach-force", type=float, default=ReachForcing().force,
+                        help="the reach's force on the palm in N (use another --output)")
     argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(argv)
     stages = args.stages or [s for s in SOURCE_STAGES if s <= args.problem_tries]
@@ -421,7 +430,7 @@ def main(argv=None) -> None:
     output = pathlib.Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
     settings = RunSettings(args.strategies[0], 0, args.problem_tries, stages, args.evaluations,
-                           args.checkpoint_every, args.predictor, args.mdp)
+                           args.checkpoint_every, args.predictor, args.mdp, args.reach_force)
     if args.watch:
         from pydrake.geometry import StartMeshcat
 
