@@ -53,6 +53,17 @@ class TestPredictors(unittest.TestCase):
         self.assertEqual(TransitionReward(0.2, 0.3), 0.0)
         self.assertEqual(TransitionReward(0.3, 0.3), FAILED_TRANSITION_REWARD)
 
+    def test_distance_unit(self):
+        from mobee_drake.reaching.predictors import PredictorConfig
+
+        # In centimetres a 5 cm miss is worth 1/6, not 1/1.05 (eq. 8.4).
+        self.assertAlmostEqual(ReachReward([0.05, 0, 0], [0, 0, 0], unit=0.01), 1 / 6)
+        h = RewardHistories([True], PredictorConfig(distance_unit=0.01))
+        h.Record(0, [0, 0, 0], 1.0, 0.5)
+        w = 1 / (1 + 3.0)  # a target 3 cm away
+        self.assertAlmostEqual(h.Predict(0, [0, 0.03, 0]), (1 + w * 0.5) / (1 + w))  # eq. 8.5
+        with self.assertRaisesRegex(ValueError, "distance_unit must be > 0, got 0"):
+            RewardHistories([True], PredictorConfig(distance_unit=0.0))
 
 if __name__ == "__main__":
     unittest.main()
@@ -93,7 +104,7 @@ class FakeRobot:
 
 
 def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10, predictor="weighted",
-             learn_mdp=False, goals=None):
+             learn_mdp=False, goals=None, distance_unit=1.0):
     from mobee_drake.planning.state_space import Lattice
     from mobee_drake.reaching.learner import ReachLearner, ReachLearningConfig
     from mobee_drake.reaching.predictors import PredictorConfig
@@ -105,7 +116,7 @@ def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10, predictor=
         if targets is None else targets
     return space, ReachLearner(space, T, targets, ReachLearningConfig(
         strategy=strategy, seed=seed, max_actions=max_actions,
-        predictor=PredictorConfig(predictor), learn_mdp=learn_mdp,
+        predictor=PredictorConfig(predictor, distance_unit=distance_unit), learn_mdp=learn_mdp,
         **({} if goals is None else dict(goals=goals))))
 
 
@@ -303,6 +314,13 @@ class TestReachLearner(unittest.TestCase):
         timid.babbler.Select = lambda rng: np.zeros(3)
         self.assertIsNone(timid.Explore(FakeRobot(space, PALMS, state=0)).reward)
         self.assertEqual(timid.babbler.competences, [-1.0])
+
+    def test_rewards_in_the_distance_unit(self):
+        # A fresh greedy learner reaches at once from state 0, its palm 30 cm from the target.
+        for unit, reward in ((1.0, 1 / 1.3), (0.01, 1 / 31)):
+            space, learner = _Learner(targets=np.zeros((1, 3)), distance_unit=unit)
+            result = learner.Explore(FakeRobot(space, PALMS, state=0))
+            self.assertAlmostEqual(result.reward, reward)
 
     def test_bad_configuration(self):
         with self.assertRaisesRegex(ValueError, "unknown reach-learning strategy 'curious'"):

@@ -20,7 +20,8 @@ Beyond the source (ch. 9.4.1), ``--mdp simultaneous``: no MDP is learned first; 
 from the optimistic initialisation of ch. 6 and learns the MDP with the reaches, telling a model
 update from a penalty by whether MoBeE's fields felt the target (see
 :mod:`mobee_drake.reaching.learner`); each run keeps its final counts in ``mdp.npz``.
-``--reach-force`` sets the reach's force on the palm (the source gives none; 300 N by default).
+``--reach-force`` sets the reach's force on the palm (the source gives none; 300 N by default),
+``--distance-unit`` the unit of eq. 8.1-8.7's distances (none given; metres by default).
 
 Run: ``mobee-drake experiment ch8 --output results/ch8`` (the whole battery), or a reduced one:
 ``mobee-drake experiment ch8 --problem-tries 400 --seeds 2``; watch one run in Meshcat:
@@ -99,6 +100,8 @@ class RunSettings:
     # The reach's force on the palm (N; ch. 8.2 gives none). Weaker reaches leave the palm
     # farther from targets it starts far from, so the pre-reach state matters more.
     reach_force: float = ReachForcing().force
+    # The length (m) that counts as 1 in eq. 8.1-8.7 (the source gives no unit).
+    distance_unit: float = PredictorConfig().distance_unit
 
 
 def ReachScenario(reach_force: float = ReachForcing().force) -> Scenario:
@@ -141,7 +144,9 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
     grid = LoadTargetGrid()
     learner = ReachLearner(model.space, model.transitions.counts, grid.Centres(),
                            ReachLearningConfig(strategy=settings.strategy, seed=settings.seed,
-                                               predictor=PredictorConfig(settings.predictor),
+                                               predictor=PredictorConfig(
+                                                   settings.predictor,
+                                                   distance_unit=settings.distance_unit),
                                                learn_mdp=simultaneous))
     robot = SimulatedRobot(ReachScenario(settings.reach_force), RIGHT_ARM, model.space,
                            grid.radius, meshcat=meshcat)
@@ -422,6 +427,9 @@ def main(argv=None) -> None:
                              "reaches (ch. 9.4.1; use another --output)")
     parser.add_argument("--reach-force", type=float, default=ReachForcing().force,
                         help="the reach's force on the palm in N (use another --output)")
+    parser.add_argument("--distance-unit", type=float, default=PredictorConfig().distance_unit,
+                        help="the length in m that counts as 1 in the rewards and predictions "
+                             "of eq. 8.1-8.7, e.g. 0.01 for centimetres (use another --output)")
     argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(argv)
     stages = args.stages or [s for s in SOURCE_STAGES if s <= args.problem_tries]
@@ -430,7 +438,8 @@ def main(argv=None) -> None:
     output = pathlib.Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
     settings = RunSettings(args.strategies[0], 0, args.problem_tries, stages, args.evaluations,
-                           args.checkpoint_every, args.predictor, args.mdp, args.reach_force)
+                           args.checkpoint_every, args.predictor, args.mdp, args.reach_force,
+                           args.distance_unit)
     if args.watch:
         from pydrake.geometry import StartMeshcat
 

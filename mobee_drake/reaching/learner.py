@@ -237,7 +237,8 @@ class ReachLearner:
             estimate = histories.Predict(sa, target)  # eq. 8.1 or 8.5, before it runs
             if self.reaching[sa]:
                 reached = robot.Reach(target)
-                reward, outcome = ReachReward(reached, target), state
+                reward = ReachReward(reached, target, self.config.predictor.distance_unit)
+                outcome = state
             else:
                 outcome = robot.Transition(int(self.space.action_goal[sa]))
                 reward = TransitionReward(v[state], v[outcome])

@@ -20,6 +20,11 @@ kernel is squared-exponential, ``exp(-|x - x'|^2 / (2 l^2))``, with independent 
 signal variance. Records at the same target are pooled (their mean, with noise divided by their
 count: exact for this model), so a history over the 27 grid targets is a 27-point GP however long
 it is.
+
+Distances in eq. 8.1-8.7 are counted in ``PredictorConfig.distance_unit`` (the source gives no
+unit; metres by default). The unit sets how much the pre-reach state matters: a transition costs
+the factor gamma = 0.9, so moving to reach from elsewhere pays only where eq. 8.4 predicts more
+than 1/0.9 times the reward here; in metres the rewards of 2-30 cm misses all lie in 0.77-0.98.
 """
 
 import dataclasses as dc
@@ -35,6 +40,8 @@ class PredictorConfig:
     """Which predictor (eq. 8.1-8.7, or a Gaussian process) and the process's settings."""
 
     kind: str = "weighted"
+    # The length (m) that counts as 1 in eq. 8.1-8.7 and in the reward of eq. 8.4.
+    distance_unit: float = 1.0
     # The kernel's length scale (m) and the noise variance relative to the signal's.
     length_scale: float = 0.1
     noise_ratio: float = 0.25
@@ -43,6 +50,9 @@ class PredictorConfig:
         if self.kind not in PREDICTORS:
             raise ValueError(f"unknown reward predictor '{self.kind}'; predictors are "
                              + ", ".join(PREDICTORS))
+        if not self.distance_unit > 0:
+            raise ValueError(f"the predictor's distance_unit must be > 0, got "
+                             f"{self.distance_unit}")
         if not (self.length_scale > 0 and self.noise_ratio > 0):
             raise ValueError(f"the predictor's length_scale and noise_ratio must be > 0, got "
                              f"{self.length_scale} and {self.noise_ratio}")
@@ -51,9 +61,10 @@ class PredictorConfig:
 FAILED_TRANSITION_REWARD = -10.0
 
 
-def ReachReward(x: np.ndarray, target: np.ndarray) -> float:
-    """Eq. 8.4: ``1 / (1 + |x - x*|)`` for the marker's final position ``x``."""
-    return 1.0 / (1.0 + float(np.linalg.norm(np.asarray(x) - np.asarray(target))))
+def ReachReward(x: np.ndarray, target: np.ndarray, unit: float = 1.0) -> float:
+    """Eq. 8.4: ``1 / (1 + |x - x*|)`` for the marker's final position ``x``, the distance
+    counted in ``unit`` (m)."""
+    return 1.0 / (1.0 + float(np.linalg.norm(np.asarray(x) - np.asarray(target))) / unit)
 
 
 def TransitionReward(value_before: float, value_after: float) -> float:
@@ -62,12 +73,13 @@ def TransitionReward(value_before: float, value_after: float) -> float:
 
 
 def WeightedEstimate(target: np.ndarray, targets: np.ndarray, values: np.ndarray,
-                     prior: float) -> float:
-    """``(prior + sum w_i v_i) / (prior + sum w_i)`` with ``w_i = 1 / (1 + |x* - x*_i|)``;
-    with ``prior`` 0 this is eq. 8.1 (0 with no history, eq. 8.3), with 1 eq. 8.5 and 8.7."""
+                     prior: float, unit: float = 1.0) -> float:
+    """``(prior + sum w_i v_i) / (prior + sum w_i)`` with ``w_i = 1 / (1 + |x* - x*_i|)``, the
+    distance counted in ``unit`` (m); with ``prior`` 0 this is eq. 8.1 (0 with no history,
+    eq. 8.3), with 1 eq. 8.5 and 8.7."""
     if len(values) == 0:
         return 1.0 if prior else 0.0
-    weights = 1.0 / (1.0 + np.linalg.norm(targets - target, axis=1))
+    weights = 1.0 / (1.0 + np.linalg.norm(targets - target, axis=1) / unit)
     return float((prior + weights @ values) / (prior + weights.sum()))
 
 
@@ -114,7 +126,8 @@ class RewardHistories:
                   intrinsic: bool) -> float:
         target = np.asarray(target, dtype=float)
         if self.predictor.kind == "weighted" or len(values) == 0:
-            return WeightedEstimate(target, self._targets[state_action], values, prior)
+            return WeightedEstimate(target, self._targets[state_action], values, prior,
+                                    self.predictor.distance_unit)
         fit = self._fits.get((state_action, intrinsic))
         if fit is None:
             fit = GaussianProcessFit(self._targets[state_action], values, prior, self.predictor)
