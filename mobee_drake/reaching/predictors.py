@@ -61,10 +61,15 @@ class PredictorConfig:
 FAILED_TRANSITION_REWARD = -10.0
 
 
+def Closeness(a, b, unit: float = 1.0):
+    """``1 / (1 + |a - b|)`` over the last axis, the distance counted in ``unit`` (m): the reward
+    of eq. 8.4 and the weights of eq. 8.1, 8.5 and 8.7."""
+    return 1.0 / (1.0 + np.linalg.norm(np.asarray(a) - np.asarray(b), axis=-1) / unit)
+
+
 def ReachReward(x: np.ndarray, target: np.ndarray, unit: float = 1.0) -> float:
-    """Eq. 8.4: ``1 / (1 + |x - x*|)`` for the marker's final position ``x``, the distance
-    counted in ``unit`` (m)."""
-    return 1.0 / (1.0 + float(np.linalg.norm(np.asarray(x) - np.asarray(target))) / unit)
+    """Eq. 8.4 for the marker's final position ``x``."""
+    return float(Closeness(x, target, unit))
 
 
 def TransitionReward(value_before: float, value_after: float) -> float:
@@ -79,7 +84,7 @@ def WeightedEstimate(target: np.ndarray, targets: np.ndarray, values: np.ndarray
     eq. 8.3), with 1 eq. 8.5 and 8.7."""
     if len(values) == 0:
         return 1.0 if prior else 0.0
-    weights = 1.0 / (1.0 + np.linalg.norm(targets - target, axis=1) / unit)
+    weights = Closeness(targets, target, unit)
     return float((prior + weights @ values) / (prior + weights.sum()))
 
 
