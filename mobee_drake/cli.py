@@ -4,27 +4,36 @@ import argparse
 import importlib
 import sys
 
+from mobee_drake import __version__
+
 
 def _Run(args: list[str]) -> None:
     """Runs a scenario file and prints its summary."""
     parser = argparse.ArgumentParser(
         prog="mobee-drake run",
         description="Simulate a scenario (diagrams/*.yaml). Headless by default: the run is "
-                    "recorded to results/<scenario>.html unless --record or --no-record says "
-                    "otherwise; --meshcat serves the live view.")
+        "recorded to results/<scenario>.html unless --record or --no-record says "
+        "otherwise; --meshcat serves the live view.",
+    )
     parser.add_argument("scenario", help="a scenario file, e.g. diagrams/reach_around_ball.yaml")
     parser.add_argument("--duration", type=float, help="seconds to simulate (default: the file's)")
     parser.add_argument("--record", help="save a replayable Meshcat recording to this HTML file")
     parser.add_argument("--no-record", action="store_true", help="do not save a recording")
-    parser.add_argument("--meshcat", action="store_true",
-                        help="serve the live view in Meshcat and run in real time")
-    parser.add_argument("--no-meshcat", action="store_true",
-                        help="no viewer at all (fastest; implies --no-record)")
-    parser.add_argument("--set", default=None,
-                        help="YAML overrides of the scenario, e.g. '{robot_model: dynamic}'")
-    parser.add_argument("--checkpoint", default=None,
-                        help="a folder: resume from the checkpoint there, and save one after "
-                             "every completed action of the exploring agents")
+    parser.add_argument(
+        "--meshcat", action="store_true", help="serve the live view in Meshcat and run in real time"
+    )
+    parser.add_argument(
+        "--no-meshcat", action="store_true", help="no viewer at all (fastest; implies --no-record)"
+    )
+    parser.add_argument(
+        "--set", default=None, help="YAML overrides of the scenario, e.g. '{robot_model: dynamic}'"
+    )
+    parser.add_argument(
+        "--checkpoint",
+        default=None,
+        help="a folder: resume from the checkpoint there, and save one after "
+        "every completed action of the exploring agents",
+    )
     known = parser.parse_args(args)
 
     import pathlib
@@ -41,17 +50,23 @@ def _Run(args: list[str]) -> None:
         scenario.duration = known.duration
     record = None
     if not (known.no_record or known.no_meshcat):
-        record = known.record or str(pathlib.Path("results") / (pathlib.Path(known.scenario).stem
-                                                                + ".html"))
+        record = known.record or str(
+            pathlib.Path("results") / (pathlib.Path(known.scenario).stem + ".html")
+        )
     meshcat = None
     if known.meshcat and not known.no_meshcat:
         from pydrake.geometry import StartMeshcat
 
         meshcat = StartMeshcat()
     try:
-        summary = RunScenario(scenario, meshcat=meshcat, record=record,
-                              realtime_rate=1.0 if meshcat else 0.0, progress=True,
-                              checkpoint=known.checkpoint)
+        summary = RunScenario(
+            scenario,
+            meshcat=meshcat,
+            record=record,
+            realtime_rate=1.0 if meshcat else 0.0,
+            progress=True,
+            checkpoint=known.checkpoint,
+        )
     except ValueError as e:
         sys.exit(f"error: {known.scenario}: {e}")
     print(summary.Format())
@@ -68,10 +83,16 @@ def _Dispatch(prog: str, args: list[str], modules: dict[str, str]) -> None:
 
 def _Bench(args: list[str]) -> None:
     """Benchmarks that print their figures."""
-    _Dispatch("mobee-drake bench", args, {"babbling": "mobee_drake.bench.babbling",
-                                          "forces": "mobee_drake.bench.forces",
-                                          "ik": "mobee_drake.bench.ik",
-                                          "simulation": "mobee_drake.bench.simulation"})
+    _Dispatch(
+        "mobee-drake bench",
+        args,
+        {
+            "babbling": "mobee_drake.bench.babbling",
+            "forces": "mobee_drake.bench.forces",
+            "ik": "mobee_drake.bench.ik",
+            "simulation": "mobee_drake.bench.simulation",
+        },
+    )
 
 
 def _Experiment(args: list[str]) -> None:
@@ -79,11 +100,17 @@ def _Experiment(args: list[str]) -> None:
     experiments of the dissertation's ch. 7), ch8 (learning to reach, ch. 8), saggriac (SAGG-RIAC
     on the 15-joint arm), trm (task-relevant roadmaps, ch. 3), roadmaps (adaptive roadmap
     planning on MoBeE 1.0, ch. 4.3)."""
-    _Dispatch("mobee-drake experiment", args, {"ch7": "mobee_drake.planning.experiments",
-                                               "ch8": "mobee_drake.reaching.experiments",
-                                               "saggriac": "mobee_drake.goal_babbling.experiments",
-                                               "roadmaps": "mobee_drake.reflex.demos",
-                                               "trm": "mobee_drake.trm.experiments"})
+    _Dispatch(
+        "mobee-drake experiment",
+        args,
+        {
+            "ch7": "mobee_drake.planning.experiments",
+            "ch8": "mobee_drake.reaching.experiments",
+            "saggriac": "mobee_drake.goal_babbling.experiments",
+            "roadmaps": "mobee_drake.reflex.demos",
+            "trm": "mobee_drake.trm.experiments",
+        },
+    )
 
 
 def _Info(args: list[str]) -> None:
@@ -110,11 +137,14 @@ def _Info(args: list[str]) -> None:
     lower, upper = mobee.position_limits
     import numpy as np
 
-    for name, lo, hi, home in zip(mobee.joints, np.degrees(lower), np.degrees(upper),
-                                  np.degrees(mobee.home)):
+    for name, lo, hi, home in zip(
+        mobee.joints, np.degrees(lower), np.degrees(upper), np.degrees(mobee.home)
+    ):
         print(f"  {name:18s} [{lo:7.1f}, {hi:7.1f}] deg, home {home:6.1f}")
-    print("overlay primitives (field margin, m): " + ", ".join(
-        f"{robot.geometry_names[g]} ({m:.3f})" for g, m in robot.field_margins.items()))
+    print(
+        "overlay primitives (field margin, m): "
+        + ", ".join(f"{robot.geometry_names[g]} ({m:.3f})" for g, m in robot.field_margins.items())
+    )
     print("markers: " + ", ".join(mobee.marker_names))
     print("constraint clauses: " + ", ".join(mobee.clauses.names))
 
@@ -125,7 +155,9 @@ COMMANDS = {"bench": _Bench, "experiment": _Experiment, "info": _Info, "run": _R
 def main(argv: list[str] | None = None) -> None:
     argv = sys.argv[1:] if argv is None else argv
     parser = argparse.ArgumentParser(
-        prog="mobee-drake", description="MoBeE 2.0 on Drake for the iCub.")
+        prog="mobee-drake", description="MoBeE 2.0 on Drake for the iCub."
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument("command", choices=sorted(COMMANDS))
     parser.add_argument("args", nargs=argparse.REMAINDER)
     known = parser.parse_args(argv[:1])

@@ -24,16 +24,27 @@ class ArmDiagram:
         builder = DiagramBuilder()
         self.plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
         self.robot = AddRobotWithOverlay(
-            self.plant, scene_graph, model_file=MODELS / "three_link_arm.urdf",
-            overlay_file=MODELS / "three_link_arm_overlay.yaml", controlled_joints=JOINTS)
+            self.plant,
+            scene_graph,
+            model_file=MODELS / "three_link_arm.urdf",
+            overlay_file=MODELS / "three_link_arm_overlay.yaml",
+            controlled_joints=JOINTS,
+        )
         world = LiveWorld(self.plant, scene_graph)
         for i, (size, center) in enumerate(boxes):
-            world.Register(SceneObject(name=f"box{i}", shape=Box(size=list(size)),
-                                       position=list(center)))
+            world.Register(
+                SceneObject(name=f"box{i}", shape=Box(size=list(size)), position=list(center))
+            )
         self.plant.Finalize()
         self.params = params or MobeeParams()
-        self.dut = Mobee.AddToBuilder(builder, plant=self.plant, scene_graph=scene_graph,
-                                      robot=self.robot, joints=JOINTS, params=self.params)
+        self.dut = Mobee.AddToBuilder(
+            builder,
+            plant=self.plant,
+            scene_graph=scene_graph,
+            robot=self.robot,
+            joints=JOINTS,
+            params=self.params,
+        )
         self.diagram = builder.Build()
         self.root_context = self.diagram.CreateDefaultContext()
         self.context = self.dut.GetMyMutableContextFromRoot(self.root_context)
@@ -52,5 +63,5 @@ class ArmDiagram:
         X_BW = body.EvalPoseInWorld(self.plant_context).inverse()
         world = self.plant.world_frame()
         return self.plant.CalcJacobianTranslationalVelocity(
-            self.plant_context, JacobianWrtVariable.kV, body.body_frame(), X_BW @ p_WP,
-            world, world)
+            self.plant_context, JacobianWrtVariable.kV, body.body_frame(), X_BW @ p_WP, world, world
+        )

@@ -37,8 +37,7 @@ class AdaptiveRoadmapTest(unittest.TestCase):
     def test_k_nearest_is_symmetric(self):
         roadmap = AdaptiveRoadmap.KNearest(POSES, 1)
         pairs = {tuple(e) for e in roadmap.edges.tolist()}
-        self.assertEqual(pairs, {(0, 1), (1, 0), (1, 4), (4, 1), (2, 1), (1, 2), (3, 2),
-                                 (2, 3)})
+        self.assertEqual(pairs, {(0, 1), (1, 0), (1, 4), (4, 1), (2, 1), (1, 2), (3, 2), (2, 3)})
         np.testing.assert_array_equal(roadmap.status, UNTRIED)
 
     def test_plans_around_infeasible_edges(self):

@@ -34,8 +34,10 @@ class TestBadCommands(unittest.TestCase):
     def test_attractor_outside_the_joint_limits(self):
         self._Fix("attractor", [0.0, 0.0, 3.5])
         with self.assertRaisesRegex(
-                ValueError, r"attractor for joint 'joint3' is 200\.5\d* deg, "
-                            r"outside its limits \[-171\.8\d*, 171\.8\d*\] deg"):
+            ValueError,
+            r"attractor for joint 'joint3' is 200\.5\d* deg, "
+            r"outside its limits \[-171\.8\d*, 171\.8\d*\] deg",
+        ):
             self.arm.Out("total")
 
     def test_non_finite_forces(self):
@@ -63,9 +65,12 @@ class TestBadCommands(unittest.TestCase):
         builder = DiagramBuilder()
         plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
         robot = AddRobotWithOverlay(
-            plant, scene_graph, model_file=MODELS / "three_link_arm.urdf",
+            plant,
+            scene_graph,
+            model_file=MODELS / "three_link_arm.urdf",
             overlay_file=MODELS / "three_link_arm_overlay.yaml",
-            controlled_joints=["joint1", "joint2", "joint3"])
+            controlled_joints=["joint1", "joint2", "joint3"],
+        )
         plant.Finalize()
         with self.assertRaisesRegex(ValueError, "unknown joint 'joint4'; the robot's joints are"):
             Mobee(plant, robot, joints=["joint1", "joint4"])
@@ -82,8 +87,9 @@ class TestBadRobots(unittest.TestCase):
         AddIcub(plant, scene_graph, config)
 
     def test_unknown_model(self):
-        with self.assertRaisesRegex(ValueError, "unknown iCub model 'iCubMars'; icub-models "
-                                                "provides: .*iCubGazeboV2_5"):
+        with self.assertRaisesRegex(
+            ValueError, "unknown iCub model 'iCubMars'; icub-models provides: .*iCubGazeboV2_5"
+        ):
             self._Build(IcubConfig(model="iCubMars"))
 
     def test_unknown_controlled_joint(self):
@@ -91,8 +97,11 @@ class TestBadRobots(unittest.TestCase):
             self._Build(IcubConfig(controlled_joints=["r_elbow", "r_pinky"]))
 
     def test_home_outside_limits(self):
-        with self.assertRaisesRegex(ValueError, "home angle of joint 'r_elbow' is 0 deg, outside "
-                                                r"its limits \[15, 106\] deg"):
+        with self.assertRaisesRegex(
+            ValueError,
+            "home angle of joint 'r_elbow' is 0 deg, outside "
+            r"its limits \[15, 106\] deg",
+        ):
             self._Build(IcubConfig(home_deg={"r_elbow": 0.0}))
 
 
@@ -129,17 +138,22 @@ class TestBadOverlays(unittest.TestCase):
             LoadOverlay("/nowhere.yaml")
 
     def test_bad_values_name_the_element_and_line(self):
-        path = self._Load(self.GOOD.replace("end: [0.6, 0, 0], radius: 0.03",
-                                            "end: [0.6, 0, 0], radius: -0.03"))
+        path = self._Load(
+            self.GOOD.replace("end: [0.6, 0, 0], radius: 0.03", "end: [0.6, 0, 0], radius: -0.03")
+        )
         line = next(i for i, text in enumerate(self.GOOD.splitlines(), 1) if "name: link2" in text)
-        with self.assertRaisesRegex(ValueError, f"{path}:{line}: 'link2': radius must be > 0, "
-                                                "got -0.03"):
+        with self.assertRaisesRegex(
+            ValueError, f"{path}:{line}: 'link2': radius must be > 0, got -0.03"
+        ):
             LoadOverlay(path)
         path = self._Load(self.GOOD + "exclude:\n  - [link1, link9]\n")
         with self.assertRaisesRegex(ValueError, "'link9': exclusion names an unknown primitive"):
             LoadOverlay(path)
-        path = self._Load(self.GOOD.replace("direction: [1, 0, 0]}\n  - {name: elbow",
-                                            "direction: [0, 0, 0]}\n  - {name: elbow"))
+        path = self._Load(
+            self.GOOD.replace(
+                "direction: [1, 0, 0]}\n  - {name: elbow", "direction: [0, 0, 0]}\n  - {name: elbow"
+            )
+        )
         with self.assertRaisesRegex(ValueError, "'tip': direction must not be zero"):
             LoadOverlay(path)
 
@@ -148,8 +162,13 @@ class TestBadOverlays(unittest.TestCase):
         builder = DiagramBuilder()
         plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
         with self.assertRaisesRegex(ValueError, "'link3' is attached to unknown link 'link7'"):
-            AddRobotWithOverlay(plant, scene_graph, model_file=MODELS / "three_link_arm.urdf",
-                                overlay_file=path, controlled_joints=["joint1"])
+            AddRobotWithOverlay(
+                plant,
+                scene_graph,
+                model_file=MODELS / "three_link_arm.urdf",
+                overlay_file=path,
+                controlled_joints=["joint1"],
+            )
 
 
 if __name__ == "__main__":

@@ -17,8 +17,13 @@ def _Literal(joint: str, bound_deg: float) -> Literal:
 
 
 # Five literals, each "q_j >= 0" on one joint (c carries three).
-L1, L2, L3, L4, L5 = (_Literal("a", 0), _Literal("b", 0), _Literal("c", 0), _Literal("c", 0),
-                      _Literal("c", 0))
+L1, L2, L3, L4, L5 = (
+    _Literal("a", 0),
+    _Literal("b", 0),
+    _Literal("c", 0),
+    _Literal("c", 0),
+    _Literal("c", 0),
+)
 
 
 def _Force(clauses, q_deg):
@@ -63,14 +68,14 @@ class TestClauses(unittest.TestCase):
 
     def test_example_3_two_disjunctions(self):
         # (f1 <-> 0  OR  f2 <-> 0)  AND  (f3 <-> 0  OR  f4 <-> 0  OR  f5 <-> 0)
-        clauses = [Clause("12", [L1, L2]),
-                   Clause("345", [L3, _Literal("c", 5), _Literal("c", -5)])]
+        clauses = [Clause("12", [L1, L2]), Clause("345", [L3, _Literal("c", 5), _Literal("c", -5)])]
         # c = 8: literal "c >= 0" (g = 8) and "c >= 5" (g = 3) are inside, "c >= -5" (g = 13) is
         # clear, so the second clause stays off; a and b both inside: the first is on.
         np.testing.assert_allclose(_Force(clauses, [1, 9, 8]), [_Spring(1), _Spring(9), 0])
         # c = 4: all three literals of the second clause inside (g = 4, -1, 9): on, summed.
-        np.testing.assert_allclose(_Force(clauses, [40, 9, 4]),
-                                   [0, 0, _Spring(4) + _Spring(-1) + _Spring(9)])
+        np.testing.assert_allclose(
+            _Force(clauses, [40, 9, 4]), [0, 0, _Spring(4) + _Spring(-1) + _Spring(9)]
+        )
         active = ClauseSet(clauses, JOINTS).ActiveClauses(np.radians([40, 9, 4]), DELTA)
         np.testing.assert_array_equal(active, [False, True])
 
@@ -82,13 +87,15 @@ class TestClauses(unittest.TestCase):
         # z <= 0 never holds: the clause reduces to its other literal, a >= 0.
         clause = Clause("fails", [Literal(coefficients={"z": -1.0}, offset=0.0), L1])
         clauses = ClauseSet([clause], JOINTS, frozen)
-        np.testing.assert_allclose(clauses.Force(np.radians([4, 0, 0]), DELTA, F_MAX),
-                                   [_Spring(4), 0, 0])
+        np.testing.assert_allclose(
+            clauses.Force(np.radians([4, 0, 0]), DELTA, F_MAX), [_Spring(4), 0, 0]
+        )
         # a - z >= -20 deg with z = 30: the literal a >= 10 deg.
         mixed = Clause("mixed", [Literal(coefficients={"a": 1.0, "z": -1.0}, offset=20.0)])
         np.testing.assert_allclose(
             ClauseSet([mixed], JOINTS, frozen).Force(np.radians([14, 0, 0]), DELTA, F_MAX),
-            [_Spring(4), 0, 0])
+            [_Spring(4), 0, 0],
+        )
         with self.assertRaisesRegex(ValueError, "'mixed'.*'z'"):
             ClauseSet([mixed], JOINTS)
 

@@ -13,9 +13,15 @@ from mobee_drake.robots.icub import UPPER_BODY_JOINTS, AddIcub, IcubConfig
 
 # Joint limits of icub-models iCubGazeboV2_5 in degrees (docs: facts, "iCub joint limits").
 EXPECTED_LIMITS_DEG = {
-    "torso_pitch": (-20, 70), "torso_roll": (-30, 30), "torso_yaw": (-50, 50),
-    "r_shoulder_pitch": (-95.5, 10), "r_shoulder_roll": (0, 160.8), "r_shoulder_yaw": (-37, 80),
-    "r_elbow": (15, 106), "r_wrist_prosup": (-60, 60), "r_wrist_pitch": (-80, 25),
+    "torso_pitch": (-20, 70),
+    "torso_roll": (-30, 30),
+    "torso_yaw": (-50, 50),
+    "r_shoulder_pitch": (-95.5, 10),
+    "r_shoulder_roll": (0, 160.8),
+    "r_shoulder_yaw": (-37, 80),
+    "r_elbow": (15, 106),
+    "r_wrist_prosup": (-60, 60),
+    "r_wrist_pitch": (-80, 25),
     "r_wrist_yaw": (-20, 25),
 }
 
@@ -27,9 +33,14 @@ class IcubDiagram:
         self.config = config or IcubConfig()
         self.robot = AddIcub(self.plant, self.scene_graph, self.config)
         self.plant.Finalize()
-        self.dut = Mobee.AddToBuilder(builder, plant=self.plant, scene_graph=self.scene_graph,
-                                      robot=self.robot, joints=self.config.controlled_joints,
-                                      params=params)
+        self.dut = Mobee.AddToBuilder(
+            builder,
+            plant=self.plant,
+            scene_graph=self.scene_graph,
+            robot=self.robot,
+            joints=self.config.controlled_joints,
+            params=params,
+        )
         self.diagram = builder.Build()
         self.root_context = self.diagram.CreateDefaultContext()
         self.context = self.dut.GetMyMutableContextFromRoot(self.root_context)
@@ -78,9 +89,14 @@ class TestIcubModel(unittest.TestCase):
         inspector = self.icub.scene_graph.model_inspector()
         by_name = {name: gid for gid, name in robot.geometry_names.items()}
         # Adjacent links (Drake's own filter) and the overlay's exclusions never interact ...
-        for a, b in (("r_upper_arm", "r_elbow"), ("r_elbow", "r_forearm"),
-                     ("r_upper_arm", "r_forearm"), ("r_forearm", "r_hand"),
-                     ("chest", "r_upper_arm"), ("chest", "head")):
+        for a, b in (
+            ("r_upper_arm", "r_elbow"),
+            ("r_elbow", "r_forearm"),
+            ("r_upper_arm", "r_forearm"),
+            ("r_forearm", "r_hand"),
+            ("chest", "r_upper_arm"),
+            ("chest", "head"),
+        ):
             self.assertTrue(inspector.CollisionFiltered(by_name[a], by_name[b]), (a, b))
         # ... but the hand and the head, the two hands, the forearm and the hips do.
         for a, b in (("r_hand", "head"), ("r_hand", "l_hand"), ("r_forearm", "hips")):
@@ -114,7 +130,7 @@ class TestIcubForces(unittest.TestCase):
         i = icub.dut.marker_index("r_palm")
         f = np.array([3.0, -1.0, 2.0])
         forces = np.zeros(3 * len(icub.dut.marker_names))
-        forces[3 * i:3 * i + 3] = f
+        forces[3 * i : 3 * i + 3] = f
         icub.dut.GetInputPort("marker_forces").FixValue(icub.context, forces)
         f_work = icub.Out("f_work")
         h = 1e-6
@@ -123,16 +139,29 @@ class TestIcubForces(unittest.TestCase):
             dq = np.zeros(len(q))
             dq[j] = h
             icub.SetPositions(q + dq)
-            plus = icub.Out("marker_positions")[3 * i:3 * i + 3]
+            plus = icub.Out("marker_positions")[3 * i : 3 * i + 3]
             icub.SetPositions(q - dq)
-            minus = icub.Out("marker_positions")[3 * i:3 * i + 3]
+            minus = icub.Out("marker_positions")[3 * i : 3 * i + 3]
             J[:, j] = (plus - minus) / (2 * h)
         np.testing.assert_allclose(f_work, Squash(J.T @ f, 1e6, 1.0), atol=1e-7)
         # Only the torso and the right arm move the right palm.
         moving = {icub.dut.joints[j] for j in np.flatnonzero(np.abs(f_work) > 1e-9)}
-        self.assertTrue(moving <= {"torso_pitch", "torso_roll", "torso_yaw", "r_shoulder_pitch",
-                                   "r_shoulder_roll", "r_shoulder_yaw", "r_elbow", "r_wrist_prosup",
-                                   "r_wrist_pitch", "r_wrist_yaw"}, moving)
+        self.assertTrue(
+            moving
+            <= {
+                "torso_pitch",
+                "torso_roll",
+                "torso_yaw",
+                "r_shoulder_pitch",
+                "r_shoulder_roll",
+                "r_shoulder_yaw",
+                "r_elbow",
+                "r_wrist_prosup",
+                "r_wrist_pitch",
+                "r_wrist_yaw",
+            },
+            moving,
+        )
 
     def test_shoulder_cable_constraint(self):
         icub = IcubDiagram()
@@ -159,16 +188,20 @@ class TestIcubForces(unittest.TestCase):
         self.assertLess(f[prosup], 0)
         self.assertEqual(np.count_nonzero(f), 2)
         # Either literal clear of its band keeps the clause off.
-        for angles in ({"r_elbow": 95, "r_wrist_prosup": 20},
-                       {"r_elbow": 70, "r_wrist_prosup": 50}):
+        for angles in (
+            {"r_elbow": 95, "r_wrist_prosup": 20},
+            {"r_elbow": 70, "r_wrist_prosup": 50},
+        ):
             icub.SetDegrees(**angles)
             np.testing.assert_array_equal(icub.Out("f_cst"), 0.0)
 
 
 class TestOtherModels(unittest.TestCase):
     def test_another_icub_and_a_subset_of_joints(self):
-        config = IcubConfig(model="iCubGazeboV2_7",
-                            controlled_joints=["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"])
+        config = IcubConfig(
+            model="iCubGazeboV2_7",
+            controlled_joints=["r_shoulder_pitch", "r_shoulder_roll", "r_elbow"],
+        )
         icub = IcubDiagram(config)
         self.assertEqual(icub.plant.num_positions(), 3)
         # The five shoulder clauses of the right arm remain (the frozen yaw enters as a constant).

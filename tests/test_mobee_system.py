@@ -58,8 +58,9 @@ class TestConfigurationSpaceTerms(unittest.TestCase):
         q = np.array([3.0 - np.radians(5), np.radians(70), np.radians(75)])
         arm.Set(q)
         delta = params.limit_delta
-        np.testing.assert_allclose(arm.Out("f_lim"),
-                                   [-params.limit_force * (delta - np.radians(5)) / delta, 0, 0])
+        np.testing.assert_allclose(
+            arm.Out("f_lim"), [-params.limit_force * (delta - np.radians(5)) / delta, 0, 0]
+        )
         g = np.radians(5) / np.sqrt(2)
         delta = params.constraint_delta
         magnitude = params.constraint_force * (delta - g) / delta
@@ -72,8 +73,9 @@ class TestWorkspaceForces(unittest.TestCase):
         q = np.array([0.3, -0.7, 1.1])
         arm.Set(q)
         f_tip, f_elbow = np.array([1.0, -2.0, 0.5]), np.array([-0.5, 0.0, 0.0])
-        arm.dut.GetInputPort("marker_forces").FixValue(arm.context,
-                                                       np.concatenate([f_tip, f_elbow]))
+        arm.dut.GetInputPort("marker_forces").FixValue(
+            arm.context, np.concatenate([f_tip, f_elbow])
+        )
         p = arm.Out("marker_positions").reshape(2, 3)
         J_tip, J_elbow = arm.Jacobian("link3", p[0]), arm.Jacobian("link2", p[1])
         expected = Squash(J_tip.T @ f_tip + J_elbow.T @ f_elbow, 1e6, 1.0)
@@ -105,8 +107,9 @@ class TestWorkspaceForces(unittest.TestCase):
     def test_marker_directions(self):
         arm = ArmDiagram()
         arm.Set([np.pi / 2, 0.0, 0.0])
-        np.testing.assert_allclose(arm.Out("marker_directions").reshape(2, 3)[0], [0, 1, 0],
-                                   atol=1e-12)
+        np.testing.assert_allclose(
+            arm.Out("marker_directions").reshape(2, 3)[0], [0, 1, 0], atol=1e-12
+        )
 
 
 class TestCollisionForce(unittest.TestCase):
@@ -134,8 +137,9 @@ class TestCollisionForce(unittest.TestCase):
         np.testing.assert_allclose(contact.p_WCa, [0.9, 0.03, 0.0], atol=1e-3)
         np.testing.assert_allclose(contact.nhat_BA_W, [0, -1, 0], atol=1e-2)
         F = 1e3 * (0.05 - d)
-        np.testing.assert_allclose(arm.Out("f_coll"),
-                                   Squash(-F * np.array([0.9, 0.6, 0.3]), 1e6, 1.0), rtol=1e-4)
+        np.testing.assert_allclose(
+            arm.Out("f_coll"), Squash(-F * np.array([0.9, 0.6, 0.3]), 1e6, 1.0), rtol=1e-4
+        )
 
     def test_grows_with_penetration_and_vanishes_outside_the_field(self):
         params = MobeeParams()
@@ -157,8 +161,9 @@ class TestCollisionForce(unittest.TestCase):
         # Folded: link3 comes back near link1 (non-adjacent links, so not filtered), 2.7 cm apart.
         q = np.array([0.0, np.radians(100), np.radians(124)])
         arm.Set(q)
-        contacts = [c for c in arm.Out("field_contacts")
-                    if {c.name_A, c.name_B} == {"link1", "link3"}]
+        contacts = [
+            c for c in arm.Out("field_contacts") if {c.name_A, c.name_B} == {"link1", "link3"}
+        ]
         self.assertEqual(len(contacts), 1)
         (c,) = contacts
         f_W = 1e3 * c.penetration * c.nhat_BA_W
@@ -169,13 +174,17 @@ class TestCollisionForce(unittest.TestCase):
                 g = 1e3 * other.penetration * other.nhat_BA_W
                 expected += arm.Jacobian(other.name_A, other.p_WCa).T @ g
                 expected -= arm.Jacobian(other.name_B, other.p_WCb).T @ g
-        np.testing.assert_allclose(arm.Out("f_coll"), Squash(expected, 1e6, 1.0), rtol=1e-9,
-                                   atol=1e-9)
+        np.testing.assert_allclose(
+            arm.Out("f_coll"), Squash(expected, 1e6, 1.0), rtol=1e-9, atol=1e-9
+        )
         # A small step along the force separates the two links.
         before = c.distance
         arm.Set(q + 1e-4 * arm.Out("f_coll") / np.linalg.norm(arm.Out("f_coll")))
-        after = [x.distance for x in arm.Out("field_contacts")
-                 if {x.name_A, x.name_B} == {"link1", "link3"}]
+        after = [
+            x.distance
+            for x in arm.Out("field_contacts")
+            if {x.name_A, x.name_B} == {"link1", "link3"}
+        ]
         self.assertGreater(after[0], before)
 
 

@@ -29,8 +29,9 @@ class NesTest(unittest.TestCase):
             self.assertAlmostEqual(u.sum(), 0.0)
             self.assertTrue(np.all(np.diff(u) <= 0))  # best rank first
             # Only the ranks k < n/2 + 1 get more than the baseline -1/n.
-            self.assertEqual(int(np.sum(u > -1.0 / n + 1e-12)),
-                             int(np.sum(np.arange(1, n + 1) < n / 2 + 1)))
+            self.assertEqual(
+                int(np.sum(u > -1.0 / n + 1e-12)), int(np.sum(np.arange(1, n + 1) < n / 2 + 1))
+            )
         self.assertEqual(DefaultPopulation(10), 4 + int(3 * math.log(10)))
 
     def test_symmetric_exponential(self):
@@ -45,9 +46,15 @@ class NesTest(unittest.TestCase):
     def test_minimises_a_shifted_quadratic(self):
         center = np.array([3.0, -1.0, 0.5, 2.0])
         for variant in ("xnes", "snes"):
-            result = Minimize(lambda x: float(np.sum((x - center) ** 2)), np.zeros(4), 1.0,
-                              NesConfig(variant=variant, max_evaluations=20000, target_cost=1e-10,
-                                        tolerance=1e-12), np.random.default_rng(0))
+            result = Minimize(
+                lambda x: float(np.sum((x - center) ** 2)),
+                np.zeros(4),
+                1.0,
+                NesConfig(
+                    variant=variant, max_evaluations=20000, target_cost=1e-10, tolerance=1e-12
+                ),
+                np.random.default_rng(0),
+            )
             self.assertEqual(result.reason, "target")
             np.testing.assert_allclose(result.x, center, atol=1e-4)
 
@@ -55,20 +62,27 @@ class NesTest(unittest.TestCase):
         def rosenbrock(x):
             return float(np.sum(100 * (x[1:] - x[:-1] ** 2) ** 2 + (1 - x[:-1]) ** 2))
 
-        result = Minimize(rosenbrock, np.zeros(5), 1.0,
-                          NesConfig(variant="xnes", max_evaluations=20000, target_cost=1e-8,
-                                    tolerance=1e-12), np.random.default_rng(1))
+        result = Minimize(
+            rosenbrock,
+            np.zeros(5),
+            1.0,
+            NesConfig(variant="xnes", max_evaluations=20000, target_cost=1e-8, tolerance=1e-12),
+            np.random.default_rng(1),
+        )
         self.assertEqual(result.reason, "target")
         np.testing.assert_allclose(result.x, np.ones(5), atol=1e-3)
 
     def test_stops_at_the_budget_and_on_convergence(self):
         config = NesConfig(max_evaluations=30, target_cost=-1.0)
-        result = Minimize(lambda x: float(x @ x), np.ones(3), 1.0, config,
-                          np.random.default_rng(0))
+        result = Minimize(lambda x: float(x @ x), np.ones(3), 1.0, config, np.random.default_rng(0))
         self.assertEqual((result.reason, result.evaluations), ("budget", 30))
-        result = Minimize(lambda x: float(x @ x), np.ones(3), 1.0,
-                          NesConfig(max_evaluations=100000, target_cost=-1.0, tolerance=1e-3),
-                          np.random.default_rng(0))
+        result = Minimize(
+            lambda x: float(x @ x),
+            np.ones(3),
+            1.0,
+            NesConfig(max_evaluations=100000, target_cost=-1.0, tolerance=1e-3),
+            np.random.default_rng(0),
+        )
         self.assertEqual(result.reason, "converged")
         self.assertLess(np.linalg.norm(result.x), 1e-2)
 
@@ -81,18 +95,25 @@ class NesTest(unittest.TestCase):
             Minimize(lambda x: 0.0, np.zeros(2), 0.0, NesConfig(), np.random.default_rng(0))
 
 
-def _Evaluation(q=(0.0, 0.0), positions=((0, 0, 0), (0, 0, 0)), directions=((1, 0, 0), (1, 0, 0)),
-                pairs=()):
-    return PoseEvaluation(q=np.array(q, dtype=float),
-                          marker_positions=np.array(positions, dtype=float),
-                          marker_directions=np.array(directions, dtype=float),
-                          collision_pairs=tuple(pairs))
+def _Evaluation(
+    q=(0.0, 0.0), positions=((0, 0, 0), (0, 0, 0)), directions=((1, 0, 0), (1, 0, 0)), pairs=()
+):
+    return PoseEvaluation(
+        q=np.array(q, dtype=float),
+        marker_positions=np.array(positions, dtype=float),
+        marker_directions=np.array(directions, dtype=float),
+        collision_pairs=tuple(pairs),
+    )
 
 
 class CostTest(unittest.TestCase):
     def test_table_3_1(self):
-        e = _Evaluation(q=(0.3, -0.4), positions=((1, 2, 2), (1, 2, 5)),
-                        directions=((0, 1, 0), (1, 0, 0)), pairs=(("a", "b"), ("a", "c")))
+        e = _Evaluation(
+            q=(0.3, -0.4),
+            positions=((1, 2, 2), (1, 2, 5)),
+            directions=((0, 1, 0), (1, 0, 0)),
+            pairs=(("a", "b"), ("a", "c")),
+        )
         self.assertAlmostEqual(HomeCost(np.zeros(2))(e), 0.5)
         self.assertAlmostEqual(HomeCost(np.zeros(2), joints=np.array([1]), weight=2)(e), 0.8)
         self.assertEqual(CollisionCost()(e), 2)
@@ -107,10 +128,16 @@ class CostTest(unittest.TestCase):
 
     def test_clause_violation(self):
         # q0 >= 10 deg, and (q0 <= 20 deg or q1 <= 0 deg).
-        clauses = [Clause(name="floor", literals=[Literal(coefficients={"a": 1.0}, offset=-10.0)]),
-                   Clause(name="either", literals=[
-                       Literal(coefficients={"a": -1.0}, offset=20.0),
-                       Literal(coefficients={"b": -1.0}, offset=0.0)])]
+        clauses = [
+            Clause(name="floor", literals=[Literal(coefficients={"a": 1.0}, offset=-10.0)]),
+            Clause(
+                name="either",
+                literals=[
+                    Literal(coefficients={"a": -1.0}, offset=20.0),
+                    Literal(coefficients={"b": -1.0}, offset=0.0),
+                ],
+            ),
+        ]
         s = ClauseSet(clauses, ["a", "b"])
         self.assertEqual(s.Violation(np.radians([15.0, 5.0])), 0.0)
         self.assertAlmostEqual(s.Violation(np.radians([5.0, 5.0])), math.radians(5.0))
@@ -142,9 +169,16 @@ class IcubIkTest(unittest.TestCase):
         model = self.model
         self.assertEqual(model.Evaluate(model.home).collision_pairs, ())
         # Put the palm into the ball: its pose from a known configuration, the ball moved there.
-        moved = KinematicModel(IcubConfig(), [SceneObject(
-            name="ball", shape=Sphere(radius=0.05),
-            position=list(model.Evaluate(model.home).marker_positions[self.palm]))])
+        moved = KinematicModel(
+            IcubConfig(),
+            [
+                SceneObject(
+                    name="ball",
+                    shape=Sphere(radius=0.05),
+                    position=list(model.Evaluate(model.home).marker_positions[self.palm]),
+                )
+            ],
+        )
         pairs = moved.Evaluate(moved.home).collision_pairs
         self.assertTrue(any("ball" in pair for pair in pairs), pairs)
 
@@ -172,10 +206,12 @@ class IcubIkTest(unittest.TestCase):
                 if model.IsValid(q) and not e.collision_pairs:
                     break
             target = e.marker_positions[self.palm]
-            problem = IkProblem(model, [MarkerPositionCost(self.palm, target), CollisionCost()],
-                                joints=self.joints)
-            solution = SolveNgik(problem, model.home, 0.3,
-                                 NesConfig(max_evaluations=4000, target_cost=0.005), rng)
+            problem = IkProblem(
+                model, [MarkerPositionCost(self.palm, target), CollisionCost()], joints=self.joints
+            )
+            solution = SolveNgik(
+                problem, model.home, 0.3, NesConfig(max_evaluations=4000, target_cost=0.005), rng
+            )
             found = model.Evaluate(solution.q)
             if solution.solved:
                 solved += 1

@@ -53,9 +53,12 @@ class TestObserve(unittest.TestCase):
         # value is that of the swapped divergence of the printed T and P, to four decimals, and
         # Alg. 6 gives what it says instead.
         printed = [  # (T, P, R) of Table 6.4, rows 3-7
-            ([2, 2, 2, 1], [2, 2, 2, 2], 0.0345), ([2, 2, 2, 2, 1], [2, 2, 2, 2, 2], 0.0283),
-            ([2, 2, 2, 2, 2], [2, 3, 2, 2, 2], 0.0142), ([2, 3, 2, 2, 2], [2, 3, 3, 2, 2], 0.0133),
-            ([2, 3, 3, 2, 2], [2, 3, 3, 3, 2], 0.0125)]
+            ([2, 2, 2, 1], [2, 2, 2, 2], 0.0345),
+            ([2, 2, 2, 2, 1], [2, 2, 2, 2, 2], 0.0283),
+            ([2, 2, 2, 2, 2], [2, 3, 2, 2, 2], 0.0142),
+            ([2, 3, 2, 2, 2], [2, 3, 3, 2, 2], 0.0133),
+            ([2, 3, 3, 2, 2], [2, 3, 3, 3, 2], 0.0125),
+        ]
         for (t, p, r), ours in zip(printed, rewards[3:]):
             self.assertAlmostEqual(KlDivergence(t, p), r, delta=1e-4)
             self.assertEqual(ours, round(KlDivergence(p, t), 4))
@@ -72,8 +75,7 @@ class TestStateActionSpaces(unittest.TestCase):
             (Lattice([0.25, 0.5, 0.75], 3, k=8), 27, 216),
         ]
         for space, states, state_actions in cases:
-            self.assertEqual((space.num_states, space.num_state_actions),
-                             (states, state_actions))
+            self.assertEqual((space.num_states, space.num_state_actions), (states, state_actions))
 
     def test_equidistant_neighbours_of_the_rank_3_lattice(self):
         space = Lattice([0.25, 0.5, 0.75], 4)
@@ -193,9 +195,14 @@ class TestSupervisor(unittest.TestCase):
         space = Lattice([0.25, 0.75], 2)
         agent = Agent(name="arm", joints=["b", "c"], space=space)
         dut = ExplorationSupervisor(
-            agents=[agent], joints=["a", "b", "c"], lower=np.array([-1.0, 0.0, 0.0]),
-            upper=np.array([1.0, 2.0, 4.0]), home=np.array([0.5, 0.5, 1.0]),
-            timing=ActionTiming(**timing), period=0.2)
+            agents=[agent],
+            joints=["a", "b", "c"],
+            lower=np.array([-1.0, 0.0, 0.0]),
+            upper=np.array([1.0, 2.0, 4.0]),
+            home=np.array([0.5, 0.5, 1.0]),
+            timing=ActionTiming(**timing),
+            period=0.2,
+        )
         return dut, space
 
     def test_an_action_runs_until_the_robot_settles(self):
@@ -247,10 +254,15 @@ class TestSupervisor(unittest.TestCase):
 
         # A 2 x 2 lattice over joints b, c; the planner starts in state 0 heading for state 3.
         space = Lattice([0.25, 0.75], 2)
-        agent = Agent(name="arm", joints=["b", "c"], space=space,
-                      explorer=ExplorerConfig(strategy="planner", goal_state=3))
-        dut = ExplorationSupervisor(agents=[agent], joints=["b", "c"], lower=np.zeros(2),
-                                    upper=np.ones(2), home=np.zeros(2))
+        agent = Agent(
+            name="arm",
+            joints=["b", "c"],
+            space=space,
+            explorer=ExplorerConfig(strategy="planner", goal_state=3),
+        )
+        dut = ExplorationSupervisor(
+            agents=[agent], joints=["b", "c"], lower=np.zeros(2), upper=np.ones(2), home=np.zeros(2)
+        )
         context = dut.CreateDefaultContext()
         dut.GetInputPort("robot_state").FixValue(context, [0.25, 0.25, 0.0, 0.0])
         dut.ExecuteInitializationEvents(context)
@@ -277,11 +289,11 @@ class TestSupervisor(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "agent 'x': unknown joints \\['z'\\]"):
             ExplorationSupervisor(agents=[Agent("x", ["a", "z"], space)], **kwargs)
         with self.assertRaisesRegex(ValueError, "share a joint"):
-            ExplorationSupervisor(agents=[Agent("x", ["a", "b"], space),
-                                          Agent("y", ["b", "a"], space)], **kwargs)
+            ExplorationSupervisor(
+                agents=[Agent("x", ["a", "b"], space), Agent("y", ["b", "a"], space)], **kwargs
+            )
         with self.assertRaisesRegex(ValueError, "2 dimensions for 1 joints"):
             ExplorationSupervisor(agents=[Agent("x", ["a"], space)], **kwargs)
-
 
 
 class TestExperimentsSmoke(unittest.TestCase):
@@ -294,8 +306,9 @@ class TestExperimentsSmoke(unittest.TestCase):
         from mobee_drake.planning import experiments
 
         output = pathlib.Path(tempfile.mkdtemp())
-        experiments.main(["--experiment", "7.2", "--output", str(output), "--runs", "1",
-                          "--transitions", "3"])
+        experiments.main(
+            ["--experiment", "7.2", "--output", str(output), "--runs", "1", "--transitions", "3"]
+        )
         for strategy in ("curious", "random", "least_tried"):
             self.assertTrue((output / f"7.2_{strategy}_run0.json").is_file())
         self.assertTrue((output / "7.2_coverage.png").is_file())
@@ -308,8 +321,9 @@ class TestExperimentsSmoke(unittest.TestCase):
         self.assertIn("correlation of the right and the left arm", report)
         self.assertIn("hand-table contact", report)
         self.assertTrue((output / "7.4_three_agents.png").is_file())
-        experiments.main(["--experiment", "7.4.1", "--output", str(output), "--transitions", "4",
-                          "--runs", "1"])
+        experiments.main(
+            ["--experiment", "7.4.1", "--output", str(output), "--transitions", "4", "--runs", "1"]
+        )
         self.assertIn("| moving_box |", (output / "report_7.4.1.md").read_text())
 
     def test_detour_problems(self):
@@ -319,8 +333,9 @@ class TestExperimentsSmoke(unittest.TestCase):
         # and 2 -> 1 (over 0 or 3) have one risky and one safe shortest route; 3 -> 0 and 1 -> 2
         # have two safe ones.
         space = Lattice([0.0, 1.0], 2)
-        unreliable = np.array([(s, g) == (0, 1)
-                               for s, g in zip(space.action_state, space.action_goal)])
+        unreliable = np.array(
+            [(s, g) == (0, 1) for s, g in zip(space.action_state, space.action_goal)]
+        )
         self.assertEqual(experiments._DetourProblems(space, unreliable), [(0, 3), (2, 1)])
         self.assertEqual(experiments._DetourProblems(space, np.zeros_like(unreliable)), [])
 

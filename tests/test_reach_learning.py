@@ -17,12 +17,17 @@ from mobee_drake.reaching.executor import Phase, ReachForcing, StateActionExecut
 
 class TestStateActionExecutor(unittest.TestCase):
     def setUp(self):
-        self.timing = ActionTiming(settle_speed=0.1, settle_time=0.5, min_duration=1.0,
-                                   timeout=5.0)
+        self.timing = ActionTiming(settle_speed=0.1, settle_time=0.5, min_duration=1.0, timeout=5.0)
         self.forcing = ReachForcing(marker="palm", force=300.0, softening=0.05)
-        self.dut = StateActionExecutor(num_joints=2, marker_index=1, num_markers=2,
-                                       initial_attractor=np.array([0.1, 0.2]),
-                                       forcing=self.forcing, timing=self.timing, period=0.1)
+        self.dut = StateActionExecutor(
+            num_joints=2,
+            marker_index=1,
+            num_markers=2,
+            initial_attractor=np.array([0.1, 0.2]),
+            forcing=self.forcing,
+            timing=self.timing,
+            period=0.1,
+        )
         self.simulator = Simulator(self.dut)
         self.context = self.simulator.get_mutable_context()
         self.markers = np.array([9.0, 9.0, 9.0, 0.1, 0.2, 0.3])
@@ -33,9 +38,16 @@ class TestStateActionExecutor(unittest.TestCase):
     def Pairs(self, b_is_robot):
         """Fixes MoBeE's field pairs: one per entry, against the robot (True) or not."""
         k = len(b_is_robot)
-        pairs = FieldPairs([None] * k, [None] * k, np.zeros(k), np.full(k, 0.05),
-                           np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)),
-                           np.array(b_is_robot, dtype=bool))
+        pairs = FieldPairs(
+            [None] * k,
+            [None] * k,
+            np.zeros(k),
+            np.full(k, 0.05),
+            np.zeros((k, 3)),
+            np.zeros((k, 3)),
+            np.zeros((k, 3)),
+            np.array(b_is_robot, dtype=bool),
+        )
         self.dut.GetInputPort("field_pairs").FixValue(self.context, AbstractValue.Make(pairs))
 
     def Velocity(self, v):
@@ -170,8 +182,7 @@ class TestBattery(unittest.TestCase):
         from mobee_drake.reaching.robot import SimulatedRobot
 
         meshcat = Meshcat()
-        robot = SimulatedRobot(ReachScenario(), RIGHT_ARM, self.model.space, 0.05,
-                               meshcat=meshcat)
+        robot = SimulatedRobot(ReachScenario(), RIGHT_ARM, self.model.space, 0.05, meshcat=meshcat)
         robot.simulator.set_target_realtime_rate(0.0)  # the test need not wait
         robot.SetProblem(np.array([-0.23, 0.22, 0.19]))
         state = robot.State()
@@ -215,10 +226,12 @@ class TestBattery(unittest.TestCase):
         from mobee_drake.planning.state_space import Lattice
         from mobee_drake.reaching.experiments import LEVELS, RIGHT_ARM
 
-        np.testing.assert_array_equal(Lattice(LEVELS, len(RIGHT_ARM)).action_goal,
-                                      self.model.space.action_goal)
-        result = self.Run("simultaneous", self.Settings("random", 0, 8, [8], 1, 4,
-                                                        mdp="simultaneous"))
+        np.testing.assert_array_equal(
+            Lattice(LEVELS, len(RIGHT_ARM)).action_goal, self.model.space.action_goal
+        )
+        result = self.Run(
+            "simultaneous", self.Settings("random", 0, 8, [8], 1, 4, mdp="simultaneous")
+        )
         log = np.array(result["log"])
         counts = np.load(self.output / "simultaneous" / "mdp.npz")["counts"]
         initial = Explorer(self.model.space).transitions.counts
@@ -255,8 +268,12 @@ class TestBattery(unittest.TestCase):
             if result["settings"]["strategy"] == "goal_babbling":
                 # Goals of its own, in the targets' box grown by their radius.
                 grid = LoadTargetGrid().Centres()
-                self.assertTrue(np.all((log[:, 7:] >= grid.min(axis=0) - 0.05)
-                                       & (log[:, 7:] <= grid.max(axis=0) + 0.05)))
+                self.assertTrue(
+                    np.all(
+                        (log[:, 7:] >= grid.min(axis=0) - 0.05)
+                        & (log[:, 7:] <= grid.max(axis=0) + 0.05)
+                    )
+                )
                 self.assertFalse(np.any(np.all(np.isin(log[:, 7:], grid), axis=1)))
             else:  # Least-tried problems first: 12 tries on 12 different problems.
                 self.assertEqual(len(np.unique(log[log[:, 2] >= 432][:, 1])), len(reaches))
@@ -269,8 +286,12 @@ class TestBattery(unittest.TestCase):
         report = Report(self.output, results)
         self.assertIn("| intrinsic |", report)
         self.assertIn("| goal_babbling |", report)
-        for figure in ("8.2_cumulative_reward.png", "8.7_problem_tries.png",
-                       "8.8_failed_transitions.png", "8.4-8.6_reaches_greedy.png"):
+        for figure in (
+            "8.2_cumulative_reward.png",
+            "8.7_problem_tries.png",
+            "8.8_failed_transitions.png",
+            "8.4-8.6_reaches_greedy.png",
+        ):
             self.assertTrue((self.output / figure).is_file(), figure)
 
     def test_resume_after_a_kill_is_exact(self):

@@ -65,6 +65,7 @@ class TestPredictors(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "distance_unit must be > 0, got 0"):
             RewardHistories([True], PredictorConfig(distance_unit=0.0))
 
+
 if __name__ == "__main__":
     unittest.main()
 
@@ -103,8 +104,16 @@ class FakeRobot:
         return self.palms[self.state]
 
 
-def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10, predictor="weighted",
-             learn_mdp=False, goals=None, distance_unit=1.0):
+def _Learner(
+    strategy="greedy",
+    seed=0,
+    targets=None,
+    max_actions=10,
+    predictor="weighted",
+    learn_mdp=False,
+    goals=None,
+    distance_unit=1.0,
+):
     from mobee_drake.planning.state_space import Lattice
     from mobee_drake.reaching.learner import ReachLearner, ReachLearningConfig
     from mobee_drake.reaching.predictors import PredictorConfig
@@ -112,12 +121,24 @@ def _Learner(strategy="greedy", seed=0, targets=None, max_actions=10, predictor=
     space = Lattice([0.25, 0.75], 2)  # states 0=(0,0) 1=(0,1) 2=(1,0) 3=(1,1)
     T = np.zeros((space.num_state_actions, space.num_states))
     T[np.arange(space.num_state_actions), space.action_goal] = 1.0
-    targets = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]) \
-        if targets is None else targets
-    return space, ReachLearner(space, T, targets, ReachLearningConfig(
-        strategy=strategy, seed=seed, max_actions=max_actions,
-        predictor=PredictorConfig(predictor, distance_unit=distance_unit), learn_mdp=learn_mdp,
-        **({} if goals is None else dict(goals=goals))))
+    targets = (
+        np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+        if targets is None
+        else targets
+    )
+    return space, ReachLearner(
+        space,
+        T,
+        targets,
+        ReachLearningConfig(
+            strategy=strategy,
+            seed=seed,
+            max_actions=max_actions,
+            predictor=PredictorConfig(predictor, distance_unit=distance_unit),
+            learn_mdp=learn_mdp,
+            **({} if goals is None else dict(goals=goals)),
+        ),
+    )
 
 
 PALMS = np.array([[0.3, 0, 0], [0.2, 0, 0], [0.1, 0, 0], [0.0, 0, 0]], dtype=float)
@@ -141,7 +162,7 @@ class TestReachLearner(unittest.TestCase):
         q, v = learner.Values(rewards)
         gamma = learner.config.gamma
         # V(3) = 1 (the reach is terminal, not repeated), one step away gamma, two gamma^2.
-        np.testing.assert_allclose(v, [gamma ** 2, gamma, gamma, 1.0], atol=1e-3)
+        np.testing.assert_allclose(v, [gamma**2, gamma, gamma, 1.0], atol=1e-3)
         self.assertAlmostEqual(q[learner.Reach(3)], 1.0)
 
     def test_fresh_optimist_reaches_at_once(self):
@@ -198,10 +219,12 @@ class TestReachLearner(unittest.TestCase):
         robot = FakeRobot(space, PALMS)
         for _ in range(6):
             learner.Explore(robot)
-        before = (list(learner.log), learner.problem_tries.copy(),
-                  learner.rng.bit_generator.state,
-                  [learner.histories.History(sa)[2].copy()
-                   for sa in range(learner.num_state_actions)])
+        before = (
+            list(learner.log),
+            learner.problem_tries.copy(),
+            learner.rng.bit_generator.state,
+            [learner.histories.History(sa)[2].copy() for sa in range(learner.num_state_actions)],
+        )
         results = learner.Evaluate(robot, seed=7)
         self.assertEqual(sorted(r.problem for r in results), [0, 1, 2])
         self.assertTrue(all(r.reward is None or 0 < r.reward <= 1 for r in results))
@@ -213,10 +236,14 @@ class TestReachLearner(unittest.TestCase):
 
     def test_exact_resume(self):
         for strategy, predictor, learn_mdp in [
-                ("random", "weighted", False), ("greedy", "weighted", False),
-                ("intrinsic", "weighted", False), ("intrinsic", "gaussian_process", False),
-                ("random", "weighted", True), ("intrinsic", "weighted", True),
-                ("goal_babbling", "weighted", False)]:
+            ("random", "weighted", False),
+            ("greedy", "weighted", False),
+            ("intrinsic", "weighted", False),
+            ("intrinsic", "gaussian_process", False),
+            ("random", "weighted", True),
+            ("intrinsic", "weighted", True),
+            ("goal_babbling", "weighted", False),
+        ]:
             space, whole = _Learner(strategy, seed=3, predictor=predictor, learn_mdp=learn_mdp)
 
             def Robot(space=space):
@@ -238,7 +265,8 @@ class TestReachLearner(unittest.TestCase):
             np.testing.assert_array_equal(resumed.model.counts, whole.model.counts)
             with self.assertRaisesRegex(ValueError, "configuration"):
                 _Learner("random" if strategy != "random" else "greedy", seed=3)[1].LoadArrays(
-                    arrays, data)
+                    arrays, data
+                )
 
     def test_learned_mdp_tells_model_updates_from_penalties(self):
         # Ch. 9.4.1: from state 0, the edge to 1 is blocked by the robot's own body (a model
@@ -252,8 +280,10 @@ class TestReachLearner(unittest.TestCase):
         initial = learner.model.counts.copy()
         for _ in range(4):
             learner.Explore(robot)
-        edge = {g: int(np.flatnonzero((space.action_state == 0) & (space.action_goal == g))[0])
-                for g in (1, 2)}
+        edge = {
+            g: int(np.flatnonzero((space.action_state == 0) & (space.action_goal == g))[0])
+            for g in (1, 2)
+        }
         tried = [row[2] for row in learner.log]
         n1, n2 = tried.count(edge[1]), tried.count(edge[2])
         self.assertGreaterEqual(min(n1, n2), 1)
@@ -266,7 +296,7 @@ class TestReachLearner(unittest.TestCase):
         # Rewarding that edge alone: V(0) = 1 + gamma (p_stay V(0) + p_go V(1)), V(1) = gamma V(0).
         _, v = learner.Values(np.eye(learner.num_state_actions)[edge[1]])
         gamma, p_go = learner.config.gamma, 1 / (2 + n1)
-        self.assertAlmostEqual(v[0], 1 / (1 - gamma * (1 - p_go) - gamma ** 2 * p_go), delta=0.01)
+        self.assertAlmostEqual(v[0], 1 / (1 - gamma * (1 - p_go) - gamma**2 * p_go), delta=0.01)
         # Blocked by the target: penalised, model unchanged; nothing else was learned.
         self.assertEqual(learner.histories.History(edge[2])[2].tolist(), [-10.0] * n2)
         changed = np.flatnonzero(np.any(learner.model.counts != initial, axis=1))
@@ -283,8 +313,9 @@ class TestReachLearner(unittest.TestCase):
 
         # Small regions so the goal space splits within the test (g_max 6, zeta 4).
         interest = InterestConfig(max_region_goals=6, window=4, min_child_goals=2)
-        space, learner = _Learner("goal_babbling", seed=2, goals=ReachGoalsConfig(interest,
-                                                                                  margin=0.1))
+        space, learner = _Learner(
+            "goal_babbling", seed=2, goals=ReachGoalsConfig(interest, margin=0.1)
+        )
         robot = FakeRobot(space, PALMS, state=1)
         starts = []
         for _ in range(40):
@@ -341,8 +372,9 @@ class TestGaussianProcessPredictor(unittest.TestCase):
         # One record: prior + (v - prior) k / (1 + rho).
         self.assertAlmostEqual(h.Predict(1, [0, 0, 0]), 1 - 0.4 / (1 + rho))
         d = 0.05
-        self.assertAlmostEqual(h.Predict(1, [d, 0, 0]),
-                               1 - 0.4 * np.exp(-d ** 2 / (2 * 0.1 ** 2)) / (1 + rho))
+        self.assertAlmostEqual(
+            h.Predict(1, [d, 0, 0]), 1 - 0.4 * np.exp(-(d**2) / (2 * 0.1**2)) / (1 + rho)
+        )
         # Far from every record the prediction returns to the prior (eq. 8.5 approaches it only
         # as 1 / distance).
         self.assertAlmostEqual(h.Predict(1, [2, 0, 0]), 1.0, places=9)

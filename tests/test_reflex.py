@@ -24,20 +24,29 @@ from mobee_drake.robots.overlay import Clause, Literal
 
 H = 0.02
 # One pair inside its field (the controller only asks whether there is any).
-ONE_PAIR = FieldPairs([None], [None], np.zeros(1), np.full(1, 0.05), np.zeros((1, 3)),
-                      np.zeros((1, 3)), np.zeros((1, 3)), np.ones(1, dtype=bool))
+ONE_PAIR = FieldPairs(
+    [None],
+    [None],
+    np.zeros(1),
+    np.full(1, 0.05),
+    np.zeros((1, 3)),
+    np.zeros((1, 3)),
+    np.zeros((1, 3)),
+    np.ones(1, dtype=bool),
+)
 
 
 class ReflexControllerTest(unittest.TestCase):
     def Make(self, *, history=100, clauses=()):
         controller = ReflexController(
-            initial_positions=np.zeros(2), period=H,
+            initial_positions=np.zeros(2),
+            period=H,
             params=ReflexParams(speed_deg=10.0, history=history, tolerance_deg=0.01),
-            clauses=ClauseSet(list(clauses), ["a", "b"]))
+            clauses=ClauseSet(list(clauses), ["a", "b"]),
+        )
         simulator = Simulator(controller)
         context = simulator.get_mutable_context()
-        controller.GetInputPort("field_pairs").FixValue(context, AbstractValue.Make(
-            NO_FIELD_PAIRS))
+        controller.GetInputPort("field_pairs").FixValue(context, AbstractValue.Make(NO_FIELD_PAIRS))
         return controller, simulator, context
 
     def Q(self, controller, context):
@@ -59,8 +68,10 @@ class ReflexControllerTest(unittest.TestCase):
         simulator.AdvanceTo((steps + 2) * H)
         np.testing.assert_allclose(self.Q(controller, context), command, atol=1e-12)
         status = self.Status(controller, context)
-        self.assertEqual((status[MODE], status[COMMANDS], status[COMPLETED], status[REFLEXES]),
-                         (HOLDING, 1, 1, 0))
+        self.assertEqual(
+            (status[MODE], status[COMMANDS], status[COMPLETED], status[REFLEXES]),
+            (HOLDING, 1, 1, 0),
+        )
 
     def test_the_reflex_retraces_the_move_back_to_its_waypoint(self):
         controller, simulator, context = self.Make()
@@ -83,13 +94,11 @@ class ReflexControllerTest(unittest.TestCase):
             controller.GetInputPort("command").FixValue(context, np.radians([0.0, 0.0]))
         # The poses of the way out, in reverse order, ending at the waypoint.
         expected = path[-2::-1] + [first]
-        np.testing.assert_allclose(np.array(back[:len(expected)]), np.array(expected),
-                                   atol=1e-12)
+        np.testing.assert_allclose(np.array(back[: len(expected)]), np.array(expected), atol=1e-12)
         status = self.Status(controller, context)
         self.assertEqual((status[COMMANDS], status[COMPLETED], status[REFLEXES]), (2, 1, 1))
         # Trouble gone: the suppressed command now runs.
-        controller.GetInputPort("field_pairs").FixValue(context, AbstractValue.Make(
-            NO_FIELD_PAIRS))
+        controller.GetInputPort("field_pairs").FixValue(context, AbstractValue.Make(NO_FIELD_PAIRS))
         simulator.AdvanceTo(3.0)
         np.testing.assert_allclose(self.Q(controller, context), np.zeros(2), atol=1e-12)
         self.assertEqual(self.Status(controller, context)[COMMANDS], 3)
@@ -104,8 +113,9 @@ class ReflexControllerTest(unittest.TestCase):
         self.assertEqual((status[MODE], status[STUCK_COUNT]), (STUCK, 1))
         # Ten moves of 0.2 deg (the updates at 0 ... 9 H), then back as far as the history
         # allowed (two poses before the current one), and it stays there.
-        np.testing.assert_allclose(self.Q(controller, context),
-                                   np.radians([10 * 0.2 - 2 * 0.2, 0.0]), atol=1e-12)
+        np.testing.assert_allclose(
+            self.Q(controller, context), np.radians([10 * 0.2 - 2 * 0.2, 0.0]), atol=1e-12
+        )
 
     def test_a_violated_clause_triggers_the_reflex(self):
         # b <= 1 deg.

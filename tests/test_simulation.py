@@ -28,8 +28,11 @@ REACH = DIAGRAMS / "reach_around_ball.yaml"
 def _Palm(simulation, context):
     mobee = simulation.mobee
     i = mobee.marker_index("r_palm")
-    return mobee.GetOutputPort("marker_positions").Eval(
-        mobee.GetMyContextFromRoot(context))[3 * i:3 * i + 3].copy()
+    return (
+        mobee.GetOutputPort("marker_positions")
+        .Eval(mobee.GetMyContextFromRoot(context))[3 * i : 3 * i + 3]
+        .copy()
+    )
 
 
 def _RunAgents(scenario):
@@ -121,23 +124,32 @@ class TestVirtualDynamics(unittest.TestCase):
         # M q'' = -K (q - 1) - C q' with K = 50, C = 50: overdamped, its slow pole at -1.02/s,
         # so after 30 s it is at q = 1 to within e^-30.
         h, K, C = 0.02, 50.0, 50.0
-        dut = VirtualDynamics(mass=np.ones(1), damping=np.array([C]), period=h,
-                              initial_positions=np.zeros(1))
+        dut = VirtualDynamics(
+            mass=np.ones(1), damping=np.array([C]), period=h, initial_positions=np.zeros(1)
+        )
         context = dut.CreateDefaultContext()
         for _ in range(1500):
             q, v = context.get_discrete_state_vector().value()
             dut.GetInputPort("total").FixValue(context, [-K * (q - 1.0) - C * v])
             dut.GetInputPort("damping").FixValue(context, [-C * v])
             context.SetDiscreteState(dut.EvalUniquePeriodicDiscreteUpdate(context).value())
-        np.testing.assert_allclose(context.get_discrete_state_vector().value(), [1.0, 0.0],
-                                   atol=1e-6)
+        np.testing.assert_allclose(
+            context.get_discrete_state_vector().value(), [1.0, 0.0], atol=1e-6
+        )
 
 
 class TestRandomAttractors(unittest.TestCase):
     def test_reproducible_in_range_and_home_elsewhere(self):
         lower, upper, home = np.array([-1.0, 0.0, 2.0]), np.array([1.0, 2.0, 4.0]), np.zeros(3)
-        kwargs = dict(lower=lower, upper=upper, home=home, babbling=[True, True, False],
-                      range_fraction=0.5, period=2.0, seed=7)
+        kwargs = dict(
+            lower=lower,
+            upper=upper,
+            home=home,
+            babbling=[True, True, False],
+            range_fraction=0.5,
+            period=2.0,
+            seed=7,
+        )
         draws = []
         for _ in range(2):
             dut = RandomAttractorSource(**kwargs)
@@ -165,8 +177,10 @@ class TestSafetyMonitor(unittest.TestCase):
         source = scene_graph.RegisterSource("test")
         ball, table, thing, arm, chest = (
             scene_graph.RegisterAnchoredGeometry(
-                source, GeometryInstance(RigidTransform(), DrakeSphere(0.1), name))
-            for name in ("ball", "table", "thing", "arm", "chest"))
+                source, GeometryInstance(RigidTransform(), DrakeSphere(0.1), name)
+            )
+            for name in ("ball", "table", "thing", "arm", "chest")
+        )
         query = scene_graph.get_query_output_port().Eval(scene_graph.CreateDefaultContext())
         dut = SafetyMonitor(names=["ball", "table"], period=0.01)
         context = dut.CreateDefaultContext()
@@ -174,9 +188,16 @@ class TestSafetyMonitor(unittest.TestCase):
 
         def Step(ids, distances):
             k = len(ids)
-            pairs = FieldPairs([arm] * k, list(ids), np.array(distances), np.full(k, 0.03),
-                               np.zeros((k, 3)), np.zeros((k, 3)), np.zeros((k, 3)),
-                               np.array([i == chest for i in ids]))
+            pairs = FieldPairs(
+                [arm] * k,
+                list(ids),
+                np.array(distances),
+                np.full(k, 0.03),
+                np.zeros((k, 3)),
+                np.zeros((k, 3)),
+                np.zeros((k, 3)),
+                np.array([i == chest for i in ids]),
+            )
             dut.GetInputPort("field_pairs").FixValue(context, pairs)
             context.SetDiscreteState(dut.EvalUniquePeriodicDiscreteUpdate(context).value())
 
@@ -184,8 +205,10 @@ class TestSafetyMonitor(unittest.TestCase):
         Step([ball, chest, thing], [0.01, -0.002, 0.025])
         Step([ball], [0.015])
         report = dut.Report(context)
-        self.assertEqual(report.closest_approach, {"ball": 0.01, "table": None, "(self)": -0.002,
-                                                   "(other objects)": 0.025})
+        self.assertEqual(
+            report.closest_approach,
+            {"ball": 0.01, "table": None, "(self)": -0.002, "(other objects)": 0.025},
+        )
         self.assertEqual(report.penetrating_steps, 1)
         self.assertAlmostEqual(report.deepest_penetration, 0.002)
 
@@ -198,7 +221,8 @@ class TestKinematicRobot(unittest.TestCase):
         ball = next(o for o in scenario.objects if o.name == "ball")
         center, radius = np.array(ball.position), ball.shape.radius
         report = simulation.monitor.Report(
-            simulation.monitor.GetMyContextFromRoot(simulator.get_context()))
+            simulation.monitor.GetMyContextFromRoot(simulator.get_context())
+        )
         self.assertEqual(report.penetrating_steps, 0)
         self.assertGreater(report.closest_approach["ball"], 0.0)
         # The palm went past the ball (from y = 0.14 to the other side of its centre) ...
@@ -271,7 +295,8 @@ class TestDynamicRobot(unittest.TestCase):
         error = np.degrees(np.abs(states[:, :n] - self.kinematic[:, :n])).max()
         self.assertLess(error, tolerance_deg, control)
         report = simulation.monitor.Report(
-            simulation.monitor.GetMyContextFromRoot(simulator.get_context()))
+            simulation.monitor.GetMyContextFromRoot(simulator.get_context())
+        )
         self.assertEqual(report.penetrating_steps, 0, control)
         np.testing.assert_allclose(palms, self.kinematic_palms, atol=0.01)
 
@@ -316,8 +341,15 @@ class TestLiveWorld(unittest.TestCase):
         self.assertEqual(world.role("ball"), "obstacle")
         world.Move(context, "ball", [-0.6, 0.0, 0.3])
         palm = _Palm(simulation, context)
-        world.Add(context, SceneObject(name="cube", shape=Sphere(radius=0.02),
-                                       position=list(palm + [-0.05, 0, 0]), role="obstacle"))
+        world.Add(
+            context,
+            SceneObject(
+                name="cube",
+                shape=Sphere(radius=0.02),
+                position=list(palm + [-0.05, 0, 0]),
+                role="obstacle",
+            ),
+        )
         self.assertIn("cube", Touching())
         simulator.AdvanceTo(1.5)  # The simulation goes on with the new object ...
         self.assertGreater(np.linalg.norm(_Palm(simulation, context) - palm), 0.0)
@@ -333,7 +365,8 @@ class TestLiveWorld(unittest.TestCase):
 
     def test_scenario_events(self):
         scenario = LoadScenario(
-            REACH, "{duration: 3, world_events: [{time: 0.1, object: ball, role: ghost}]}")
+            REACH, "{duration: 3, world_events: [{time: 0.1, object: ball, role: ghost}]}"
+        )
         simulation = BuildSimulation(scenario)
         simulator = Simulator(simulation.diagram)
         simulator.Initialize()
@@ -344,7 +377,8 @@ class TestLiveWorld(unittest.TestCase):
         # The hand was still outside the ball's field at 0.1 s; from then on MoBeE ignores the
         # ball, so the motion is exactly the one without it.
         report = simulation.monitor.Report(
-            simulation.monitor.GetMyContextFromRoot(simulator.get_context()))
+            simulation.monitor.GetMyContextFromRoot(simulator.get_context())
+        )
         self.assertIsNone(report.closest_approach["ball"])
         scenario.objects = [o for o in scenario.objects if o.name != "ball"]
         scenario.world_events = []
@@ -364,8 +398,9 @@ class TestExploration(unittest.TestCase):
         # state-action's count of its goal grew by its tries (the initialisation put 1 there).
         tried = np.flatnonzero(explorer.tries)
         goals = explorer.space.action_goal[tried]
-        np.testing.assert_array_equal(explorer.transitions.counts[tried, goals],
-                                      2 + explorer.tries[tried])
+        np.testing.assert_array_equal(
+            explorer.transitions.counts[tried, goals], 2 + explorer.tries[tried]
+        )
         # The attractor is the goal centre of the action in flight, inside the joint limits.
         q_star = simulation.attractor.Eval(context)
         lower, upper = simulation.mobee.position_limits
@@ -375,8 +410,10 @@ class TestExploration(unittest.TestCase):
 class TestPlanningOnTheRobot(unittest.TestCase):
     def test_planner_reuses_a_learned_model_to_reach_a_goal(self):
         folder = pathlib.Path(tempfile.mkdtemp()) / "learned"
-        RunScenario(LoadScenario(DIAGRAMS / "explore_hypercube.yaml", "{duration: 30}"),
-                    checkpoint=str(folder))
+        RunScenario(
+            LoadScenario(DIAGRAMS / "explore_hypercube.yaml", "{duration: 30}"),
+            checkpoint=str(folder),
+        )
         # The goal: the corner of the hypercube opposite the start (4 steps away).
         scenario = LoadScenario(DIAGRAMS / "explore_hypercube.yaml", "{duration: 60}")
         simulation = BuildSimulation(scenario)
@@ -421,8 +458,12 @@ class TestCheckpoints(unittest.TestCase):
             context = simulator.get_context()
             supervisor = simulation.diagram.GetSubsystemByName("attractor")
             (record,) = supervisor.Records(supervisor.GetMyContextFromRoot(context))
-            return (simulation.robot_state.Eval(context).copy(), record.explorer.tries.copy(),
-                    record.explorer.transitions.counts.copy(), record.state_action)
+            return (
+                simulation.robot_state.Eval(context).copy(),
+                record.explorer.tries.copy(),
+                record.explorer.transitions.counts.copy(),
+                record.state_action,
+            )
 
         # Uninterrupted: 0 to 30 s.
         simulation = BuildSimulation(scenario)
@@ -479,7 +520,7 @@ class TestInteractive(unittest.TestCase):
         # MoBeE's field forces are drawn while the hand is near the ball: put it 1 cm off the palm.
         mobee, mobee_context = simulation.mobee, simulation.mobee.GetMyContextFromRoot(context)
         i = mobee.marker_index("r_palm")
-        normal = mobee.GetOutputPort("marker_directions").Eval(mobee_context)[3 * i:3 * i + 3]
+        normal = mobee.GetOutputPort("marker_directions").Eval(mobee_context)[3 * i : 3 * i + 3]
         ball = _Palm(simulation, context) + 0.05 * normal
         simulation.world.Move(simulator.get_mutable_context(), "ball", ball)
         simulation.diagram.ForcedPublish(context)
@@ -499,19 +540,23 @@ class BallSwitcher(LeafSystem):
         super().__init__()
         self._ball = np.asarray(ball_position)
         self._palm = 3 * mobee.marker_index("r_palm")
-        self._positions = self.DeclareVectorInputPort("marker_positions",
-                                                      3 * len(mobee.marker_names))
+        self._positions = self.DeclareVectorInputPort(
+            "marker_positions", 3 * len(mobee.marker_names)
+        )
         self._issued = self.DeclareAbstractState(AbstractValue.Make([]))
         self.DeclarePeriodicUnrestrictedUpdateEvent(0.1, 0.0, self._Update)
         self.DeclareAbstractOutputPort(
-            "world_events", lambda: AbstractValue.Make([]),
+            "world_events",
+            lambda: AbstractValue.Make([]),
             lambda context, output: output.set_value(
-                context.get_abstract_state(int(self._issued)).get_value()),
-            prerequisites_of_calc={self.abstract_state_ticket(self._issued)})
+                context.get_abstract_state(int(self._issued)).get_value()
+            ),
+            prerequisites_of_calc={self.abstract_state_ticket(self._issued)},
+        )
 
     def _Update(self, context, state):
         issued = context.get_abstract_state(int(self._issued)).get_value()
-        palm = self._positions.Eval(context)[self._palm:self._palm + 3]
+        palm = self._positions.Eval(context)[self._palm : self._palm + 3]
         if not issued and np.linalg.norm(palm - self._ball) < 0.10:
             event = WorldEvent(time=context.get_time(), object="ball", role="ghost")
             state.get_mutable_abstract_state(int(self._issued)).set_value([event])
@@ -524,8 +569,9 @@ class TestSupervisorWorldEvents(unittest.TestCase):
 
         def Prebuild(parts):
             switcher = parts.builder.AddNamedSystem("switcher", BallSwitcher(parts.mobee, ball))
-            parts.builder.Connect(parts.mobee.GetOutputPort("marker_positions"),
-                                  switcher.get_input_port())
+            parts.builder.Connect(
+                parts.mobee.GetOutputPort("marker_positions"), switcher.get_input_port()
+            )
 
         simulation = BuildSimulation(scenario, prebuild=Prebuild)
         simulator = Simulator(simulation.diagram)
@@ -541,16 +587,20 @@ class TestRunner(unittest.TestCase):
 
         path = pathlib.Path(tempfile.mkdtemp()) / "run.html"
         meshcat = Meshcat()
-        summary = RunScenario(LoadScenario(REACH, "{duration: 1}"), meshcat=meshcat,
-                              record=str(path))
+        summary = RunScenario(
+            LoadScenario(REACH, "{duration: 1}"), meshcat=meshcat, record=str(path)
+        )
         self.assertEqual(summary.recording, str(path.resolve()))
         text = path.read_text()
         self.assertTrue(text.startswith("<!DOCTYPE html>"))
         self.assertGreater(len(text), 1_000_000)  # the meshes and the animation are embedded
         # The robot, the translucent attractor robot, the ball, the trail.
-        for scene_path in ("/drake/illustration/icub_iCubGazeboV2_5",
-                           "/drake/illustration/attractor", "/drake/illustration/ball",
-                           "/trail"):
+        for scene_path in (
+            "/drake/illustration/icub_iCubGazeboV2_5",
+            "/drake/illustration/attractor",
+            "/drake/illustration/ball",
+            "/trail",
+        ):
             self.assertTrue(meshcat.HasPath(scene_path), scene_path)
         self.assertAlmostEqual(summary.simulated_time, 1.0)
         self.assertIn("penetrations of solid geometry: 0", summary.Format())

@@ -16,15 +16,17 @@ class TestSquash(unittest.TestCase):
     def test_zero_and_slope_at_zero(self):
         self.assertEqual(Squash(np.array([0.0]), self.m, self.k)[0], 0.0)
         h = 1e-7
-        slope = (Squash(np.array([h]), self.m, self.k)
-                 - Squash(np.array([-h]), self.m, self.k)) / (2 * h)
+        slope = (Squash(np.array([h]), self.m, self.k) - Squash(np.array([-h]), self.m, self.k)) / (
+            2 * h
+        )
         np.testing.assert_allclose(slope, self.k, rtol=1e-6)
 
     def test_limit_is_m_and_odd_and_increasing(self):
         v = np.linspace(-1e6, 1e6, 20001)
         L = Squash(v, self.m, self.k)
-        np.testing.assert_allclose(Squash(np.array([1e9, -1e9]), self.m, self.k), [2.0, -2.0],
-                                   rtol=1e-8)
+        np.testing.assert_allclose(
+            Squash(np.array([1e9, -1e9]), self.m, self.k), [2.0, -2.0], rtol=1e-8
+        )
         self.assertTrue(np.all(np.abs(L) < self.m))
         np.testing.assert_allclose(L, -Squash(-v, self.m, self.k))
         self.assertTrue(np.all(np.diff(L) > 0))
@@ -35,8 +37,9 @@ class TestSquash(unittest.TestCase):
 
     def test_per_dimension_parameters(self):
         v = np.array([1.0, 1.0])
-        np.testing.assert_allclose(Squash(v, np.array([1.0, 10.0]), np.array([1.0, 1.0])),
-                                   [1 / 2, 10 / 11])
+        np.testing.assert_allclose(
+            Squash(v, np.array([1.0, 10.0]), np.array([1.0, 1.0])), [1 / 2, 10 / 11]
+        )
 
 
 class TestJointLimitForce(unittest.TestCase):

@@ -20,11 +20,20 @@ FAST_NES = NesConfig(variant="snes", max_evaluations=300, target_cost=-1.0, tole
 
 class TaskSpaceTest(unittest.TestCase):
     def test_table_3_2(self):
-        e = PoseEvaluation(q=np.array([0.1, 0.2, 0.3]),
-                           marker_positions=np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]),
-                           marker_directions=np.zeros((2, 3)), collision_pairs=())
-        space = TaskSpace((MarkerCoordinates(1), MarkerAlong(0, (1.0, 1.0, 1.0)),
-                           JointCoordinates((2, 0)), MarkerCoordinates(0, (2,))))
+        e = PoseEvaluation(
+            q=np.array([0.1, 0.2, 0.3]),
+            marker_positions=np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]),
+            marker_directions=np.zeros((2, 3)),
+            collision_pairs=(),
+        )
+        space = TaskSpace(
+            (
+                MarkerCoordinates(1),
+                MarkerAlong(0, (1.0, 1.0, 1.0)),
+                JointCoordinates((2, 0)),
+                MarkerCoordinates(0, (2,)),
+            )
+        )
         self.assertEqual(space.dimension, 7)
         np.testing.assert_allclose(space(e), [4, 5, 6, 6, 0.3, 0.1, 3])
 
@@ -66,13 +75,17 @@ class IcubTrmTest(unittest.TestCase):
         palm = cls.model.Evaluate(cls.model.home).marker_positions[cls.palm]
         # A 6 cm cube around the resting palm, vertices 3 cm apart: a small map that ends.
         cls.box = (palm - 0.03, palm + 0.03)
-        cls.terms = [HomeCost(cls.model.home, weight=0.1), CollisionCost(),
-                     MarkerInBox(cls.palm, *cls.box, weight=10.0)]
+        cls.terms = [
+            HomeCost(cls.model.home, weight=0.1),
+            CollisionCost(),
+            MarkerInBox(cls.palm, *cls.box, weight=10.0),
+        ]
         cls.config = TrmConfig(spacing=0.03, delta=0.5, nes=FAST_NES)
         cls.problem = IkProblem(cls.model, cls.terms, joints=JOINTS)
         cls.space = TaskSpace((MarkerCoordinates(cls.palm),))
-        cls.roadmap = BuildTrm(cls.problem, cls.space, cls.model.home, cls.config,
-                               np.random.default_rng(0))
+        cls.roadmap = BuildTrm(
+            cls.problem, cls.space, cls.model.home, cls.config, np.random.default_rng(0)
+        )
 
     def test_vertices_are_valid_solutions_spread_in_task_space(self):
         r = self.roadmap
@@ -119,8 +132,10 @@ class IcubTrmTest(unittest.TestCase):
         np.testing.assert_array_equal(loaded.q, self.roadmap.q)
         np.testing.assert_array_equal(loaded.edges, self.roadmap.edges)
         self.assertEqual(loaded.simplices, self.roadmap.simplices)
-        with tempfile.TemporaryDirectory() as folder, self.assertRaisesRegex(FileNotFoundError,
-                                                                             "roadmap.npz"):
+        with (
+            tempfile.TemporaryDirectory() as folder,
+            self.assertRaisesRegex(FileNotFoundError, "roadmap.npz"),
+        ):
             TaskRelevantRoadmap.Load(folder)
 
     def test_a_roadmap_as_the_mdp_state_space(self):
@@ -137,9 +152,11 @@ class IcubTrmTest(unittest.TestCase):
         r = self.roadmap
         with tempfile.TemporaryDirectory() as folder:
             r.Save(folder)
-            scenario = Scenario(attractor=ExploreAttractor(agents=[ExploringAgent(
-                joints=JOINTS, roadmap=folder)]), time_step=0.02,
-                visualization=Visualization(meshcat=False))
+            scenario = Scenario(
+                attractor=ExploreAttractor(agents=[ExploringAgent(joints=JOINTS, roadmap=folder)]),
+                time_step=0.02,
+                visualization=Visualization(meshcat=False),
+            )
             simulation = BuildSimulation(scenario)
         space = simulation.diagram.GetSubsystemByName("attractor").agents[0].space
         self.assertEqual(space.num_states, r.num_vertices)
@@ -161,8 +178,9 @@ class ReachIntoTest(unittest.TestCase):
     def test_the_hand_goes_into_the_box_without_touching_it(self):
         example = ReachInto()
         config = TrmConfig(max_vertices=6, nes=FAST_NES)
-        roadmap = BuildTrm(example.problem, example.task_space, example.q_init, config,
-                           np.random.default_rng(1))
+        roadmap = BuildTrm(
+            example.problem, example.task_space, example.q_init, config, np.random.default_rng(1)
+        )
         self.assertEqual(roadmap.num_vertices, 6)
         box = example.problem.terms[-1]
         for q in roadmap.q:

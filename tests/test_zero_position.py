@@ -27,8 +27,10 @@ def _Write(text: str) -> pathlib.Path:
 
 
 def _Tree(body: str) -> str:
-    return ('<?xml version="1.0"?>\n<ZeroPositionKinematicTree version="1.0" robotName="r">\n'
-            f'<bodypart name="arm">\n{body}\n</bodypart>\n</ZeroPositionKinematicTree>\n')
+    return (
+        '<?xml version="1.0"?>\n<ZeroPositionKinematicTree version="1.0" robotName="r">\n'
+        f'<bodypart name="arm">\n{body}\n</bodypart>\n</ZeroPositionKinematicTree>\n'
+    )
 
 
 def _Plant(robot, **kwargs):
@@ -106,9 +108,14 @@ class TestKatana(unittest.TestCase):
 
 class TestFormat(unittest.TestCase):
     def test_numbers_with_blanks_sphere_field_and_marker(self):
-        robot = LoadZeroPositionTree(_Write(_Tree(
-            '<link z="- .5" radius="0.1" field="0.15">'
-            '<sphere radius=".05" px="1" field="true"/><marker name="tip"/></link>')))
+        robot = LoadZeroPositionTree(
+            _Write(
+                _Tree(
+                    '<link z="- .5" radius="0.1" field="0.15">'
+                    '<sphere radius=".05" px="1" field="true"/><marker name="tip"/></link>'
+                )
+            )
+        )
         capsule, sphere = (p.shape for p in robot.overlay.primitives)
         np.testing.assert_allclose(capsule.end, [0, 0, -0.5])
         self.assertAlmostEqual(robot.overlay.primitives[0].field, 0.05)  # 0.15 - 0.1
@@ -120,8 +127,9 @@ class TestFormat(unittest.TestCase):
         np.testing.assert_allclose(marker.direction, [0, 0, -1])
 
     def test_box_orientation(self):
-        robot = LoadZeroPositionTree(_Write(_Tree(
-            '<box width="1" depth="2" height="3" hx="1" angle="90"/>')))
+        robot = LoadZeroPositionTree(
+            _Write(_Tree('<box width="1" depth="2" height="3" hx="1" angle="90"/>'))
+        )
         from pydrake.math import RollPitchYaw
 
         (box,) = (p.shape for p in robot.overlay.primitives)
@@ -132,11 +140,16 @@ class TestFormat(unittest.TestCase):
 
     def test_constraints_over_motors(self):
         # Motor 0 drives joint arm_0 one to one; motor 1 maps [0, 100] onto arm_1's [-50, 50].
-        robot = LoadZeroPositionTree(_Write(_Tree(
-            '<motor minPos="-90" maxPos="90"><joint z="1" minPos="-90" maxPos="90">'
-            '<link x="1"><motor minPos="0" maxPos="100">'
-            '<joint z="1" minPos="-50" maxPos="50"/></motor></link></joint></motor>'
-            '<constraintList><constraint a="1 2" q="0 1" b="100"/></constraintList>')))
+        robot = LoadZeroPositionTree(
+            _Write(
+                _Tree(
+                    '<motor minPos="-90" maxPos="90"><joint z="1" minPos="-90" maxPos="90">'
+                    '<link x="1"><motor minPos="0" maxPos="100">'
+                    '<joint z="1" minPos="-50" maxPos="50"/></motor></link></joint></motor>'
+                    '<constraintList><constraint a="1 2" q="0 1" b="100"/></constraintList>'
+                )
+            )
+        )
         (clause,) = robot.overlay.clauses
         clauses = ClauseSet(robot.overlay.clauses, ["arm_0", "arm_1"], {})
         # a . m < b  <=>  100 - m0 - 2 m1 > 0 with m0 = q0, m1 = q1 + 50 (degrees).
@@ -156,23 +169,34 @@ class TestErrors(unittest.TestCase):
     def test_errors_name_file_line_and_element(self):
         self._Fails(_Tree('<link z="1">'), r"robot\.xml:\d+: malformed XML")
         self._Fails(_Tree('<wheel z="1"/>'), r"robot\.xml:4: <wheel>: unknown element")
-        self._Fails(_Tree('<link z="1" colour="red"/>'),
-                    r"robot\.xml:4: <link>: unknown attribute\(s\) \['colour'\]")
-        self._Fails(_Tree('<motor minPos="0" maxPos="1">\n<joint z="1" minPos="5" maxPos="-5"/>'
-                          '</motor>'), r"robot\.xml:5: <joint>: minPos 5.0 must be smaller")
-        self._Fails(_Tree('<motor minPos="0" maxPos="1"><joint z="1" minPos="0" maxPos="1"/>'
-                          '</motor>\n<constraintList><constraint a="1" q="3" b="0"/>'
-                          '</constraintList>'),
-                    r"robot\.xml:5: <constraint>: q names motor 3, but this bodypart has 1")
+        self._Fails(
+            _Tree('<link z="1" colour="red"/>'),
+            r"robot\.xml:4: <link>: unknown attribute\(s\) \['colour'\]",
+        )
+        self._Fails(
+            _Tree('<motor minPos="0" maxPos="1">\n<joint z="1" minPos="5" maxPos="-5"/></motor>'),
+            r"robot\.xml:5: <joint>: minPos 5.0 must be smaller",
+        )
+        self._Fails(
+            _Tree(
+                '<motor minPos="0" maxPos="1"><joint z="1" minPos="0" maxPos="1"/>'
+                '</motor>\n<constraintList><constraint a="1" q="3" b="0"/>'
+                "</constraintList>"
+            ),
+            r"robot\.xml:5: <constraint>: q names motor 3, but this bodypart has 1",
+        )
         self._Fails(_Tree('<link z="abc"/>'), r'<link>: z="abc" is not a number')
-        self._Fails(_Tree('<link z="1" radius="0.2" field="0.1"/>'),
-                    "field 0.1 is smaller than radius 0.2")
-        self._Fails(_Tree('<joint z="1" minPos="0" maxPos="1"/>'),
-                    "a joint must sit inside the motor that drives it")
-        self._Fails(_Tree('<box width="1" depth="1" height="1" field="true"/>'),
-                    "field volumes are supported for spheres only")
-
-
+        self._Fails(
+            _Tree('<link z="1" radius="0.2" field="0.1"/>'), "field 0.1 is smaller than radius 0.2"
+        )
+        self._Fails(
+            _Tree('<joint z="1" minPos="0" maxPos="1"/>'),
+            "a joint must sit inside the motor that drives it",
+        )
+        self._Fails(
+            _Tree('<box width="1" depth="1" height="1" field="true"/>'),
+            "field volumes are supported for spheres only",
+        )
 
 
 class TestKatanaScenario(unittest.TestCase):
@@ -180,16 +204,20 @@ class TestKatanaScenario(unittest.TestCase):
         from mobee_drake.simulation.runner import RunScenario
         from mobee_drake.simulation.scenario import LoadScenario
 
-        scenario = LoadScenario(MODELS.parent / "diagrams" / "katana.yaml",
-                                "{duration: 30.0, visualization: {meshcat: false}}")
+        scenario = LoadScenario(
+            MODELS.parent / "diagrams" / "katana.yaml",
+            "{duration: 30.0, visualization: {meshcat: false}}",
+        )
         summary = RunScenario(scenario)
         self.assertEqual(summary.safety.penetrating_steps, 0)
         # The arm came inside the field of at least one obstacle, and MoBeE kept it out.
-        approaches = [d for name, d in summary.safety.closest_approach.items()
-                      if name in ("post", "ball", "shelf") and d is not None]
+        approaches = [
+            d
+            for name, d in summary.safety.closest_approach.items()
+            if name in ("post", "ball", "shelf") and d is not None
+        ]
         self.assertTrue(approaches)
         self.assertGreater(min(approaches), 0.0)
-
 
 
 class TestTwoRobots(unittest.TestCase):
@@ -201,8 +229,9 @@ class TestTwoRobots(unittest.TestCase):
         from mobee_drake.simulation.builder import BuildSimulation
         from mobee_drake.simulation.scenario import LoadScenario
 
-        scenario = LoadScenario(MODELS.parent / "diagrams" / "icub_and_katana.yaml",
-                                "{visualization: {meshcat: false}}")
+        scenario = LoadScenario(
+            MODELS.parent / "diagrams" / "icub_and_katana.yaml", "{visualization: {meshcat: false}}"
+        )
         simulation = BuildSimulation(scenario)
         simulator = Simulator(simulation.diagram)
         simulator.Initialize()
@@ -214,10 +243,13 @@ class TestTwoRobots(unittest.TestCase):
         for t in np.arange(1.0, 61.0, 1.0):
             simulator.AdvanceTo(t)
             pairs = katana.GetOutputPort("field_pairs").Eval(katana.GetMyContextFromRoot(context))
-            bodies = [simulation.plant.GetBodyFromFrameId(inspector.GetFrameId(b))
-                      for b in pairs.geometry_B]
+            bodies = [
+                simulation.plant.GetBodyFromFrameId(inspector.GetFrameId(b))
+                for b in pairs.geometry_B
+            ]
             samples_with_icub_in_katana_fields += any(
-                b is not None and b.model_instance() == icub for b in bodies)
+                b is not None and b.model_instance() == icub for b in bodies
+            )
         self.assertGreater(samples_with_icub_in_katana_fields, 0)
         report = simulation.monitor.Report(simulation.monitor.GetMyContextFromRoot(context))
         self.assertEqual(report.penetrating_steps, 0)
@@ -228,10 +260,12 @@ class TestTwoRobots(unittest.TestCase):
         from mobee_drake.simulation.scenario import LoadScenario
         from mobee_drake.yaml_io import YamlFileError
 
-        with self.assertRaisesRegex(YamlFileError, "companion 'katana': other robots run in "
-                                    "kinematic scenarios only"):
-            LoadScenario(MODELS.parent / "diagrams" / "icub_and_katana.yaml",
-                         "{robot_model: dynamic}")
+        with self.assertRaisesRegex(
+            YamlFileError, "companion 'katana': other robots run in kinematic scenarios only"
+        ):
+            LoadScenario(
+                MODELS.parent / "diagrams" / "icub_and_katana.yaml", "{robot_model: dynamic}"
+            )
 
 
 if __name__ == "__main__":

@@ -62,10 +62,17 @@ def RunOne(controller: str, seed: int, minutes: float, scenario_file: str) -> di
     state = logs["state"].FindLog(context)
     attractor = logs["attractor"].FindLog(context)
     errors = CommandErrors(state.data()[:n], attractor.data())
-    row = {"controller": controller, "seed": seed, "wall": wall, "commands": len(errors),
-           "completed": int(np.sum(errors <= REACHED_DEG)),
-           "near": int(np.sum(errors <= NEAR_DEG)), "errors": errors,
-           "penetrating": safety.penetrating_steps, "deepest": safety.deepest_penetration}
+    row = {
+        "controller": controller,
+        "seed": seed,
+        "wall": wall,
+        "commands": len(errors),
+        "completed": int(np.sum(errors <= REACHED_DEG)),
+        "near": int(np.sum(errors <= NEAR_DEG)),
+        "errors": errors,
+        "penetrating": safety.penetrating_steps,
+        "deepest": safety.deepest_penetration,
+    }
     if controller == "reflex":
         reflex = simulation.diagram.GetSubsystemByName("reflex")
         status = reflex.GetOutputPort("status").Eval(reflex.GetMyContextFromRoot(context))
@@ -76,29 +83,36 @@ def RunOne(controller: str, seed: int, minutes: float, scenario_file: str) -> di
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(prog="mobee-drake bench babbling",
-                                     description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="mobee-drake bench babbling", description=__doc__.split("\n")[0]
+    )
     parser.add_argument("--seeds", type=int, default=5)
     parser.add_argument("--minutes", type=float, default=5.0)
     parser.add_argument("--scenario", default=SCENARIO)
     args = parser.parse_args(argv)
     print(f"{SCENARIO}, {args.seeds} seeds x {args.minutes} simulated minutes per controller")
-    print("| controller | penetrating periods/min | deepest mm | commands/min | within 2 deg/min "
-          "| within 10 deg/min | median error deg | reflexes or stalls/min | runs stuck "
-          "| wall s/run |")
+    print(
+        "| controller | penetrating periods/min | deepest mm | commands/min | within 2 deg/min "
+        "| within 10 deg/min | median error deg | reflexes or stalls/min | runs stuck "
+        "| wall s/run |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|")
     for controller in ("reflex", "mobee2"):
         rows = [RunOne(controller, seed, args.minutes, args.scenario) for seed in range(args.seeds)]
-        per_minute = {key: np.mean([r[key] for r in rows]) / args.minutes
-                      for key in ("penetrating", "commands", "completed", "near", "reflexes")}
+        per_minute = {
+            key: np.mean([r[key] for r in rows]) / args.minutes
+            for key in ("penetrating", "commands", "completed", "near", "reflexes")
+        }
         median_error = np.median(np.concatenate([r["errors"] for r in rows]))
         label = "MoBeE 1.0 (reflex)" if controller == "reflex" else "MoBeE 2.0"
-        print(f"| {label} | {per_minute['penetrating']:.2f} | "
-              f"{1000 * max(r['deepest'] for r in rows):.1f} | {per_minute['commands']:.1f} | "
-              f"{per_minute['completed']:.2f} | {per_minute['near']:.2f} | {median_error:.1f} | "
-              f"{per_minute['reflexes']:.2f} | "
-              f"{sum(r['stuck'] for r in rows)} of {len(rows)} | "
-              f"{np.mean([r['wall'] for r in rows]):.1f} |")
+        print(
+            f"| {label} | {per_minute['penetrating']:.2f} | "
+            f"{1000 * max(r['deepest'] for r in rows):.1f} | {per_minute['commands']:.1f} | "
+            f"{per_minute['completed']:.2f} | {per_minute['near']:.2f} | {median_error:.1f} | "
+            f"{per_minute['reflexes']:.2f} | "
+            f"{sum(r['stuck'] for r in rows)} of {len(rows)} | "
+            f"{np.mean([r['wall'] for r in rows]):.1f} |"
+        )
 
 
 if __name__ == "__main__":

@@ -31,8 +31,10 @@ from mobee_drake.simulation.world import LiveWorld
 # Where boxes are placed, per robot (root frame, metres). In front of the iCub (x backwards, y
 # right, z up): 60 cm in front of the chest, 1.2 m across and 1 m high; the arms reach about half
 # of it. Around the Katana: its reach (about 0.5 m around the shoulder at (0, 0, -0.01)).
-BOX_REGIONS = {"icub": (np.array([-0.80, -0.60, -0.40]), np.array([-0.20, 0.60, 0.60])),
-               "katana": (np.array([-0.50, -0.50, -0.20]), np.array([0.50, 0.50, 0.55]))}
+BOX_REGIONS = {
+    "icub": (np.array([-0.80, -0.60, -0.40]), np.array([-0.20, 0.60, 0.60])),
+    "katana": (np.array([-0.50, -0.50, -0.20]), np.array([0.50, 0.50, 0.55])),
+}
 ROBOTS = {"icub": IcubConfig, "katana": ZeroPositionConfig}
 
 
@@ -47,8 +49,11 @@ class ForceBenchmarkResult:
 
 def _RandomBox(name: str, robot: str, rng: np.random.Generator) -> SceneObject:
     low, high = BOX_REGIONS[robot]
-    return SceneObject(name=name, shape=Box(size=rng.uniform(0.02, 0.05, size=3).tolist()),
-                       position=rng.uniform(low, high).tolist())
+    return SceneObject(
+        name=name,
+        shape=Box(size=rng.uniform(0.02, 0.05, size=3).tolist()),
+        position=rng.uniform(low, high).tolist(),
+    )
 
 
 def _BuildRobotAmongBoxes(robot: str, num_boxes: int, rng: np.random.Generator):
@@ -59,14 +64,16 @@ def _BuildRobotAmongBoxes(robot: str, num_boxes: int, rng: np.random.Generator):
     for i in range(num_boxes):
         world.Register(_RandomBox(f"box{i}", robot, rng))
     plant.Finalize()
-    mobee = Mobee.AddToBuilder(builder, plant=plant, scene_graph=scene_graph, robot=overlay,
-                               joints=joints)
+    mobee = Mobee.AddToBuilder(
+        builder, plant=plant, scene_graph=scene_graph, robot=overlay, joints=joints
+    )
     diagram = builder.Build()
     return diagram, plant, mobee, world
 
 
-def _OscillatorPoses(mobee: Mobee, num_poses: int, rng: np.random.Generator,
-                     amplitude: float = 1.0) -> np.ndarray:
+def _OscillatorPoses(
+    mobee: Mobee, num_poses: int, rng: np.random.Generator, amplitude: float = 1.0
+) -> np.ndarray:
     """Poses 10 ms apart, each joint on its own sinusoid.
 
     With ``amplitude`` 1 every joint sweeps its whole range (Fig. 2.4); with a smaller amplitude it
@@ -81,9 +88,16 @@ def _OscillatorPoses(mobee: Mobee, num_poses: int, rng: np.random.Generator,
     return np.clip(q, q_min, q_max)
 
 
-def MeasureForceEvaluations(num_obstacles: int, *, robot: str = "icub", num_poses: int = 2000,
-                            repeats: int = 5, amplitude: float = 1.0, churn: bool = False,
-                            seed: int = 0) -> ForceBenchmarkResult:
+def MeasureForceEvaluations(
+    num_obstacles: int,
+    *,
+    robot: str = "icub",
+    num_poses: int = 2000,
+    repeats: int = 5,
+    amplitude: float = 1.0,
+    churn: bool = False,
+    seed: int = 0,
+) -> ForceBenchmarkResult:
     """Times ``repeats`` sweeps of ``num_poses`` total-force evaluations among boxes; with
     ``churn``, each evaluation follows the removal of one box and the insertion of another."""
     rng = np.random.default_rng(seed)
@@ -92,8 +106,10 @@ def MeasureForceEvaluations(num_obstacles: int, *, robot: str = "icub", num_pose
     plant_context = plant.GetMyMutableContextFromRoot(context)
     mobee_context = mobee.GetMyContextFromRoot(context)
     boxes = [f"box{i}" for i in range(num_obstacles)]
-    replacements = [_RandomBox(f"new{k}", robot, rng)
-                    for k in range(num_poses * repeats if churn and boxes else 0)]
+    replacements = [
+        _RandomBox(f"new{k}", robot, rng)
+        for k in range(num_poses * repeats if churn and boxes else 0)
+    ]
     total, contacts = mobee.GetOutputPort("total"), mobee.GetOutputPort("field_contacts")
     # The plant's positions are the controlled joints, possibly in another order.
     order = [plant.GetJointByName(j).position_start() for j in mobee.joints]
@@ -117,36 +133,56 @@ def MeasureForceEvaluations(num_obstacles: int, *, robot: str = "icub", num_pose
         x[order] = q
         plant.SetPositions(plant_context, x)
         pairs += len(contacts.Eval(mobee_context))
-    return ForceBenchmarkResult(num_obstacles, max(rates), float(np.median(rates)),
-                                pairs / len(poses[::10]))
+    return ForceBenchmarkResult(
+        num_obstacles, max(rates), float(np.median(rates)), pairs / len(poses[::10])
+    )
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--robot", choices=sorted(ROBOTS), nargs="+", default=["icub"])
     parser.add_argument("--obstacles", type=int, nargs="+", default=[0, 10, 30, 100, 300])
     parser.add_argument("--poses", type=int, default=2000, help="evaluations per sweep")
     parser.add_argument("--repeats", type=int, default=5, help="sweeps per row")
-    parser.add_argument("--amplitude", type=float, default=1.0,
-                        help="fraction of each joint's range swept (1: the whole range, Fig. 2.4)")
-    parser.add_argument("--churn", action="store_true",
-                        help="remove one box and insert another before every evaluation (Alg. 1)")
+    parser.add_argument(
+        "--amplitude",
+        type=float,
+        default=1.0,
+        help="fraction of each joint's range swept (1: the whole range, Fig. 2.4)",
+    )
+    parser.add_argument(
+        "--churn",
+        action="store_true",
+        help="remove one box and insert another before every evaluation (Alg. 1)",
+    )
     parser.add_argument("--plot", default="", help="save the curves (like Fig. 2.4) to this PNG")
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)
-    print("| robot | boxes | evaluations/s (best) | evaluations/s (median) | us/evaluation (best) "
-          "| pairs inside fields (mean) |")
+    print(
+        "| robot | boxes | evaluations/s (best) | evaluations/s (median) | us/evaluation (best) "
+        "| pairs inside fields (mean) |"
+    )
     print("|---|---:|---:|---:|---:|---:|")
     curves = {}
     for robot in args.robot:
         for n in args.obstacles:
-            r = MeasureForceEvaluations(n, robot=robot, num_poses=args.poses,
-                                        repeats=args.repeats, amplitude=args.amplitude,
-                                        churn=args.churn, seed=args.seed)
+            r = MeasureForceEvaluations(
+                n,
+                robot=robot,
+                num_poses=args.poses,
+                repeats=args.repeats,
+                amplitude=args.amplitude,
+                churn=args.churn,
+                seed=args.seed,
+            )
             curves.setdefault(robot, []).append((n, r.best_per_second, r.median_per_second))
-            print(f"| {robot} | {n} | {r.best_per_second:,.0f} | {r.median_per_second:,.0f} | "
-                  f"{1e6 / r.best_per_second:.0f} | {r.mean_pairs_in_fields:.2f} |", flush=True)
+            print(
+                f"| {robot} | {n} | {r.best_per_second:,.0f} | {r.median_per_second:,.0f} | "
+                f"{1e6 / r.best_per_second:.0f} | {r.mean_pairs_in_fields:.2f} |",
+                flush=True,
+            )
     if args.plot:
         import matplotlib
 

@@ -36,9 +36,10 @@ from mobee_drake.robots.icub import RIGHT_ARM_JOINTS, TORSO_JOINTS, IcubConfig
 from mobee_drake.simulation.scenario import Box, SceneObject, Sphere
 
 JOINTS = list(TORSO_JOINTS + RIGHT_ARM_JOINTS)
-OBJECTS = [SceneObject(name="table", shape=Box(size=[0.5, 0.9, 0.04]),
-                       position=[-0.38, 0.0, -0.17]),
-           SceneObject(name="ball", shape=Sphere(radius=0.06), position=[-0.32, 0.12, 0.05])]
+OBJECTS = [
+    SceneObject(name="table", shape=Box(size=[0.5, 0.9, 0.04]), position=[-0.38, 0.0, -0.17]),
+    SceneObject(name="ball", shape=Sphere(radius=0.06), position=[-0.32, 0.12, 0.05]),
+]
 SIGMA = 0.3  # initial spread (rad) of the sampling solvers
 BUDGET = 6000  # cost evaluations per solve
 SOLVERS = ("ngik_xnes", "ngik_snes", "cma_es", "drake_ik")
@@ -74,14 +75,24 @@ def Terms(model: KinematicModel, target: Target, oriented: bool) -> list:
 
 def SolveCma(problem: IkProblem, start: np.ndarray, target_cost: float, seed: int) -> IkSolution:
     began = time.perf_counter()
-    options = {"ftarget": target_cost, "maxfevals": BUDGET, "verbose": -9, "seed": seed + 1,
-               "tolx": 1e-4}
+    options = {
+        "ftarget": target_cost,
+        "maxfevals": BUDGET,
+        "verbose": -9,
+        "seed": seed + 1,
+        "tolx": 1e-4,
+    }
     strategy = cma.CMAEvolutionStrategy(problem.SearchVector(start), SIGMA, options)
     strategy.optimize(problem.Cost)
     seconds = time.perf_counter() - began
     evaluation, cost = problem.Evaluate(strategy.result.xbest)
-    return IkSolution(q=evaluation.q, cost=cost, solved=problem.IsSolved(evaluation),
-                      evaluations=strategy.result.evaluations, seconds=seconds)
+    return IkSolution(
+        q=evaluation.q,
+        cost=cost,
+        solved=problem.IsSolved(evaluation),
+        evaluations=strategy.result.evaluations,
+        seconds=seconds,
+    )
 
 
 def SolveDrakeIk(problem: IkProblem, target: Target, oriented: bool) -> IkSolution:
@@ -99,11 +110,13 @@ def SolveDrakeIk(problem: IkProblem, target: Target, oriented: bool) -> IkSoluti
     palm = model.markers[model.MarkerIndex("r_palm")]
     hand = plant.GetBodyByName(palm.body_name).body_frame()
     half = MarkerPositionCost(0, target.position).tolerance / 2
-    ik.AddPositionConstraint(hand, palm.p_BM, plant.world_frame(), target.position - half,
-                             target.position + half)
+    ik.AddPositionConstraint(
+        hand, palm.p_BM, plant.world_frame(), target.position - half, target.position + half
+    )
     if oriented:
         ik.AddAngleBetweenVectorsConstraint(
-            plant.world_frame(), target.direction, hand, palm.u_B, 0.0, np.radians(9.0))
+            plant.world_frame(), target.direction, hand, palm.u_B, 0.0, np.radians(9.0)
+        )
     ik.AddMinimumDistanceLowerBoundConstraint(0.0, 0.02)
     # A single-literal clause is a linear constraint a.q + b >= 0; the disjunctions are not (a
     # pose that violates one fails the final check).
@@ -117,8 +130,13 @@ def SolveDrakeIk(problem: IkProblem, target: Target, oriented: bool) -> IkSoluti
     seconds = time.perf_counter() - began
     q_found = result.GetSolution(q)[positions]
     evaluation, cost = problem.Evaluate(q_found[problem.columns])
-    return IkSolution(q=evaluation.q, cost=cost, solved=problem.IsSolved(evaluation),
-                      evaluations=0, seconds=seconds)
+    return IkSolution(
+        q=evaluation.q,
+        cost=cost,
+        solved=problem.IsSolved(evaluation),
+        evaluations=0,
+        seconds=seconds,
+    )
 
 
 def PosesPerSecond(model: KinematicModel, rng: np.random.Generator, count: int = 2000) -> float:
@@ -134,8 +152,9 @@ def PosesPerSecond(model: KinematicModel, rng: np.random.Generator, count: int =
 def Run(problems: int, seed: int) -> list[dict]:
     model = KinematicModel(IcubConfig(), OBJECTS)
     rng = np.random.default_rng(seed)
-    print(f"kinematic model: {PosesPerSecond(model, rng):.0f} random poses/s with a table and a "
-          "ball")
+    print(
+        f"kinematic model: {PosesPerSecond(model, rng):.0f} random poses/s with a table and a ball"
+    )
     targets = RandomTargets(model, problems, rng)
     rows = []
     for oriented in (False, True):
@@ -145,41 +164,56 @@ def Run(problems: int, seed: int) -> list[dict]:
                 problem = IkProblem(model, Terms(model, target, oriented), joints=JOINTS)
                 target_cost = problem.terms[0].tolerance / 2
                 if solver.startswith("ngik"):
-                    config = NesConfig(variant=solver.split("_")[1], max_evaluations=BUDGET,
-                                       target_cost=target_cost)
-                    solutions.append(SolveNgik(problem, model.home, SIGMA, config,
-                                               np.random.default_rng([seed, k])))
+                    config = NesConfig(
+                        variant=solver.split("_")[1],
+                        max_evaluations=BUDGET,
+                        target_cost=target_cost,
+                    )
+                    solutions.append(
+                        SolveNgik(
+                            problem, model.home, SIGMA, config, np.random.default_rng([seed, k])
+                        )
+                    )
                 elif solver == "cma_es":
                     solutions.append(SolveCma(problem, model.home, target_cost, seed + k))
                 else:
                     solutions.append(SolveDrakeIk(problem, target, oriented))
             seconds = np.array([s.seconds for s in solutions])
             solved = np.array([s.solved for s in solutions])
-            rows.append({
-                "family": "position + normal" if oriented else "position",
-                "solver": solver, "solved": float(solved.mean()),
-                "median_ms": 1000 * float(np.median(seconds)),
-                "mean_ms": 1000 * float(seconds.mean()),
-                "evaluations": float(np.mean([s.evaluations for s in solutions])),
-                "solves_per_s": float(len(solutions) / seconds.sum())})
+            rows.append(
+                {
+                    "family": "position + normal" if oriented else "position",
+                    "solver": solver,
+                    "solved": float(solved.mean()),
+                    "median_ms": 1000 * float(np.median(seconds)),
+                    "mean_ms": 1000 * float(seconds.mean()),
+                    "evaluations": float(np.mean([s.evaluations for s in solutions])),
+                    "solves_per_s": float(len(solutions) / seconds.sum()),
+                }
+            )
     return rows
 
 
 def Format(rows: list[dict], problems: int) -> str:
-    lines = [f"{problems} problems per family; budget {BUDGET} evaluations; sigma {SIGMA} rad",
-             "| problems | solver | solved | median ms | mean ms | evaluations | solves/s |",
-             "|---|---|---|---|---|---|---|"]
+    lines = [
+        f"{problems} problems per family; budget {BUDGET} evaluations; sigma {SIGMA} rad",
+        "| problems | solver | solved | median ms | mean ms | evaluations | solves/s |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
         evaluations = f"{r['evaluations']:.0f}" if r["evaluations"] else "-"
-        lines.append(f"| {r['family']} | {r['solver']} | {100 * r['solved']:.0f} % | "
-                     f"{r['median_ms']:.1f} | {r['mean_ms']:.1f} | {evaluations} | "
-                     f"{r['solves_per_s']:.1f} |")
+        lines.append(
+            f"| {r['family']} | {r['solver']} | {100 * r['solved']:.0f} % | "
+            f"{r['median_ms']:.1f} | {r['mean_ms']:.1f} | {evaluations} | "
+            f"{r['solves_per_s']:.1f} |"
+        )
     return "\n".join(lines)
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(prog="mobee-drake bench ik",
-                                     description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="mobee-drake bench ik", description=__doc__.split("\n")[0]
+    )
     parser.add_argument("--problems", type=int, default=50)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)

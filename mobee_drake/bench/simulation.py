@@ -19,28 +19,40 @@ SCENARIO = pathlib.Path(__file__).resolve().parents[2] / "diagrams" / "motor_bab
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--seconds", type=float, default=600.0, help="simulated time per run")
-    parser.add_argument("--controls", nargs="*", default=["position"],
-                        help="dynamic-robot modalities to run (none: kinematic only)")
+    parser.add_argument(
+        "--controls",
+        nargs="*",
+        default=["position"],
+        help="dynamic-robot modalities to run (none: kinematic only)",
+    )
     parser.add_argument("--scenario", default=str(SCENARIO))
     args = parser.parse_args(argv)
     runs = [("kinematic", "-")] + [("dynamic", control) for control in args.controls]
     print(f"{args.scenario}, {args.seconds:g} s simulated per run")
-    print("| robot | control | real-time factor | penetrating periods | deepest (mm) "
-          "| closest to table (m) | closest to itself (m) |")
+    print(
+        "| robot | control | real-time factor | penetrating periods | deepest (mm) "
+        "| closest to table (m) | closest to itself (m) |"
+    )
     print("|---|---|---:|---:|---:|---:|---:|")
     for robot_model, control in runs:
         overrides = f"{{robot_model: {robot_model}, duration: {args.seconds}"
         overrides += f", control: {control}}}" if control != "-" else "}"
         summary = RunScenario(LoadScenario(args.scenario, overrides))
         safety = summary.safety
-        closest = {name: "-" if value is None else f"{value:.4f}"
-                   for name, value in safety.closest_approach.items()}
-        print(f"| {robot_model} | {control} | {summary.realtime_factor:.1f} | "
-              f"{safety.penetrating_steps} | {1000 * safety.deepest_penetration:.2f} | "
-              f"{closest.get('table', '-')} | {closest['(self)']} |", flush=True)
+        closest = {
+            name: "-" if value is None else f"{value:.4f}"
+            for name, value in safety.closest_approach.items()
+        }
+        print(
+            f"| {robot_model} | {control} | {summary.realtime_factor:.1f} | "
+            f"{safety.penetrating_steps} | {1000 * safety.deepest_penetration:.2f} | "
+            f"{closest.get('table', '-')} | {closest['(self)']} |",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

@@ -47,8 +47,13 @@ class ClauseSet:
     A joint neither controlled nor frozen is an error.
     """
 
-    def __init__(self, clauses: Sequence[Clause], joints: Sequence[str],
-                 frozen_joints: Mapping[str, float] | None = None, source: str = "overlay"):
+    def __init__(
+        self,
+        clauses: Sequence[Clause],
+        joints: Sequence[str],
+        frozen_joints: Mapping[str, float] | None = None,
+        source: str = "overlay",
+    ):
         column = {name: i for i, name in enumerate(joints)}
         frozen = {name: np.degrees(angle) for name, angle in (frozen_joints or {}).items()}
         rows, offsets, membership, self.names = [], [], [], []
@@ -62,15 +67,19 @@ class ClauseSet:
                     elif name in frozen:
                         b += coefficient * frozen[name]
                     else:
-                        raise ValueError(f"{source}: clause '{clause.name}' names joint '{name}', "
-                                         "which is neither controlled nor frozen")
+                        raise ValueError(
+                            f"{source}: clause '{clause.name}' names joint '{name}', "
+                            "which is neither controlled nor frozen"
+                        )
                 literals.append((a, b))
             if any(not a.any() and b >= 0 for a, b in literals):
                 continue  # A literal that always holds: the clause can never switch on.
             literals = [(a, b) for a, b in literals if a.any()]
             if not literals:
-                raise ValueError(f"{source}: clause '{clause.name}' is violated by the frozen "
-                                 "joints and no controlled joint can satisfy it")
+                raise ValueError(
+                    f"{source}: clause '{clause.name}' is violated by the frozen "
+                    "joints and no controlled joint can satisfy it"
+                )
             members = []
             for a, b in literals:
                 members.append(len(rows))

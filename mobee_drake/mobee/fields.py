@@ -68,12 +68,21 @@ class FieldPairs:
 
 
 # No pair inside any field (shared: FieldPairs are never modified).
-NO_FIELD_PAIRS = FieldPairs([], [], np.zeros(0), np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)),
-                            np.zeros((0, 3)), np.zeros(0, dtype=bool))
+NO_FIELD_PAIRS = FieldPairs(
+    [],
+    [],
+    np.zeros(0),
+    np.zeros(0),
+    np.zeros((0, 3)),
+    np.zeros((0, 3)),
+    np.zeros((0, 3)),
+    np.zeros(0, dtype=bool),
+)
 
 
-def FindFieldPairs(query: QueryObject, margins: Mapping[GeometryId, float],
-                   max_margin: float) -> FieldPairs:
+def FindFieldPairs(
+    query: QueryObject, margins: Mapping[GeometryId, float], max_margin: float
+) -> FieldPairs:
     """Finds every pair with a robot geometry (a key of ``margins``) inside its field.
 
     ``max_margin`` is the largest of ``margins``: no pair farther apart can be inside its field.
@@ -94,29 +103,55 @@ def FindFieldPairs(query: QueryObject, margins: Mapping[GeometryId, float],
         if distance >= margin:
             continue
         if margin_A is None:  # Make A the robot's geometry.
-            rows.append((id_B, id_A, distance, margin, pair.p_BCb, pair.p_ACa, -pair.nhat_BA_W,
-                         False))
+            rows.append(
+                (id_B, id_A, distance, margin, pair.p_BCb, pair.p_ACa, -pair.nhat_BA_W, False)
+            )
         else:
-            rows.append((id_A, id_B, distance, margin, pair.p_ACa, pair.p_BCb, pair.nhat_BA_W,
-                         margin_B is not None))
+            rows.append(
+                (
+                    id_A,
+                    id_B,
+                    distance,
+                    margin,
+                    pair.p_ACa,
+                    pair.p_BCb,
+                    pair.nhat_BA_W,
+                    margin_B is not None,
+                )
+            )
     if not rows:
         return NO_FIELD_PAIRS
     ids_A, ids_B, distance, margin, p_ACa, p_BCb, nhat, both = zip(*rows)
-    return FieldPairs(list(ids_A), list(ids_B), np.array(distance), np.array(margin),
-                      np.array(p_ACa), np.array(p_BCb), np.array(nhat), np.array(both))
+    return FieldPairs(
+        list(ids_A),
+        list(ids_B),
+        np.array(distance),
+        np.array(margin),
+        np.array(p_ACa),
+        np.array(p_BCb),
+        np.array(nhat),
+        np.array(both),
+    )
 
 
-def ToFieldContacts(pairs: FieldPairs, query: QueryObject,
-                    names: Mapping[GeometryId, str]) -> list[FieldContact]:
+def ToFieldContacts(
+    pairs: FieldPairs, query: QueryObject, names: Mapping[GeometryId, str]
+) -> list[FieldContact]:
     """The pairs as a list of :class:`FieldContact`, witness points in world."""
     inspector = query.inspector()
     contacts = []
     for i, (a, b) in enumerate(zip(pairs.geometry_A, pairs.geometry_B)):
-        contacts.append(FieldContact(
-            geometry_A=a, geometry_B=b, name_A=names.get(a) or inspector.GetName(a),
-            name_B=names.get(b) or inspector.GetName(b), distance=float(pairs.distance[i]),
-            margin=float(pairs.margin[i]),
-            p_WCa=query.GetPoseInWorld(a).multiply(pairs.p_ACa[i]),
-            p_WCb=query.GetPoseInWorld(b).multiply(pairs.p_BCb[i]),
-            nhat_BA_W=pairs.nhat_BA_W[i].copy()))
+        contacts.append(
+            FieldContact(
+                geometry_A=a,
+                geometry_B=b,
+                name_A=names.get(a) or inspector.GetName(a),
+                name_B=names.get(b) or inspector.GetName(b),
+                distance=float(pairs.distance[i]),
+                margin=float(pairs.margin[i]),
+                p_WCa=query.GetPoseInWorld(a).multiply(pairs.p_ACa[i]),
+                p_WCb=query.GetPoseInWorld(b).multiply(pairs.p_BCb[i]),
+                nhat_BA_W=pairs.nhat_BA_W[i].copy(),
+            )
+        )
     return contacts

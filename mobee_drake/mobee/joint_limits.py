@@ -22,11 +22,17 @@ class JointLimits:
 
     def Force(self, q: np.ndarray) -> np.ndarray:
         """The per-joint limit force ``f_lim(q)`` (eq. 5.12-5.13, typos corrected)."""
-        return self._slope * (np.maximum(0.0, self._lower_edge - q)
-                              - np.maximum(0.0, q - self._upper_edge))
+        return self._slope * (
+            np.maximum(0.0, self._lower_edge - q) - np.maximum(0.0, q - self._upper_edge)
+        )
 
 
-def JointLimitForce(q: np.ndarray, q_min: np.ndarray, q_max: np.ndarray,
-                    delta: np.ndarray | float, f_max: np.ndarray | float) -> np.ndarray:
+def JointLimitForce(
+    q: np.ndarray,
+    q_min: np.ndarray,
+    q_max: np.ndarray,
+    delta: np.ndarray | float,
+    f_max: np.ndarray | float,
+) -> np.ndarray:
     """The per-joint limit force ``f_lim(q)`` (eq. 5.12-5.13, with the typos above corrected)."""
     return JointLimits(q_min, q_max, delta, f_max).Force(q)

@@ -66,10 +66,13 @@ class MobeeParams:
     def Validate(self, joints: list[str]) -> None:
         """Raises ValueError naming the parameter (and joint) whose value is out of range."""
         positive = {
-            "mass": self.mass, "stiffness": self.stiffness,
+            "mass": self.mass,
+            "stiffness": self.stiffness,
             "collision_gain": self.collision_gain,
-            "limit_delta": self.limit_delta, "limit_force": self.limit_force,
-            "constraint_delta": self.constraint_delta, "constraint_force": self.constraint_force,
+            "limit_delta": self.limit_delta,
+            "limit_force": self.limit_force,
+            "constraint_delta": self.constraint_delta,
+            "constraint_force": self.constraint_force,
         }
         for name in ("spring", "config", "work", "collision"):
             squash = getattr(self, f"{name}_squash")
@@ -77,13 +80,17 @@ class MobeeParams:
             positive[f"{name}_squash.k"] = squash.k
         for name, override in self.joint_overrides.items():
             if name not in joints:
-                raise ValueError(f"MoBeE parameters: joint_overrides names unknown joint '{name}'; "
-                                 "controlled joints are: " + ", ".join(joints))
+                raise ValueError(
+                    f"MoBeE parameters: joint_overrides names unknown joint '{name}'; "
+                    "controlled joints are: " + ", ".join(joints)
+                )
             positive[f"joint_overrides[{name}].mass"] = override.mass
             positive[f"joint_overrides[{name}].stiffness"] = override.stiffness
             if not (math.isfinite(override.damping) and override.damping >= 0):
-                raise ValueError(f"MoBeE parameters: joint_overrides[{name}].damping must be >= 0, "
-                                 f"got {override.damping}")
+                raise ValueError(
+                    f"MoBeE parameters: joint_overrides[{name}].damping must be >= 0, "
+                    f"got {override.damping}"
+                )
         for name, value in positive.items():
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"MoBeE parameters: {name} must be > 0, got {value}")

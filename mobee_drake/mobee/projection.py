@@ -16,8 +16,10 @@ class PointForceProjector:
         self._world = plant.world_frame()
         self._jacobian = plant.CalcJacobianTranslationalVelocity
 
-    def __call__(self, plant_context, frame_F: Frame, p_FP: np.ndarray,
-                 f_W: np.ndarray) -> np.ndarray:
-        J = self._jacobian(plant_context, JacobianWrtVariable.kV, frame_F, p_FP, self._world,
-                           self._world)
+    def __call__(
+        self, plant_context, frame_F: Frame, p_FP: np.ndarray, f_W: np.ndarray
+    ) -> np.ndarray:
+        J = self._jacobian(
+            plant_context, JacobianWrtVariable.kV, frame_F, p_FP, self._world, self._world
+        )
         return f_W @ J

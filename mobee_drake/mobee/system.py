@@ -79,8 +79,14 @@ class Mobee(LeafSystem):
     keeps no state of its own.
     """
 
-    def __init__(self, plant: MultibodyPlant, robot: RobotOverlay, *, joints: list[str],
-                 params: MobeeParams | None = None):
+    def __init__(
+        self,
+        plant: MultibodyPlant,
+        robot: RobotOverlay,
+        *,
+        joints: list[str],
+        params: MobeeParams | None = None,
+    ):
         super().__init__()
         self._plant = plant
         self._params = params = params or MobeeParams()
@@ -91,10 +97,15 @@ class Mobee(LeafSystem):
         self._q_index, self._v_index, q_min, q_max = [], [], [], []
         for name in self._joints:
             if not plant.HasJointNamed(name, robot.instance):
-                movable = [plant.get_joint(j).name() for j in plant.GetJointIndices(robot.instance)
-                           if plant.get_joint(j).num_positions() == 1]
-                raise ValueError(f"{source}: unknown joint '{name}'; the robot's joints are: "
-                                 + ", ".join(movable))
+                movable = [
+                    plant.get_joint(j).name()
+                    for j in plant.GetJointIndices(robot.instance)
+                    if plant.get_joint(j).num_positions() == 1
+                ]
+                raise ValueError(
+                    f"{source}: unknown joint '{name}'; the robot's joints are: "
+                    + ", ".join(movable)
+                )
             joint = plant.GetJointByName(name, robot.instance)
             self._q_index.append(joint.position_start())
             self._v_index.append(joint.velocity_start())
@@ -105,14 +116,15 @@ class Mobee(LeafSystem):
         self._q_min, self._q_max = np.array(q_min), np.array(q_max)
         mass, damping, stiffness = (np.array(x) for x in params.PerJoint(self._joints))
         self._mass, self._damping, self._stiffness = mass, damping, stiffness
-        self._limits = JointLimits(self._q_min, self._q_max, params.limit_delta,
-                                   params.limit_force)
-        self._clauses = ClauseSet(robot.overlay.clauses, self._joints, robot.frozen_joints,
-                                  source=source)
+        self._limits = JointLimits(self._q_min, self._q_max, params.limit_delta, params.limit_force)
+        self._clauses = ClauseSet(
+            robot.overlay.clauses, self._joints, robot.frozen_joints, source=source
+        )
         self._default_positions = plant.GetPositions(plant.CreateDefaultContext())
         self._home = self._default_positions[self._q_index]
-        self._state_names = ([f"{j} position" for j in self._joints]
-                             + [f"{j} velocity" for j in self._joints])
+        self._state_names = [f"{j} position" for j in self._joints] + [
+            f"{j} velocity" for j in self._joints
+        ]
 
         self._margins = dict(robot.field_margins)
         self._max_margin = max(self._margins.values(), default=0.0)
@@ -120,8 +132,9 @@ class Mobee(LeafSystem):
         self._geometry_frames = {g: plant.get_frame(f) for g, f in robot.geometry_frames.items()}
         self._project = PointForceProjector(plant)
         self._markers = robot.markers
-        self._marker_bodies = [plant.GetBodyByName(m.body_name, robot.instance)
-                               for m in self._markers]
+        self._marker_bodies = [
+            plant.GetBodyByName(m.body_name, robot.instance) for m in self._markers
+        ]
         self._marker_index = {m.name: i for i, m in enumerate(self._markers)}
         num_markers = len(self._markers)
 
@@ -130,72 +143,114 @@ class Mobee(LeafSystem):
         self._config_force_port = self.DeclareVectorInputPort("config_force", n)
         self._marker_forces_port = self.DeclareVectorInputPort("marker_forces", 3 * num_markers)
         self._query_port = self.DeclareAbstractInputPort(
-            "geometry_query", AbstractValue.Make(QueryObject()))
+            "geometry_query", AbstractValue.Make(QueryObject())
+        )
 
         # The attractor changes rarely: it is checked once per change, not once per evaluation.
         self._attractor_entry = self.DeclareCacheEntry(
             description="checked attractor",
-            value_producer=ValueProducer(allocate=lambda: AbstractValue.Make(np.zeros(n)),
-                                         calc=self._CalcAttractor),
-            prerequisites_of_calc={self._attractor_port.ticket()})
+            value_producer=ValueProducer(
+                allocate=lambda: AbstractValue.Make(np.zeros(n)), calc=self._CalcAttractor
+            ),
+            prerequisites_of_calc={self._attractor_port.ticket()},
+        )
         state_ticket = self._state_port.ticket()
         self._plant_context_entry = self.DeclareCacheEntry(
             description="plant context at the input configuration",
             value_producer=ValueProducer(
                 allocate=lambda: AbstractValue.Make(plant.CreateDefaultContext()),
-                calc=self._CalcPlantContext),
-            prerequisites_of_calc={state_ticket})
+                calc=self._CalcPlantContext,
+            ),
+            prerequisites_of_calc={state_ticket},
+        )
         plant_ticket = self._plant_context_entry.ticket()
         self._field_pairs_entry = self.DeclareCacheEntry(
             description="geometry pairs inside their fields",
-            value_producer=ValueProducer(allocate=lambda: AbstractValue.Make(NO_FIELD_PAIRS),
-                                         calc=self._CalcFieldPairs),
-            prerequisites_of_calc={self._query_port.ticket()})
+            value_producer=ValueProducer(
+                allocate=lambda: AbstractValue.Make(NO_FIELD_PAIRS), calc=self._CalcFieldPairs
+            ),
+            prerequisites_of_calc={self._query_port.ticket()},
+        )
         self._forces_entry = self.DeclareCacheEntry(
             description="force terms of eq. 5.7",
             value_producer=ValueProducer(
                 allocate=lambda: AbstractValue.Make(np.zeros((len(FORCE_TERMS), n))),
-                calc=self._CalcForces),
+                calc=self._CalcForces,
+            ),
             prerequisites_of_calc={
-                state_ticket, plant_ticket, self._field_pairs_entry.ticket(),
-                self._attractor_entry.ticket(), self._config_force_port.ticket(),
-                self._marker_forces_port.ticket()})
+                state_ticket,
+                plant_ticket,
+                self._field_pairs_entry.ticket(),
+                self._attractor_entry.ticket(),
+                self._config_force_port.ticket(),
+                self._marker_forces_port.ticket(),
+            },
+        )
         self._marker_pose_entry = self.DeclareCacheEntry(
             description="marker positions and directions",
             value_producer=ValueProducer(
                 allocate=lambda: AbstractValue.Make(np.zeros((2, num_markers, 3))),
-                calc=self._CalcMarkerPoses),
-            prerequisites_of_calc={plant_ticket})
+                calc=self._CalcMarkerPoses,
+            ),
+            prerequisites_of_calc={plant_ticket},
+        )
 
         for row, term in enumerate(FORCE_TERMS):
             self.DeclareVectorOutputPort(
-                term, n, lambda context, output, row=row: output.SetFromVector(
-                    self._forces_entry.Eval(context)[row]),
-                prerequisites_of_calc={self._forces_entry.ticket()})
+                term,
+                n,
+                lambda context, output, row=row: output.SetFromVector(
+                    self._forces_entry.Eval(context)[row]
+                ),
+                prerequisites_of_calc={self._forces_entry.ticket()},
+            )
         self.DeclareVectorOutputPort(
-            "total", n, lambda context, output: output.SetFromVector(
-                self._forces_entry.Eval(context).sum(axis=0)),
-            prerequisites_of_calc={self._forces_entry.ticket()})
+            "total",
+            n,
+            lambda context, output: output.SetFromVector(
+                self._forces_entry.Eval(context).sum(axis=0)
+            ),
+            prerequisites_of_calc={self._forces_entry.ticket()},
+        )
         for row, name in enumerate(("marker_positions", "marker_directions")):
             self.DeclareVectorOutputPort(
-                name, 3 * num_markers, lambda context, output, row=row: output.SetFromVector(
-                    self._marker_pose_entry.Eval(context)[row].ravel()),
-                prerequisites_of_calc={self._marker_pose_entry.ticket()})
+                name,
+                3 * num_markers,
+                lambda context, output, row=row: output.SetFromVector(
+                    self._marker_pose_entry.Eval(context)[row].ravel()
+                ),
+                prerequisites_of_calc={self._marker_pose_entry.ticket()},
+            )
         self.DeclareVectorOutputPort(
-            "marker_jacobians", 3 * num_markers * n, self._CalcMarkerJacobians,
-            prerequisites_of_calc={plant_ticket})
+            "marker_jacobians",
+            3 * num_markers * n,
+            self._CalcMarkerJacobians,
+            prerequisites_of_calc={plant_ticket},
+        )
         self.DeclareAbstractOutputPort(
-            "field_contacts", lambda: AbstractValue.Make([]), self._CalcFieldContacts,
-            prerequisites_of_calc={self._field_pairs_entry.ticket()})
+            "field_contacts",
+            lambda: AbstractValue.Make([]),
+            self._CalcFieldContacts,
+            prerequisites_of_calc={self._field_pairs_entry.ticket()},
+        )
         self.DeclareAbstractOutputPort(
-            "field_pairs", lambda: AbstractValue.Make(NO_FIELD_PAIRS),
+            "field_pairs",
+            lambda: AbstractValue.Make(NO_FIELD_PAIRS),
             lambda context, output: output.set_value(self._field_pairs_entry.Eval(context)),
-            prerequisites_of_calc={self._field_pairs_entry.ticket()})
+            prerequisites_of_calc={self._field_pairs_entry.ticket()},
+        )
 
     @staticmethod
-    def AddToBuilder(builder, *, plant: MultibodyPlant, scene_graph, robot: RobotOverlay,
-                     joints: list[str], params: MobeeParams | None = None,
-                     name: str = "mobee") -> "Mobee":
+    def AddToBuilder(
+        builder,
+        *,
+        plant: MultibodyPlant,
+        scene_graph,
+        robot: RobotOverlay,
+        joints: list[str],
+        params: MobeeParams | None = None,
+        name: str = "mobee",
+    ) -> "Mobee":
         """Adds MoBeE to ``builder`` and connects its state and geometry query.
 
         The state comes from ``plant``'s state output through a selector of ``joints``; the
@@ -204,7 +259,8 @@ class Mobee(LeafSystem):
         mobee = builder.AddNamedSystem(name, Mobee(plant, robot, joints=joints, params=params))
         joint_indices = [plant.GetJointByName(j, robot.instance).index() for j in joints]
         selector = builder.AddNamedSystem(
-            f"{name}_state_selector", MatrixGain(plant.MakeStateSelectorMatrix(joint_indices)))
+            f"{name}_state_selector", MatrixGain(plant.MakeStateSelectorMatrix(joint_indices))
+        )
         builder.Connect(plant.get_state_output_port(), selector.get_input_port())
         builder.Connect(selector.get_output_port(), mobee.GetInputPort("state"))
         builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
@@ -225,15 +281,17 @@ class Mobee(LeafSystem):
     def marker_index(self, name: str) -> int:
         """The index of marker ``name`` in the marker ports (its force is ``3i:3i+3``)."""
         if name not in self._marker_index:
-            raise ValueError(f"MoBeE: unknown marker '{name}'; markers are: "
-                             + ", ".join(self.marker_names))
+            raise ValueError(
+                f"MoBeE: unknown marker '{name}'; markers are: " + ", ".join(self.marker_names)
+            )
         return self._marker_index[name]
 
     def joint_index(self, name: str) -> int:
         """The index of joint ``name`` in the n-vectors of this system."""
         if name not in self._joints:
-            raise ValueError(f"MoBeE: unknown joint '{name}'; controlled joints are: "
-                             + ", ".join(self._joints))
+            raise ValueError(
+                f"MoBeE: unknown joint '{name}'; controlled joints are: " + ", ".join(self._joints)
+            )
         return self._joints.index(name)
 
     @property
@@ -249,7 +307,8 @@ class Mobee(LeafSystem):
             raise ValueError(
                 f"MoBeE: attractor for joint '{self._joints[i]}' is {np.degrees(q_star[i]):.6g} "
                 f"deg, outside its limits [{np.degrees(self._q_min[i]):.6g}, "
-                f"{np.degrees(self._q_max[i]):.6g}] deg")
+                f"{np.degrees(self._q_max[i]):.6g}] deg"
+            )
 
     @property
     def position_limits(self) -> tuple[np.ndarray, np.ndarray]:
@@ -298,27 +357,35 @@ class Mobee(LeafSystem):
         self._plant.SetPositions(plant_context, positions)
 
     def _CalcFieldPairs(self, context, value) -> None:
-        value.set_value(FindFieldPairs(self._query_port.Eval(context), self._margins,
-                                       self._max_margin))
+        value.set_value(
+            FindFieldPairs(self._query_port.Eval(context), self._margins, self._max_margin)
+        )
 
     def _CalcFieldContacts(self, context, output) -> None:
-        output.set_value(ToFieldContacts(self._field_pairs_entry.Eval(context),
-                                         self._query_port.Eval(context), self._geometry_names))
+        output.set_value(
+            ToFieldContacts(
+                self._field_pairs_entry.Eval(context),
+                self._query_port.Eval(context),
+                self._geometry_names,
+            )
+        )
 
     def _CollisionForce(self, plant_context, pairs: FieldPairs) -> np.ndarray:
         """The unsquashed sum of eq. 5.11 over the controlled joints: for each pair, the force
         gain x field penetration along the separating direction at the witness point of the
         robot geometry, and its opposite at the other witness point when that is the robot's too.
         """
-        f_W = (self._params.collision_gain * (pairs.margin - pairs.distance))[:, None] \
-            * pairs.nhat_BA_W
+        f_W = (self._params.collision_gain * (pairs.margin - pairs.distance))[
+            :, None
+        ] * pairs.nhat_BA_W
         project, frames = self._project, self._geometry_frames
         generalized = np.zeros(self._plant.num_velocities())
         for g, p_GC, f in zip(pairs.geometry_A, pairs.p_ACa, f_W):
             generalized += project(plant_context, frames[g], p_GC, f)
         for i in np.flatnonzero(pairs.b_is_robot):  # A self-collision pushes both bodies apart.
-            generalized -= project(plant_context, frames[pairs.geometry_B[i]], pairs.p_BCb[i],
-                                   f_W[i])
+            generalized -= project(
+                plant_context, frames[pairs.geometry_B[i]], pairs.p_BCb[i], f_W[i]
+            )
         return generalized[self._v_index]
 
     def _CalcForces(self, context, value) -> None:
@@ -335,8 +402,11 @@ class Mobee(LeafSystem):
         pairs = self._field_pairs_entry.Eval(context)
         if len(pairs):
             plant_context = self._plant_context_entry.Eval(context)
-            terms[4] = Squash(self._CollisionForce(plant_context, pairs), p.collision_squash.m,
-                              p.collision_squash.k)
+            terms[4] = Squash(
+                self._CollisionForce(plant_context, pairs),
+                p.collision_squash.m,
+                p.collision_squash.k,
+            )
         else:
             terms[4] = 0.0
 
@@ -350,26 +420,40 @@ class Mobee(LeafSystem):
         terms[6] = 0.0
         if self._markers and self._marker_forces_port.HasValue(context):
             f_m = self._marker_forces_port.Eval(context).reshape(-1, 3)
-            self._CheckFinite("marker_forces", f_m.ravel(),
-                              [f"{m.name}[{axis}]" for m in self._markers for axis in "xyz"])
+            self._CheckFinite(
+                "marker_forces",
+                f_m.ravel(),
+                [f"{m.name}[{axis}]" for m in self._markers for axis in "xyz"],
+            )
             loaded = np.flatnonzero(np.any(f_m != 0.0, axis=1))
             if loaded.size:
                 plant_context = self._plant_context_entry.Eval(context)
-                generalized = sum(self._project(plant_context,
-                                                self._marker_bodies[i].body_frame(),
-                                                self._markers[i].p_BM, f_m[i]) for i in loaded)
+                generalized = sum(
+                    self._project(
+                        plant_context,
+                        self._marker_bodies[i].body_frame(),
+                        self._markers[i].p_BM,
+                        f_m[i],
+                    )
+                    for i in loaded
+                )
                 terms[6] = Squash(generalized[self._v_index], p.work_squash.m, p.work_squash.k)
 
     def _CalcMarkerPoses(self, context, value) -> None:
-        MarkerStates(self._markers, self._marker_bodies, self._plant_context_entry.Eval(context),
-                     out=value.get_mutable_value())
+        MarkerStates(
+            self._markers,
+            self._marker_bodies,
+            self._plant_context_entry.Eval(context),
+            out=value.get_mutable_value(),
+        )
 
     def _CalcMarkerJacobians(self, context, output) -> None:
         plant_context = self._plant_context_entry.Eval(context)
         world = self._plant.world_frame()
-        blocks = [self._plant.CalcJacobianTranslationalVelocity(
-                      plant_context, JacobianWrtVariable.kV, body.body_frame(), marker.p_BM,
-                      world, world)[:, self._v_index]
-                  for marker, body in zip(self._markers, self._marker_bodies)]
-        output.SetFromVector(np.concatenate([b.ravel() for b in blocks]) if blocks
-                             else np.zeros(0))
+        blocks = [
+            self._plant.CalcJacobianTranslationalVelocity(
+                plant_context, JacobianWrtVariable.kV, body.body_frame(), marker.p_BM, world, world
+            )[:, self._v_index]
+            for marker, body in zip(self._markers, self._marker_bodies)
+        ]
+        output.SetFromVector(np.concatenate([b.ravel() for b in blocks]) if blocks else np.zeros(0))

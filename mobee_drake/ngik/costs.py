@@ -95,8 +95,9 @@ class TwoHandHoldCost:
 
     def __call__(self, evaluation: PoseEvaluation) -> float:
         x = evaluation.marker_positions
-        return self.weight * abs(float(np.linalg.norm(x[self.left] - x[self.right]))
-                                 - self.distance)
+        return self.weight * abs(
+            float(np.linalg.norm(x[self.left] - x[self.right])) - self.distance
+        )
 
 
 @dc.dataclass

@@ -49,9 +49,15 @@ class KinematicModel:
         meshcat: if given, the model is drawn there (see :meth:`Publish`).
     """
 
-    def __init__(self, robot: RobotConfig, objects: list[SceneObject] = (), *,
-                 clearance: float = 0.0, inside_fields: bool = False,
-                 meshcat: Meshcat | None = None):
+    def __init__(
+        self,
+        robot: RobotConfig,
+        objects: list[SceneObject] = (),
+        *,
+        clearance: float = 0.0,
+        inside_fields: bool = False,
+        meshcat: Meshcat | None = None,
+    ):
         builder = DiagramBuilder()
         plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
         self._overlay, self.joints = AddScenarioRobot(plant, scene_graph, robot)
@@ -74,8 +80,9 @@ class KinematicModel:
         self.lower = np.array([j.position_lower_limits()[0] for j in joints])
         self.upper = np.array([j.position_upper_limits()[0] for j in joints])
         self.home = plant.GetPositions(self._plant_context)[self.position_index]
-        self.clauses = ClauseSet(self._overlay.overlay.clauses, self.joints,
-                                 self._overlay.frozen_joints)
+        self.clauses = ClauseSet(
+            self._overlay.overlay.clauses, self.joints, self._overlay.frozen_joints
+        )
         self.markers = self._overlay.markers
         self.marker_names = [m.name for m in self.markers]
         self._marker_bodies = [plant.GetBodyByName(m.body_name, instance) for m in self.markers]
@@ -88,14 +95,16 @@ class KinematicModel:
 
     def JointIndex(self, name: str) -> int:
         if name not in self.joints:
-            raise ValueError(f"unknown joint '{name}'; the model's joints are: "
-                             + ", ".join(self.joints))
+            raise ValueError(
+                f"unknown joint '{name}'; the model's joints are: " + ", ".join(self.joints)
+            )
         return self.joints.index(name)
 
     def MarkerIndex(self, name: str) -> int:
         if name not in self.marker_names:
-            raise ValueError(f"unknown marker '{name}'; the model's markers are: "
-                             + ", ".join(self.marker_names))
+            raise ValueError(
+                f"unknown marker '{name}'; the model's markers are: " + ", ".join(self.marker_names)
+            )
         return self.marker_names.index(name)
 
     def SetPose(self, q: np.ndarray) -> None:
@@ -108,21 +117,26 @@ class KinematicModel:
         """Marker states and collision pairs of pose ``q``."""
         q = np.asarray(q, dtype=float)
         self.SetPose(q)
-        positions, directions = MarkerStates(self.markers, self._marker_bodies,
-                                             self._plant_context)
-        return PoseEvaluation(q=q.copy(), marker_positions=positions,
-                              marker_directions=directions,
-                              collision_pairs=self._CollisionPairs())
+        positions, directions = MarkerStates(self.markers, self._marker_bodies, self._plant_context)
+        return PoseEvaluation(
+            q=q.copy(),
+            marker_positions=positions,
+            marker_directions=directions,
+            collision_pairs=self._CollisionPairs(),
+        )
 
     def _CollisionPairs(self) -> tuple[tuple[str, str], ...]:
         query = self.scene_graph.get_query_output_port().Eval(self._scene_graph_context)
         if self._field_margins is not None:
             fields = FindFieldPairs(query, self._field_margins, self._max_margin)
-            return tuple((self._names[a], self._names[b])
-                         for a, b in zip(fields.geometry_A, fields.geometry_B))
+            return tuple(
+                (self._names[a], self._names[b])
+                for a, b in zip(fields.geometry_A, fields.geometry_B)
+            )
         pairs = query.ComputeSignedDistancePairwiseClosestPoints(self.clearance)
-        return tuple((self._names[p.id_A], self._names[p.id_B]) for p in pairs
-                     if p.distance < self.clearance)
+        return tuple(
+            (self._names[p.id_A], self._names[p.id_B]) for p in pairs if p.distance < self.clearance
+        )
 
     def Publish(self, q: np.ndarray, time: float = 0.0) -> None:
         """Draws pose ``q`` in Meshcat (at ``time`` of a recording, if one is running)."""
@@ -132,5 +146,8 @@ class KinematicModel:
 
     def IsValid(self, q: np.ndarray) -> bool:
         """Within the joint limits and every constraint clause satisfied (Alg. 4's IS_VALID)."""
-        return bool(np.all(q >= self.lower) and np.all(q <= self.upper)
-                    and not self.clauses.ActiveClauses(q, 0.0).any())
+        return bool(
+            np.all(q >= self.lower)
+            and np.all(q <= self.upper)
+            and not self.clauses.ActiveClauses(q, 0.0).any()
+        )

@@ -38,8 +38,9 @@ class NesConfig:
         if self.variant not in NES_VARIANTS:
             raise ValueError(f"NES variant must be one of {NES_VARIANTS}, got '{self.variant}'")
         if self.population < 0 or self.population == 1:
-            raise ValueError(f"NES population must be 0 (default) or at least 2, got "
-                             f"{self.population}")
+            raise ValueError(
+                f"NES population must be 0 (default) or at least 2, got {self.population}"
+            )
         if self.max_evaluations < 1:
             raise ValueError(f"NES max_evaluations must be positive, got {self.max_evaluations}")
 
@@ -71,8 +72,13 @@ def _SymmetricExp(S: np.ndarray) -> np.ndarray:
     return (vectors * np.exp(values)) @ vectors.T
 
 
-def Minimize(cost: Callable[[np.ndarray], float], mean: np.ndarray, sigma: float | np.ndarray,
-             config: NesConfig, rng: np.random.Generator) -> NesResult:
+def Minimize(
+    cost: Callable[[np.ndarray], float],
+    mean: np.ndarray,
+    sigma: float | np.ndarray,
+    config: NesConfig,
+    rng: np.random.Generator,
+) -> NesResult:
     """Minimises ``cost`` from the distribution N(mean, sigma^2 I) (``sigma`` scalar or per
     coordinate)."""
     mu = np.array(mean, dtype=float)

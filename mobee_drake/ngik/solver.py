@@ -25,8 +25,14 @@ from mobee_drake.ngik.nes import Minimize, NesConfig
 class IkProblem:
     """Minimise the sum of ``terms`` over ``joints`` of ``model``, the others at ``base``."""
 
-    def __init__(self, model: KinematicModel, terms: list[CostTerm], *,
-                 joints: list[str] | None = None, base: np.ndarray | None = None):
+    def __init__(
+        self,
+        model: KinematicModel,
+        terms: list[CostTerm],
+        *,
+        joints: list[str] | None = None,
+        base: np.ndarray | None = None,
+    ):
         self.model = model
         self.terms = list(terms)
         self.joints = list(joints) if joints is not None else list(model.joints)
@@ -65,8 +71,9 @@ class IkProblem:
 
     def IsSolved(self, evaluation: PoseEvaluation) -> bool:
         """Valid and every term met."""
-        return (self.model.IsValid(evaluation.q)
-                and all(term(evaluation) <= term.tolerance for term in self.terms))
+        return self.model.IsValid(evaluation.q) and all(
+            term(evaluation) <= term.tolerance for term in self.terms
+        )
 
 
 @dc.dataclass(frozen=True)
@@ -78,12 +85,22 @@ class IkSolution:
     seconds: float
 
 
-def SolveNgik(problem: IkProblem, start: np.ndarray, sigma: float | np.ndarray,
-              config: NesConfig, rng: np.random.Generator) -> IkSolution:
+def SolveNgik(
+    problem: IkProblem,
+    start: np.ndarray,
+    sigma: float | np.ndarray,
+    config: NesConfig,
+    rng: np.random.Generator,
+) -> IkSolution:
     """NGIK: NES from N(start, sigma^2) over the problem's joints (``start``: a full pose)."""
     began = time.perf_counter()
     result = Minimize(problem.Cost, problem.SearchVector(start), sigma, config, rng)
     seconds = time.perf_counter() - began
     evaluation, cost = problem.Evaluate(result.x)
-    return IkSolution(q=evaluation.q, cost=cost, solved=problem.IsSolved(evaluation),
-                      evaluations=result.evaluations, seconds=seconds)
+    return IkSolution(
+        q=evaluation.q,
+        cost=cost,
+        solved=problem.IsSolved(evaluation),
+        evaluations=result.evaluations,
+        seconds=seconds,
+    )

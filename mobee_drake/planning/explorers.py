@@ -46,14 +46,19 @@ class Explorer:
     def __init__(self, space: StateActionSpace, config: ExplorerConfig | None = None):
         config = config or ExplorerConfig()
         if config.strategy not in STRATEGIES:
-            raise ValueError(f"unknown strategy '{config.strategy}'; strategies are "
-                             + ", ".join(STRATEGIES))
+            raise ValueError(
+                f"unknown strategy '{config.strategy}'; strategies are " + ", ".join(STRATEGIES)
+            )
         if config.strategy == "planner" and not 0 <= config.goal_state < space.num_states:
-            raise ValueError(f"the planner needs a goal_state in 0..{space.num_states - 1}, "
-                             f"got {config.goal_state}")
+            raise ValueError(
+                f"the planner needs a goal_state in 0..{space.num_states - 1}, "
+                f"got {config.goal_state}"
+            )
         if config.initialization not in INITIALIZATIONS:
-            raise ValueError(f"unknown initialization '{config.initialization}'; use "
-                             + " or ".join(INITIALIZATIONS))
+            raise ValueError(
+                f"unknown initialization '{config.initialization}'; use "
+                + " or ".join(INITIALIZATIONS)
+            )
         self.space, self.config = space, config
         self.rng = np.random.default_rng(config.seed)
         self.transitions = TransitionCounts(space.num_state_actions, space.num_states)
@@ -74,9 +79,14 @@ class Explorer:
 
     def Values(self) -> tuple[np.ndarray, np.ndarray]:
         """V(s, a) and V(s) by value iteration on the current model (Alg. 7)."""
-        return ValueIteration(self.transitions.Probabilities(), self.rewards,
-                              self.space.action_state, self.space.num_states,
-                              self.config.gamma, self.config.delta)
+        return ValueIteration(
+            self.transitions.Probabilities(),
+            self.rewards,
+            self.space.action_state,
+            self.space.num_states,
+            self.config.gamma,
+            self.config.delta,
+        )
 
     def ChooseAction(self, state: int) -> int:
         """The state-action to try next from ``state``."""
@@ -90,8 +100,9 @@ class Explorer:
         elif self.config.strategy == "planner":
             from mobee_drake.planning.planner import PlanValues  # (planner imports this module)
 
-            scores = PlanValues(self, {self.config.goal_state: 1.0},
-                                gamma=self.config.gamma)[0][actions]
+            scores = PlanValues(self, {self.config.goal_state: 1.0}, gamma=self.config.gamma)[0][
+                actions
+            ]
         else:
             scores = self.Values()[0][actions]
         best = actions[np.flatnonzero(scores >= scores.max() - 1e-12)]
@@ -108,18 +119,27 @@ def ExplorerToArrays(explorer: Explorer) -> tuple[dict[str, np.ndarray], dict]:
     """The learned model as arrays (counts, rewards, tries, the space) and the rest as JSON-able
     data (configuration, generator state), for saving and exact resuming."""
     space = explorer.space
-    arrays = dict(counts=explorer.transitions.counts, rewards=explorer.rewards,
-                  tries=explorer.tries, centres=space.centres, action_state=space.action_state,
-                  action_goal=space.action_goal)
-    return arrays, dict(config=dc.asdict(explorer.config),
-                        generator=explorer.rng.bit_generator.state)
+    arrays = dict(
+        counts=explorer.transitions.counts,
+        rewards=explorer.rewards,
+        tries=explorer.tries,
+        centres=space.centres,
+        action_state=space.action_state,
+        action_goal=space.action_goal,
+    )
+    return arrays, dict(
+        config=dc.asdict(explorer.config), generator=explorer.rng.bit_generator.state
+    )
 
 
 def ExplorerFromArrays(arrays, data: dict, config: ExplorerConfig | None = None) -> Explorer:
     """The inverse of :func:`ExplorerToArrays`; with ``config``, the saved model under another
     configuration (e.g. a planner reusing what an explorer learned)."""
-    space = StateActionSpace(np.asarray(arrays["centres"]), np.asarray(arrays["action_state"]),
-                             np.asarray(arrays["action_goal"]))
+    space = StateActionSpace(
+        np.asarray(arrays["centres"]),
+        np.asarray(arrays["action_state"]),
+        np.asarray(arrays["action_goal"]),
+    )
     explorer = Explorer(space, config or ExplorerConfig(**data["config"]))
     explorer.transitions.counts[...] = arrays["counts"]
     explorer.rewards[...] = arrays["rewards"]
@@ -139,5 +159,6 @@ def LoadAgentModel(folder: str, name: str, config: ExplorerConfig) -> Explorer:
     for suffix in (".npz", ".json"):
         if not base.with_suffix(suffix).is_file():
             raise ValueError(f"{base.with_suffix(suffix)}: no saved model of agent '{name}'")
-    return ExplorerFromArrays(np.load(base.with_suffix(".npz")),
-                              json.loads(base.with_suffix(".json").read_text()), config)
+    return ExplorerFromArrays(
+        np.load(base.with_suffix(".npz")), json.loads(base.with_suffix(".json").read_text()), config
+    )

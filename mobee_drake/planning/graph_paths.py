@@ -5,8 +5,9 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 
-def JointSpaceDistances(poses: np.ndarray, edges: np.ndarray,
-                        start: int) -> tuple[np.ndarray, np.ndarray]:
+def JointSpaceDistances(
+    poses: np.ndarray, edges: np.ndarray, start: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Shortest distances from ``start`` along directed ``edges`` (pairs of pose indices), each as
     long as the joint-space distance between its poses, and the predecessors on those paths."""
     n = len(poses)

@@ -12,8 +12,9 @@ from mobee_drake.planning.explorers import Explorer
 from mobee_drake.planning.value_iteration import ValueIteration
 
 
-def PlanValues(explorer: Explorer, goal_rewards: dict[int, float], *, gamma: float = 0.9,
-               delta: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+def PlanValues(
+    explorer: Explorer, goal_rewards: dict[int, float], *, gamma: float = 0.9, delta: float = 1e-6
+) -> tuple[np.ndarray, np.ndarray]:
     """V(s, a) and V(s) for rewards on arriving in goal states (state index -> reward)."""
     space = explorer.space
     reward_of_state = np.zeros(space.num_states)
@@ -22,12 +23,14 @@ def PlanValues(explorer: Explorer, goal_rewards: dict[int, float], *, gamma: flo
             raise ValueError(f"goal state {state} is not a state (0..{space.num_states - 1})")
         reward_of_state[state] = reward
     T = explorer.transitions.Probabilities()
-    return ValueIteration(T, T @ reward_of_state, space.action_state, space.num_states,
-                          gamma, delta)
+    return ValueIteration(
+        T, T @ reward_of_state, space.action_state, space.num_states, gamma, delta
+    )
 
 
-def GreedyPlan(explorer: Explorer, start: int, goal: int, *, gamma: float = 0.9,
-               max_steps: int = 100) -> list[int]:
+def GreedyPlan(
+    explorer: Explorer, start: int, goal: int, *, gamma: float = 0.9, max_steps: int = 100
+) -> list[int]:
     """The states of the most likely path from ``start`` to ``goal`` following the greedy plan.
 
     Each step takes the best action of the current state and moves to that action's most likely

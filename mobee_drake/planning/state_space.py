@@ -102,8 +102,10 @@ def FromGraph(centres: np.ndarray, edges: np.ndarray) -> StateActionSpace:
         raise ValueError(f"centres must be a finite (m >= 2, d) array, got shape {centres.shape}")
     if len(edges) and (edges.min() < 0 or edges.max() >= len(centres)):
         raise ValueError(f"edges must join states 0..{len(centres) - 1}")
-    pairs = sorted({(int(a), int(b)) for a, b in edges if a != b}
-                   | {(int(b), int(a)) for a, b in edges if a != b})
+    pairs = sorted(
+        {(int(a), int(b)) for a, b in edges if a != b}
+        | {(int(b), int(a)) for a, b in edges if a != b}
+    )
     if not pairs:
         raise ValueError("a state-action space needs at least one edge")
     states, goals = np.array(pairs).T

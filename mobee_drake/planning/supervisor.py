@@ -79,9 +79,17 @@ class ExplorationSupervisor(LeafSystem):
     ``robot_state`` is (q, v) of MoBeE's joints ``joints``; ``attractor`` is q* for the same joints.
     """
 
-    def __init__(self, *, agents: list[Agent], joints: list[str], lower: np.ndarray,
-                 upper: np.ndarray, home: np.ndarray, timing: ActionTiming | None = None,
-                 period: float = 0.2):
+    def __init__(
+        self,
+        *,
+        agents: list[Agent],
+        joints: list[str],
+        lower: np.ndarray,
+        upper: np.ndarray,
+        home: np.ndarray,
+        timing: ActionTiming | None = None,
+        period: float = 0.2,
+    ):
         super().__init__()
         self._agents = list(agents)
         self._timing = timing or ActionTiming()
@@ -91,17 +99,25 @@ class ExplorationSupervisor(LeafSystem):
         for agent in self._agents:
             unknown = [j for j in agent.joints if j not in joints]
             if unknown:
-                raise ValueError(f"agent '{agent.name}': unknown joints {unknown}; MoBeE's "
-                                 "joints are: " + ", ".join(joints))
-            if agent.model is not None and agent.model.space.num_state_actions != \
-                    agent.space.num_state_actions:
-                raise ValueError(f"agent '{agent.name}': its model has "
-                                 f"{agent.model.space.num_state_actions} state-actions, its "
-                                 f"space {agent.space.num_state_actions}")
+                raise ValueError(
+                    f"agent '{agent.name}': unknown joints {unknown}; MoBeE's "
+                    "joints are: " + ", ".join(joints)
+                )
+            if (
+                agent.model is not None
+                and agent.model.space.num_state_actions != agent.space.num_state_actions
+            ):
+                raise ValueError(
+                    f"agent '{agent.name}': its model has "
+                    f"{agent.model.space.num_state_actions} state-actions, its "
+                    f"space {agent.space.num_state_actions}"
+                )
             if agent.space.centres.shape[1] != len(agent.joints):
-                raise ValueError(f"agent '{agent.name}': its space has "
-                                 f"{agent.space.centres.shape[1]} dimensions for "
-                                 f"{len(agent.joints)} joints")
+                raise ValueError(
+                    f"agent '{agent.name}': its space has "
+                    f"{agent.space.centres.shape[1]} dimensions for "
+                    f"{len(agent.joints)} joints"
+                )
             self._columns.append(np.array([joints.index(j) for j in agent.joints]))
         claimed = np.concatenate(self._columns) if self._columns else np.zeros(0, dtype=int)
         if len(set(claimed.tolist())) != len(claimed):
@@ -109,38 +125,60 @@ class ExplorationSupervisor(LeafSystem):
         self._state_port = self.DeclareVectorInputPort("robot_state", 2 * self._n)
         self._records = self.DeclareAbstractState(AbstractValue.Make(tuple()))
         self.DeclareInitializationUnrestrictedUpdateEvent(self._Start)
-        self.DeclarePeriodicUnrestrictedUpdateEvent(period_sec=period, offset_sec=period,
-                                                    update=self._Poll)
+        self.DeclarePeriodicUnrestrictedUpdateEvent(
+            period_sec=period, offset_sec=period, update=self._Poll
+        )
         # The same poll on demand (tests, scripts that step the supervisor by hand).
         self.DeclareForcedUnrestrictedUpdateEvent(self._Poll)
-        self.DeclareVectorOutputPort("attractor", self._n, self._CalcAttractor,
-                                     prerequisites_of_calc={self.abstract_state_ticket(
-                                         self._records)})
+        self.DeclareVectorOutputPort(
+            "attractor",
+            self._n,
+            self._CalcAttractor,
+            prerequisites_of_calc={self.abstract_state_ticket(self._records)},
+        )
 
     def _StateOf(self, agent: Agent, columns: np.ndarray, q: np.ndarray) -> int:
-        return agent.space.StateOfConfiguration(q[columns], self._lower[columns],
-                                                self._upper[columns])
+        return agent.space.StateOfConfiguration(
+            q[columns], self._lower[columns], self._upper[columns]
+        )
 
-    def _Begin(self, agent: Agent, columns, explorer: Explorer, q: np.ndarray, time: float,
-               actions_done: int) -> AgentRecord:
+    def _Begin(
+        self,
+        agent: Agent,
+        columns,
+        explorer: Explorer,
+        q: np.ndarray,
+        time: float,
+        actions_done: int,
+    ) -> AgentRecord:
         state = self._StateOf(agent, columns, q)
-        return AgentRecord(explorer=explorer, state=state,
-                           state_action=explorer.ChooseAction(state), started=time,
-                           slow_since=np.inf, actions_done=actions_done)
+        return AgentRecord(
+            explorer=explorer,
+            state=state,
+            state_action=explorer.ChooseAction(state),
+            started=time,
+            slow_since=np.inf,
+            actions_done=actions_done,
+        )
 
     def _Start(self, context, state) -> None:
-        q = self._state_port.Eval(context)[:self._n]
+        q = self._state_port.Eval(context)[: self._n]
         records = tuple(
-            self._Begin(agent, columns,
-                        agent.model.Copy() if agent.model else Explorer(agent.space,
-                                                                        agent.explorer),
-                        q, context.get_time(), 0)
-            for agent, columns in zip(self._agents, self._columns))
+            self._Begin(
+                agent,
+                columns,
+                agent.model.Copy() if agent.model else Explorer(agent.space, agent.explorer),
+                q,
+                context.get_time(),
+                0,
+            )
+            for agent, columns in zip(self._agents, self._columns)
+        )
         state.get_mutable_abstract_state(int(self._records)).set_value(records)
 
     def _Poll(self, context, state) -> None:
         x = self._state_port.Eval(context)
-        q, v = x[:self._n], x[self._n:]
+        q, v = x[: self._n], x[self._n :]
         now, timing = context.get_time(), self._timing
         records = list(context.get_abstract_state(int(self._records)).get_value())
         changed = False
@@ -151,19 +189,25 @@ class ExplorationSupervisor(LeafSystem):
             slow = np.max(np.abs(v[columns])) < timing.settle_speed
             slow_since = min(record.slow_since, now) if slow else np.inf
             elapsed = now - record.started
-            settled = (elapsed >= timing.min_duration and slow
-                       and now - slow_since >= timing.settle_time)
+            settled = (
+                elapsed >= timing.min_duration and slow and now - slow_since >= timing.settle_time
+            )
             if settled or elapsed >= timing.timeout:
                 explorer = record.explorer.Copy()
                 outcome = self._StateOf(agent, columns, q)
                 explorer.Observe(record.state_action, outcome)
-                if (explorer.config.strategy == "planner"
-                        and outcome == explorer.config.goal_state):
-                    records[i] = dc.replace(record, explorer=explorer, state=outcome,
-                                            actions_done=record.actions_done + 1, arrived=True)
+                if explorer.config.strategy == "planner" and outcome == explorer.config.goal_state:
+                    records[i] = dc.replace(
+                        record,
+                        explorer=explorer,
+                        state=outcome,
+                        actions_done=record.actions_done + 1,
+                        arrived=True,
+                    )
                 else:
-                    records[i] = self._Begin(agent, columns, explorer, q, now,
-                                             record.actions_done + 1)
+                    records[i] = self._Begin(
+                        agent, columns, explorer, q, now, record.actions_done + 1
+                    )
                 changed = True
             elif slow_since != record.slow_since:
                 records[i] = dc.replace(record, slow_since=slow_since)
@@ -173,11 +217,14 @@ class ExplorationSupervisor(LeafSystem):
 
     def _CalcAttractor(self, context, output) -> None:
         q_star = self._home.copy()
-        for agent, columns, record in zip(self._agents, self._columns,
-                                          context.get_abstract_state(int(self._records))
-                                          .get_value()):
-            q_star[columns] = agent.space.Centre(agent.space.action_goal[record.state_action],
-                                                 self._lower[columns], self._upper[columns])
+        for agent, columns, record in zip(
+            self._agents, self._columns, context.get_abstract_state(int(self._records)).get_value()
+        ):
+            q_star[columns] = agent.space.Centre(
+                agent.space.action_goal[record.state_action],
+                self._lower[columns],
+                self._upper[columns],
+            )
         output.SetFromVector(q_star)
 
     def Records(self, context) -> tuple[AgentRecord, ...]:
@@ -201,19 +248,24 @@ class ExplorationSupervisor(LeafSystem):
         records = list(self.Records(context))
         explorer = records[i].explorer.Copy()
         if explorer.config.strategy != "planner":
-            raise ValueError(f"agent '{agent}' explores ('{explorer.config.strategy}'); only a "
-                             "'planner' agent takes goals")
+            raise ValueError(
+                f"agent '{agent}' explores ('{explorer.config.strategy}'); only a "
+                "'planner' agent takes goals"
+            )
         if not 0 <= goal < config.space.num_states:
-            raise ValueError(f"agent '{agent}': goal state {goal} is not a state "
-                             f"(0..{config.space.num_states - 1})")
+            raise ValueError(
+                f"agent '{agent}': goal state {goal} is not a state "
+                f"(0..{config.space.num_states - 1})"
+            )
         explorer.config = dc.replace(explorer.config, goal_state=goal)
-        q = self._state_port.Eval(context)[:self._n]
+        q = self._state_port.Eval(context)[: self._n]
         state = self._StateOf(config, columns, q)
         if state == goal:
             records[i] = dc.replace(records[i], explorer=explorer, state=state, arrived=True)
         else:
-            records[i] = self._Begin(config, columns, explorer, q, context.get_time(),
-                                     records[i].actions_done)
+            records[i] = self._Begin(
+                config, columns, explorer, q, context.get_time(), records[i].actions_done
+            )
         self.SetRecords(context, tuple(records))
 
     @property

@@ -11,9 +11,15 @@ state without actions has value 0.
 import numpy as np
 
 
-def ValueIteration(transitions: np.ndarray, rewards: np.ndarray, action_state: np.ndarray,
-                   num_states: int, gamma: float, delta: float = 1e-3,
-                   max_sweeps: int = 100_000) -> tuple[np.ndarray, np.ndarray]:
+def ValueIteration(
+    transitions: np.ndarray,
+    rewards: np.ndarray,
+    action_state: np.ndarray,
+    num_states: int,
+    gamma: float,
+    delta: float = 1e-3,
+    max_sweeps: int = 100_000,
+) -> tuple[np.ndarray, np.ndarray]:
     """Returns ``(V(s, a), V(s))``.
 
     Args:

@@ -86,48 +86,68 @@ class StateActionExecutor(LeafSystem):
     _FELT_OBJECT = 10
     _Q_STAR = 11
 
-    def __init__(self, *, num_joints: int, marker_index: int, num_markers: int,
-                 initial_attractor: np.ndarray, forcing: ReachForcing | None = None,
-                 timing: ActionTiming | None = None, period: float = 0.1):
+    def __init__(
+        self,
+        *,
+        num_joints: int,
+        marker_index: int,
+        num_markers: int,
+        initial_attractor: np.ndarray,
+        forcing: ReachForcing | None = None,
+        timing: ActionTiming | None = None,
+        period: float = 0.1,
+    ):
         super().__init__()
         self._n, self._marker, self._num_markers = num_joints, marker_index, num_markers
         self._forcing = forcing or ReachForcing()
         self._timing = timing or ActionTiming()
         if not (self._forcing.force > 0 and self._forcing.softening > 0):
-            raise ValueError(f"reach forcing: force and softening must be > 0, got "
-                             f"{self._forcing.force} and {self._forcing.softening}")
+            raise ValueError(
+                f"reach forcing: force and softening must be > 0, got "
+                f"{self._forcing.force} and {self._forcing.softening}"
+            )
         initial = np.zeros(self._Q_STAR + num_joints)
         initial[self._SLOW_SINCE] = np.inf
-        initial[self._Q_STAR:] = initial_attractor
+        initial[self._Q_STAR :] = initial_attractor
         self._state_port = self.DeclareVectorInputPort("robot_state", 2 * num_joints)
         self._markers_port = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
-        self._pairs_port = self.DeclareAbstractInputPort("field_pairs",
-                                                         AbstractValue.Make(NO_FIELD_PAIRS))
+        self._pairs_port = self.DeclareAbstractInputPort(
+            "field_pairs", AbstractValue.Make(NO_FIELD_PAIRS)
+        )
         self._state = self.DeclareDiscreteState(BasicVector(initial))
-        self.DeclarePeriodicDiscreteUpdateEvent(period_sec=period, offset_sec=period,
-                                                update=self._Poll)
+        self.DeclarePeriodicDiscreteUpdateEvent(
+            period_sec=period, offset_sec=period, update=self._Poll
+        )
         self.DeclareVectorOutputPort(
-            "attractor", num_joints,
-            lambda context, output: output.SetFromVector(self._Vector(context)[self._Q_STAR:]),
-            prerequisites_of_calc={self.discrete_state_ticket(self._state)})
+            "attractor",
+            num_joints,
+            lambda context, output: output.SetFromVector(self._Vector(context)[self._Q_STAR :]),
+            prerequisites_of_calc={self.discrete_state_ticket(self._state)},
+        )
         self.DeclareVectorOutputPort(
-            "marker_forces", 3 * num_markers, self._CalcMarkerForces,
-            prerequisites_of_calc={self.discrete_state_ticket(self._state),
-                                   self._markers_port.ticket()})
+            "marker_forces",
+            3 * num_markers,
+            self._CalcMarkerForces,
+            prerequisites_of_calc={
+                self.discrete_state_ticket(self._state),
+                self._markers_port.ticket(),
+            },
+        )
 
     def _Vector(self, context) -> np.ndarray:
         return context.get_discrete_state(self._state).value()
 
     def _Marker(self, context) -> np.ndarray:
-        return self._markers_port.Eval(context)[3 * self._marker:3 * self._marker + 3]
+        return self._markers_port.Eval(context)[3 * self._marker : 3 * self._marker + 3]
 
     def _CalcMarkerForces(self, context, output) -> None:
         x = self._Vector(context)
         forces = np.zeros(3 * self._num_markers)
         if x[self._PHASE] == Phase.FORCING:
             error = x[self._TARGET] - self._Marker(context)
-            forces[3 * self._marker:3 * self._marker + 3] = (
-                self._forcing.force * error / (np.linalg.norm(error) + self._forcing.softening))
+            forces[3 * self._marker : 3 * self._marker + 3] = (
+                self._forcing.force * error / (np.linalg.norm(error) + self._forcing.softening)
+            )
         output.SetFromVector(forces)
 
     def _Poll(self, context, discrete_state) -> None:
@@ -136,15 +156,18 @@ class StateActionExecutor(LeafSystem):
         if phase == Phase.IDLE:
             return
         now, timing = context.get_time(), self._timing
-        v = self._state_port.Eval(context)[self._n:]
+        v = self._state_port.Eval(context)[self._n :]
         pairs: FieldPairs = self._pairs_port.Eval(context)
         if not np.all(pairs.b_is_robot):
             x[self._FELT_OBJECT] = 1.0
         slow = np.max(np.abs(v), initial=0.0) < timing.settle_speed
         x[self._SLOW_SINCE] = min(x[self._SLOW_SINCE], now) if slow else np.inf
         elapsed = now - x[self._STARTED]
-        settled = (elapsed >= timing.min_duration and slow
-                   and now - x[self._SLOW_SINCE] >= timing.settle_time)
+        settled = (
+            elapsed >= timing.min_duration
+            and slow
+            and now - x[self._SLOW_SINCE] >= timing.settle_time
+        )
         if settled or elapsed >= timing.timeout:
             if phase == Phase.FORCING:
                 x[self._REACHED] = self._Marker(context)
@@ -164,7 +187,7 @@ class StateActionExecutor(LeafSystem):
             raise ValueError(f"an action is in flight (phase {Phase(int(x[self._PHASE])).name})")
         x[self._PHASE], x[self._STARTED], x[self._SLOW_SINCE] = phase, context.get_time(), np.inf
         x[self._FELT_OBJECT] = 0.0
-        x[self._Q_STAR:] = q_star
+        x[self._Q_STAR :] = q_star
         if target is not None:
             x[self._TARGET] = target
         context.SetDiscreteState(self._state, x)

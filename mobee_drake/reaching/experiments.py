@@ -78,10 +78,15 @@ def _Robot() -> IcubConfig:
 def TrainMdp(folder: pathlib.Path, min_tries: int, seed: int = 0):
     """The curious agent's model of the rank-3 lattice, learned once (kept in ``folder``)."""
     if not (folder / f"{AGENT}.npz").is_file():
-        agent = ExploringAgent(name=AGENT, joints=RIGHT_ARM, levels=LEVELS,
-                               explorer=ExplorerConfig(seed=seed))
-        Explore(ExplorationScenario([agent], robot=_Robot()), chunk=5.0, keep=folder,
-                stop=lambda records: records[0].explorer.tries.min() >= min_tries)
+        agent = ExploringAgent(
+            name=AGENT, joints=RIGHT_ARM, levels=LEVELS, explorer=ExplorerConfig(seed=seed)
+        )
+        Explore(
+            ExplorationScenario([agent], robot=_Robot()),
+            chunk=5.0,
+            keep=folder,
+            stop=lambda records: records[0].explorer.tries.min() >= min_tries,
+        )
     return LoadAgentModel(str(folder), AGENT, ExplorerConfig())
 
 
@@ -116,8 +121,9 @@ def ReachScenario(reach_force: float = ReachForcing().force) -> Scenario:
     return scenario
 
 
-def _Checkpoint(folder: pathlib.Path, robot: SimulatedRobot, learner: ReachLearner,
-                data: dict) -> None:
+def _Checkpoint(
+    folder: pathlib.Path, robot: SimulatedRobot, learner: ReachLearner, data: dict
+) -> None:
     """Saves the simulation, the learner and ``data`` (evaluations, wall time) atomically."""
 
     def Write(staging: pathlib.Path) -> None:
@@ -129,8 +135,9 @@ def _Checkpoint(folder: pathlib.Path, robot: SimulatedRobot, learner: ReachLearn
     WriteFolderAtomically(folder, Write)
 
 
-def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
-           meshcat=None) -> dict:
+def RunOne(
+    run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings, meshcat=None
+) -> dict:
     """One run of the battery (resumes from ``run_dir/checkpoint``); returns its result. With
     ``meshcat``, the run is shown there in real time."""
     result_path = run_dir / "result.json"
@@ -139,17 +146,26 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
     run_dir.mkdir(parents=True, exist_ok=True)
     simultaneous = settings.mdp == "simultaneous"
     # The optimistic initial model of the MDP's lattice, or the model learned first.
-    model = (Explorer(Lattice(LEVELS, len(RIGHT_ARM))) if simultaneous
-             else LoadAgentModel(str(mdp_dir), AGENT, ExplorerConfig()))
+    model = (
+        Explorer(Lattice(LEVELS, len(RIGHT_ARM)))
+        if simultaneous
+        else LoadAgentModel(str(mdp_dir), AGENT, ExplorerConfig())
+    )
     grid = LoadTargetGrid()
-    learner = ReachLearner(model.space, model.transitions.counts, grid.Centres(),
-                           ReachLearningConfig(strategy=settings.strategy, seed=settings.seed,
-                                               predictor=PredictorConfig(
-                                                   settings.predictor,
-                                                   distance_unit=settings.distance_unit),
-                                               learn_mdp=simultaneous))
-    robot = SimulatedRobot(ReachScenario(settings.reach_force), RIGHT_ARM, model.space,
-                           grid.radius, meshcat=meshcat)
+    learner = ReachLearner(
+        model.space,
+        model.transitions.counts,
+        grid.Centres(),
+        ReachLearningConfig(
+            strategy=settings.strategy,
+            seed=settings.seed,
+            predictor=PredictorConfig(settings.predictor, distance_unit=settings.distance_unit),
+            learn_mdp=simultaneous,
+        ),
+    )
+    robot = SimulatedRobot(
+        ReachScenario(settings.reach_force), RIGHT_ARM, model.space, grid.radius, meshcat=meshcat
+    )
     checkpoint = run_dir / "checkpoint"
     data = dict(evaluations={}, wall_seconds=0.0, target=None)
     if checkpoint.is_dir():
@@ -165,15 +181,18 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
         data["wall_seconds"] = time.perf_counter() - started
         data["target"] = None if robot.target is None else robot.target.tolist()
         _Checkpoint(checkpoint, robot, learner, data)
-        SaveJson(run_dir / "progress.json", dict(
-            problem_tries=int(learner.problem_tries.sum()), total=settings.problem_tries))
+        SaveJson(
+            run_dir / "progress.json",
+            dict(problem_tries=int(learner.problem_tries.sum()), total=settings.problem_tries),
+        )
 
     while True:
         done = int(learner.problem_tries.sum())
         if done in settings.stages and str(done) not in data["evaluations"]:
             data["evaluations"][str(done)] = [
                 [dc.asdict(r) for r in learner.Evaluate(robot, seed=(settings.seed, done, e))]
-                for e in range(settings.evaluations)]
+                for e in range(settings.evaluations)
+            ]
             Save()
         if done >= settings.problem_tries:
             break
@@ -189,20 +208,35 @@ def RunOne(run_dir: pathlib.Path, mdp_dir: pathlib.Path, settings: RunSettings,
         # The state-actions the model learned about, and their learned chance of success.
         updated = np.flatnonzero(np.any(counts != model.transitions.counts, axis=1))
         success = learner.model.Probabilities()[updated, model.space.action_goal[updated]]
-        extra = dict(mdp=dict(updated_state_actions=len(updated),
-                              success_probability=float(success.mean()) if len(updated) else None))
-    result = dict(settings=dc.asdict(settings), evaluations=data["evaluations"],
-                  log=arrays["log"].tolist(), simulated_seconds=robot.simulated_seconds,
-                  wall_seconds=data["wall_seconds"],
-                  penetrating_steps=robot.PenetratingSteps(),
-                  num_transitions=learner.num_transitions,
-                  num_states=learner.space.num_states, **extra)
+        extra = dict(
+            mdp=dict(
+                updated_state_actions=len(updated),
+                success_probability=float(success.mean()) if len(updated) else None,
+            )
+        )
+    result = dict(
+        settings=dc.asdict(settings),
+        evaluations=data["evaluations"],
+        log=arrays["log"].tolist(),
+        simulated_seconds=robot.simulated_seconds,
+        wall_seconds=data["wall_seconds"],
+        penetrating_steps=robot.PenetratingSteps(),
+        num_transitions=learner.num_transitions,
+        num_states=learner.space.num_states,
+        **extra,
+    )
     SaveJson(result_path, result)
     return result
 
 
-def RunBattery(output: pathlib.Path, strategies, seeds: int, settings: RunSettings,
-               mdp_tries: int, workers: int) -> list[dict]:
+def RunBattery(
+    output: pathlib.Path,
+    strategies,
+    seeds: int,
+    settings: RunSettings,
+    mdp_tries: int,
+    workers: int,
+) -> list[dict]:
     """The MDP (unless learned with the reaches), then a run of ``settings`` for every strategy
     and seed in ``workers`` processes, with progress bars."""
     from tqdm import tqdm
@@ -210,16 +244,29 @@ def RunBattery(output: pathlib.Path, strategies, seeds: int, settings: RunSettin
     mdp_dir = output / f"mdp_tries{mdp_tries}"
     if settings.mdp == "learned_first":
         TrainMdp(mdp_dir, mdp_tries)
-    runs = {f"{strategy}_seed{seed}": dc.replace(settings, strategy=strategy, seed=seed)
-            for strategy in strategies for seed in range(seeds)}
+    runs = {
+        f"{strategy}_seed{seed}": dc.replace(settings, strategy=strategy, seed=seed)
+        for strategy in strategies
+        for seed in range(seeds)
+    }
     problem_tries = settings.problem_tries
     context = multiprocessing.get_context("spawn")
     with concurrent.futures.ProcessPoolExecutor(workers, mp_context=context) as pool:
-        futures = {name: pool.submit(RunOne, output / "runs" / name, mdp_dir, settings)
-                   for name, settings in runs.items()}
-        bars = {name: tqdm(total=problem_tries, desc=name, position=i, leave=True,
-                           unit="try", dynamic_ncols=True)
-                for i, name in enumerate(runs)}
+        futures = {
+            name: pool.submit(RunOne, output / "runs" / name, mdp_dir, settings)
+            for name, settings in runs.items()
+        }
+        bars = {
+            name: tqdm(
+                total=problem_tries,
+                desc=name,
+                position=i,
+                leave=True,
+                unit="try",
+                dynamic_ncols=True,
+            )
+            for i, name in enumerate(runs)
+        }
         while True:
             for name, bar in bars.items():
                 progress = output / "runs" / name / "progress.json"
@@ -264,25 +311,42 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
     by_strategy = {s: [r for r in results if r["settings"]["strategy"] == s] for s in strategies}
     stages = sorted({int(k) for r in results for k in r["evaluations"]})
     k, m = results[0]["num_transitions"], results[0]["num_states"]
-    lines = ["## Cumulative reward of the exploitation evaluations (Fig. 8.2)", "",
-             "Sum of the reaches' rewards (eq. 8.4) over the 27 problems of one evaluation (a "
-             "problem-try that timed out adds 0); mean and standard deviation over all "
-             "evaluations of all seeds.", "",
-             "| strategy | " + " | ".join(str(s) for s in stages) + " |",
-             "|---|" + "---:|" * len(stages)]
+    lines = [
+        "## Cumulative reward of the exploitation evaluations (Fig. 8.2)",
+        "",
+        "Sum of the reaches' rewards (eq. 8.4) over the 27 problems of one evaluation (a "
+        "problem-try that timed out adds 0); mean and standard deviation over all "
+        "evaluations of all seeds.",
+        "",
+        "| strategy | " + " | ".join(str(s) for s in stages) + " |",
+        "|---|" + "---:|" * len(stages),
+    ]
     means = {}
-    figure, axes = plt.subplots(1, len(strategies), figsize=(5 * len(strategies), 4),
-                                squeeze=False, sharey=True)
+    figure, axes = plt.subplots(
+        1, len(strategies), figsize=(5 * len(strategies), 4), squeeze=False, sharey=True
+    )
     for axis, strategy in zip(axes[0], strategies):
-        table = np.array([[[_Cumulative(e) for e in r["evaluations"][str(stage)]]
-                           for stage in stages] for r in by_strategy[strategy]])
+        table = np.array(
+            [
+                [[_Cumulative(e) for e in r["evaluations"][str(stage)]] for stage in stages]
+                for r in by_strategy[strategy]
+            ]
+        )
         means[strategy] = table.mean(axis=(0, 2))
-        lines.append(f"| {strategy} | " + " | ".join(
-            f"{mu:.2f} ± {sd:.2f}" for mu, sd in zip(means[strategy], table.std(axis=(0, 2))))
-            + " |")
+        lines.append(
+            f"| {strategy} | "
+            + " | ".join(
+                f"{mu:.2f} ± {sd:.2f}" for mu, sd in zip(means[strategy], table.std(axis=(0, 2)))
+            )
+            + " |"
+        )
         # One colour per evaluation (seed after seed), stacked per stage.
-        _Stacked(axis, table.transpose(0, 2, 1).reshape(-1, len(stages)),
-                 x=np.arange(len(stages)), width=0.6)
+        _Stacked(
+            axis,
+            table.transpose(0, 2, 1).reshape(-1, len(stages)),
+            x=np.arange(len(stages)),
+            width=0.6,
+        )
         axis.set_xticks(np.arange(len(stages)), [str(s) for s in stages])
         axis.set_xlabel("exploratory problem-tries")
         axis.set_title(strategy)
@@ -292,12 +356,24 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
 
     # Fig. 8.4-8.6: the reaching state-actions chosen in evaluations, per stage, seeds stacked.
     for strategy in strategies:
-        figure, axes = plt.subplots(len(stages), 1, figsize=(10, 1.6 * len(stages)),
-                                    squeeze=False, sharex=True)
+        figure, axes = plt.subplots(
+            len(stages), 1, figsize=(10, 1.6 * len(stages)), squeeze=False, sharex=True
+        )
         for axis, stage in zip(axes[:, 0], stages):
-            counts = np.array([np.bincount(
-                [t["reach"] - k for e in r["evaluations"][str(stage)] for t in e
-                 if t["reach"] >= 0], minlength=m) for r in by_strategy[strategy]])
+            counts = np.array(
+                [
+                    np.bincount(
+                        [
+                            t["reach"] - k
+                            for e in r["evaluations"][str(stage)]
+                            for t in e
+                            if t["reach"] >= 0
+                        ],
+                        minlength=m,
+                    )
+                    for r in by_strategy[strategy]
+                ]
+            )
             _Stacked(axis, counts)
             axis.set_ylabel(str(stage), rotation=0, labelpad=20)
         axes[-1, 0].set_xlabel(f"reaching state-action - {k} (its state)")
@@ -306,8 +382,12 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
         figure.savefig(output / f"8.4-8.6_reaches_{strategy}.png", dpi=80)
 
     # Fig. 8.7: exploratory tries per problem (row) and state-action (column), mean over seeds.
-    figure, axes = plt.subplots(len(stages), len(strategies),
-                                figsize=(5 * len(strategies), 1.4 * len(stages)), squeeze=False)
+    figure, axes = plt.subplots(
+        len(stages),
+        len(strategies),
+        figsize=(5 * len(strategies), 1.4 * len(stages)),
+        squeeze=False,
+    )
     num_problems = len(results[0]["evaluations"][str(stages[0])][0])
     for column, strategy in enumerate(strategies):
         for row, stage in enumerate(stages):
@@ -316,8 +396,12 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
                 log = np.array(r["log"]).reshape(-1, len(LOG_COLUMNS))
                 log = log[log[:, 0] < stage]
                 np.add.at(image, (log[:, 1].astype(int), log[:, 2].astype(int)), 1.0)
-            axes[row, column].imshow(image / len(by_strategy[strategy]), aspect="auto",
-                                     cmap="jet", interpolation="nearest")
+            axes[row, column].imshow(
+                image / len(by_strategy[strategy]),
+                aspect="auto",
+                cmap="jet",
+                interpolation="nearest",
+            )
             axes[row, column].set_xticks([])
             axes[row, column].set_yticks([])
             if column == 0:
@@ -327,13 +411,18 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
     figure.savefig(output / "8.7_problem_tries.png", dpi=80)
 
     # Fig. 8.8: failed transitions (reward -10) per state-action, seeds stacked.
-    figure, axes = plt.subplots(len(strategies), 1, figsize=(10, 2.2 * len(strategies)),
-                                squeeze=False, sharex=True)
-    lines += ["", "## Robot time, failed transitions and reaches", "",
-              "| strategy | runs | robot hours (all runs) | source's robot hours (5 runs of 6400) "
-              "| actions per problem-try | failed transitions per problem-try | timed-out "
-              "problem-tries | wall hours (all runs) | penetrating control periods |",
-              "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    figure, axes = plt.subplots(
+        len(strategies), 1, figsize=(10, 2.2 * len(strategies)), squeeze=False, sharex=True
+    )
+    lines += [
+        "",
+        "## Robot time, failed transitions and reaches",
+        "",
+        "| strategy | runs | robot hours (all runs) | source's robot hours (5 runs of 6400) "
+        "| actions per problem-try | failed transitions per problem-try | timed-out "
+        "problem-tries | wall hours (all runs) | penetrating control periods |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
     hours = {}
     for axis, strategy in zip(axes[:, 0], strategies):
         counts, actions, failed, timeouts, tries = [], 0, 0, 0, 0
@@ -353,83 +442,134 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
             f"| {strategy} | {len(by_strategy[strategy])} | {hours[strategy]:.1f} | "
             f"{SOURCE_HOURS.get(strategy, '-')} | {actions / tries:.2f} | {failed / tries:.2f} | "
             f"{timeouts} | {sum(r['wall_seconds'] for r in by_strategy[strategy]) / 3600:.2f} | "
-            f"{sum(r['penetrating_steps'] for r in by_strategy[strategy])} |")
+            f"{sum(r['penetrating_steps'] for r in by_strategy[strategy])} |"
+        )
     axes[-1, 0].set_xlabel("transition state-action")
     figure.tight_layout()
     figure.savefig(output / "8.8_failed_transitions.png", dpi=80)
 
     if all("mdp" in r for r in results):
-        lines += ["", "## The MDP learned with the reaches (ch. 9.4.1)", "",
-                  f"State-actions (of {k}) whose model was updated (tried without the fields "
-                  "feeling the target), and their learned probability of reaching their goal "
-                  "state (the optimistic initialisation says 0.5), mean over seeds.", "",
-                  "| strategy | state-actions updated | P(goal) |", "|---|---:|---:|"]
+        lines += [
+            "",
+            "## The MDP learned with the reaches (ch. 9.4.1)",
+            "",
+            f"State-actions (of {k}) whose model was updated (tried without the fields "
+            "feeling the target), and their learned probability of reaching their goal "
+            "state (the optimistic initialisation says 0.5), mean over seeds.",
+            "",
+            "| strategy | state-actions updated | P(goal) |",
+            "|---|---:|---:|",
+        ]
         for strategy in strategies:
             runs = [r["mdp"] for r in by_strategy[strategy]]
-            success = [r["success_probability"] for r in runs
-                       if r["success_probability"] is not None]
-            lines.append(f"| {strategy} | "
-                         f"{np.mean([r['updated_state_actions'] for r in runs]):.0f} | "
-                         + (f"{np.mean(success):.2f} |" if success else "- |"))
+            success = [
+                r["success_probability"] for r in runs if r["success_probability"] is not None
+            ]
+            lines.append(
+                f"| {strategy} | "
+                f"{np.mean([r['updated_state_actions'] for r in runs]):.0f} | "
+                + (f"{np.mean(success):.2f} |" if success else "- |")
+            )
 
-    lines += ["", "## The source's claims (ch. 8.4)", "",
-              "Differences of the mean cumulative reward, with Welch's t-test over the "
-              "evaluations (a claim about an order holds only with p < 0.05).", ""]
+    lines += [
+        "",
+        "## The source's claims (ch. 8.4)",
+        "",
+        "Differences of the mean cumulative reward, with Welch's t-test over the "
+        "evaluations (a claim about an order holds only with p < 0.05).",
+        "",
+    ]
     if {"intrinsic", "random", "greedy"} <= set(means):
         from scipy.stats import ttest_ind
 
         def Rewards(strategy, stage):
-            return [_Cumulative(e) for r in by_strategy[strategy]
-                    for e in r["evaluations"][str(stage)]]
+            return [
+                _Cumulative(e) for r in by_strategy[strategy] for e in r["evaluations"][str(stage)]
+            ]
 
         for i, stage in enumerate(stages):
             mine = Rewards("intrinsic", stage)
             comparisons = []
             for other in [s for s in strategies if s != "intrinsic"]:
                 test = ttest_ind(mine, Rewards(other, stage), equal_var=False)
-                comparisons.append(f"{other} {means['intrinsic'][i] - means[other][i]:+.2f} "
-                                   f"(p = {test.pvalue:.2g})")
-            lines.append(f"- after {stage} problem-tries, intrinsic minus " +
-                         ", ".join(comparisons) + ";")
+                comparisons.append(
+                    f"{other} {means['intrinsic'][i] - means[other][i]:+.2f} "
+                    f"(p = {test.pvalue:.2g})"
+                )
+            lines.append(
+                f"- after {stage} problem-tries, intrinsic minus " + ", ".join(comparisons) + ";"
+            )
         ratio = hours["random"] / np.mean([hours["greedy"], hours["intrinsic"]])
         lines += [
             "- the source: intrinsic motivation is the least competent after 100 problem-tries, "
             "improves steadily and is clearly the best from about 800 on;",
             f"- random exploration took {ratio:.2f} times the robot time of the other two "
-            f"(source: 207 h against 109 and 113 h, 1.86 times)."]
+            f"(source: 207 h against 109 and 113 h, 1.86 times).",
+        ]
     return "\n".join(lines)
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(prog="mobee-drake experiment ch8", description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        prog="mobee-drake experiment ch8",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     parser.add_argument("--output", default="results/ch8")
-    parser.add_argument("--strategies", nargs="+", choices=STRATEGIES,
-                        default=list(SOURCE_STRATEGIES))
+    parser.add_argument(
+        "--strategies", nargs="+", choices=STRATEGIES, default=list(SOURCE_STRATEGIES)
+    )
     parser.add_argument("--seeds", type=int, default=5)
     parser.add_argument("--problem-tries", type=int, default=6400)
-    parser.add_argument("--stages", type=int, nargs="+", default=None,
-                        help="when to evaluate (default: the source's 100, 200, ..., 6400 up to "
-                             "--problem-tries)")
+    parser.add_argument(
+        "--stages",
+        type=int,
+        nargs="+",
+        default=None,
+        help="when to evaluate (default: the source's 100, 200, ..., 6400 up to --problem-tries)",
+    )
     parser.add_argument("--evaluations", type=int, default=5)
-    parser.add_argument("--mdp-tries", type=int, default=5,
-                        help="the MDP is learned until every state-action was tried this often")
+    parser.add_argument(
+        "--mdp-tries",
+        type=int,
+        default=5,
+        help="the MDP is learned until every state-action was tried this often",
+    )
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--checkpoint-every", type=int, default=50)
-    parser.add_argument("--watch", action="store_true",
-                        help="run only the first strategy's seed 0, in this process, shown in "
-                             "Meshcat in real time (the address is printed)")
-    parser.add_argument("--predictor", choices=PREDICTORS, default="weighted",
-                        help="the reward predictor: the source's weighted averages (eq. 8.1-8.7) "
-                             "or a Gaussian process (use another --output)")
-    parser.add_argument("--mdp", choices=MDPS, default="learned_first",
-                        help="learn the MDP first and keep it (ch. 8), or learn it with the "
-                             "reaches (ch. 9.4.1; use another --output)")
-    parser.add_argument("--reach-force", type=float, default=ReachForcing().force,
-                        help="the reach's force on the palm in N (use another --output)")
-    parser.add_argument("--distance-unit", type=float, default=PredictorConfig().distance_unit,
-                        help="the length in m that counts as 1 in the rewards and predictions "
-                             "of eq. 8.1-8.7, e.g. 0.01 for centimetres (use another --output)")
+    parser.add_argument(
+        "--watch",
+        action="store_true",
+        help="run only the first strategy's seed 0, in this process, shown in "
+        "Meshcat in real time (the address is printed)",
+    )
+    parser.add_argument(
+        "--predictor",
+        choices=PREDICTORS,
+        default="weighted",
+        help="the reward predictor: the source's weighted averages (eq. 8.1-8.7) "
+        "or a Gaussian process (use another --output)",
+    )
+    parser.add_argument(
+        "--mdp",
+        choices=MDPS,
+        default="learned_first",
+        help="learn the MDP first and keep it (ch. 8), or learn it with the "
+        "reaches (ch. 9.4.1; use another --output)",
+    )
+    parser.add_argument(
+        "--reach-force",
+        type=float,
+        default=ReachForcing().force,
+        help="the reach's force on the palm in N (use another --output)",
+    )
+    parser.add_argument(
+        "--distance-unit",
+        type=float,
+        default=PredictorConfig().distance_unit,
+        help="the length in m that counts as 1 in the rewards and predictions "
+        "of eq. 8.1-8.7, e.g. 0.01 for centimetres (use another --output)",
+    )
     argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(argv)
     stages = args.stages or [s for s in SOURCE_STAGES if s <= args.problem_tries]
@@ -437,9 +577,18 @@ def main(argv=None) -> None:
         parser.error(f"--stages must lie in 0..{args.problem_tries}")
     output = pathlib.Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
-    settings = RunSettings(args.strategies[0], 0, args.problem_tries, stages, args.evaluations,
-                           args.checkpoint_every, args.predictor, args.mdp, args.reach_force,
-                           args.distance_unit)
+    settings = RunSettings(
+        args.strategies[0],
+        0,
+        args.problem_tries,
+        stages,
+        args.evaluations,
+        args.checkpoint_every,
+        args.predictor,
+        args.mdp,
+        args.reach_force,
+        args.distance_unit,
+    )
     if args.watch:
         from pydrake.geometry import StartMeshcat
 
@@ -448,11 +597,14 @@ def main(argv=None) -> None:
             TrainMdp(mdp_dir, args.mdp_tries)
         RunOne(output / "runs" / f"watch_{settings.strategy}", mdp_dir, settings, StartMeshcat())
         return
-    results = RunBattery(output, args.strategies, args.seeds, settings, args.mdp_tries,
-                         args.workers)
+    results = RunBattery(
+        output, args.strategies, args.seeds, settings, args.mdp_tries, args.workers
+    )
     report = output / "report.md"
-    report.write_text(f"# Reach learning (ch. 8.4)\n\n`mobee-drake experiment ch8 "
-                      f"{' '.join(argv)}`\n\n" + Report(output, results) + "\n")
+    report.write_text(
+        f"# Reach learning (ch. 8.4)\n\n`mobee-drake experiment ch8 "
+        f"{' '.join(argv)}`\n\n" + Report(output, results) + "\n"
+    )
     print(report.read_text())
 
 

@@ -57,8 +57,7 @@ class GoalBabbler:
     def Select(self, rng: np.random.Generator) -> np.ndarray:
         """The next goal: uniform in the goal space until its first split, then modes 1-3."""
         if len(self.tree.leaves) > 1:
-            _, region = SelectRegion(self.tree.leaves, rng,
-                                     self.config.interest.mode_probabilities)
+            _, region = SelectRegion(self.tree.leaves, rng, self.config.interest.mode_probabilities)
             if region is not None:
                 return region.Sample(rng)
         return rng.uniform(self.low, self.high)
@@ -70,8 +69,11 @@ class GoalBabbler:
         if reached is None:
             competence = interest.min_competence
         else:
-            competence = Competence(ReachingCost(goal, reached, start, interest.min_competence),
-                                    interest.competence_tolerance, interest.min_competence)
+            competence = Competence(
+                ReachingCost(goal, reached, start, interest.min_competence),
+                interest.competence_tolerance,
+                interest.min_competence,
+            )
         self._Add(goal, competence)
         return competence
 
@@ -82,8 +84,10 @@ class GoalBabbler:
         self.competences.append(competence)
 
     def ToArrays(self) -> dict[str, np.ndarray]:
-        return dict(goals=np.array(self.goals, dtype=float).reshape(-1, 3),
-                    goal_competences=np.array(self.competences, dtype=float))
+        return dict(
+            goals=np.array(self.goals, dtype=float).reshape(-1, 3),
+            goal_competences=np.array(self.competences, dtype=float),
+        )
 
     def LoadArrays(self, arrays) -> None:
         """Replays saved attempts into this (fresh) babbler: the same tree, split for split."""

@@ -84,8 +84,10 @@ class ReachLearningConfig:
         self.predictor.Validate()
         self.goals.Validate()
         if self.strategy not in STRATEGIES:
-            raise ValueError(f"unknown reach-learning strategy '{self.strategy}'; strategies "
-                             "are " + ", ".join(STRATEGIES))
+            raise ValueError(
+                f"unknown reach-learning strategy '{self.strategy}'; strategies "
+                "are " + ", ".join(STRATEGIES)
+            )
         if not 0 <= self.gamma < 1:
             raise ValueError(f"gamma must be in [0, 1), got {self.gamma}")
         if self.max_actions < 1:
@@ -132,15 +134,30 @@ class TryResult:
 
 # Columns of the action log: problem-try, problem (goal_babbling: the problem nearest the goal),
 # state-action, state before, state after, estimate, reward, target (or goal) x, y, z.
-LOG_COLUMNS = ("try", "problem", "state_action", "state", "outcome", "estimate", "reward",
-               "x", "y", "z")
+LOG_COLUMNS = (
+    "try",
+    "problem",
+    "state_action",
+    "state",
+    "outcome",
+    "estimate",
+    "reward",
+    "x",
+    "y",
+    "z",
+)
 
 
 class ReachLearner:
     """Learns which pre-reach states suit which targets (ch. 8)."""
 
-    def __init__(self, space: StateActionSpace, transition_counts: np.ndarray,
-                 targets: np.ndarray, config: ReachLearningConfig | None = None):
+    def __init__(
+        self,
+        space: StateActionSpace,
+        transition_counts: np.ndarray,
+        targets: np.ndarray,
+        config: ReachLearningConfig | None = None,
+    ):
         """``transition_counts`` are the MDP's outcome counts per state-action (as
         :class:`~mobee_drake.planning.curiosity.TransitionCounts` keeps them; normalised rows give
         T), copied: with ``learn_mdp`` the learner's own transitions add to them."""
@@ -148,8 +165,7 @@ class ReachLearner:
         config.Validate()
         m, k = space.num_states, space.num_state_actions
         if transition_counts.shape != (k, m):
-            raise ValueError(f"transition counts must be ({k}, {m}), got "
-                             f"{transition_counts.shape}")
+            raise ValueError(f"transition counts must be ({k}, {m}), got {transition_counts.shape}")
         self.space, self.targets = space, np.asarray(targets, dtype=float)
         self.num_transitions = k
         self.model = TransitionCounts(k, m)
@@ -168,8 +184,9 @@ class ReachLearner:
         self.problem_tries = np.zeros(len(self.targets), dtype=int)
         self.rng = np.random.default_rng(config.seed)
         self.log: list[tuple] = []
-        self.babbler = (GoalBabbler(self.targets, config.goals)
-                        if config.strategy == "goal_babbling" else None)
+        self.babbler = (
+            GoalBabbler(self.targets, config.goals) if config.strategy == "goal_babbling" else None
+        )
 
     @property
     def num_state_actions(self) -> int:
@@ -185,13 +202,16 @@ class ReachLearner:
     # ------------------------------------------------------------------------------------------
     # Planning.
 
-    def Rewards(self, target: np.ndarray, reach_rewards: str, histories=None,
-                random_reach: int = -1) -> np.ndarray:
+    def Rewards(
+        self, target: np.ndarray, reach_rewards: str, histories=None, random_reach: int = -1
+    ) -> np.ndarray:
         """The problem's reward matrix: eq. 8.1 on transitions; on reaches ``reach_rewards``:
         "random" (1 on ``random_reach``), "greedy" (eq. 8.5) or "intrinsic" (eq. 8.7)."""
         histories = self.histories if histories is None else histories
-        rewards = np.array([histories.Predict(sa, target)
-                            for sa in range(self.num_transitions)] + [0.0] * self.space.num_states)
+        rewards = np.array(
+            [histories.Predict(sa, target) for sa in range(self.num_transitions)]
+            + [0.0] * self.space.num_states
+        )
         reaches = np.arange(self.num_transitions, self.num_state_actions)
         if reach_rewards == "random":
             rewards[random_reach] = 1.0
@@ -203,9 +223,14 @@ class ReachLearner:
 
     def Values(self, rewards: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """V(s, a) (in state-action numbering) and V(s) by value iteration (Alg. 7)."""
-        q_sorted, v = ValueIteration(self._T_sorted, rewards[self._order],
-                                     self.action_state[self._order], self.space.num_states,
-                                     self.config.gamma, self.config.delta)
+        q_sorted, v = ValueIteration(
+            self._T_sorted,
+            rewards[self._order],
+            self.action_state[self._order],
+            self.space.num_states,
+            self.config.gamma,
+            self.config.delta,
+        )
         q = np.empty_like(q_sorted)
         q[self._order] = q_sorted
         return q, v
@@ -220,15 +245,26 @@ class ReachLearner:
 
     def _RefreshT(self) -> None:
         """T of the transitions from the model's counts, in value iteration's order."""
-        self._T_sorted[self._rank[:self.num_transitions]] = self.model.Probabilities()
+        self._T_sorted[self._rank[: self.num_transitions]] = self.model.Probabilities()
 
-    def _Try(self, robot: Robot, problem: int, target: np.ndarray, reach_rewards: str,
-             histories: RewardHistories, rng, learn: bool) -> TryResult:
+    def _Try(
+        self,
+        robot: Robot,
+        problem: int,
+        target: np.ndarray,
+        reach_rewards: str,
+        histories: RewardHistories,
+        rng,
+        learn: bool,
+    ) -> TryResult:
         """One problem-try for ``target``; ``learn`` says whether it is exploration (logged; with
         ``learn_mdp`` the model learns) or an evaluation (``histories`` a scratch copy)."""
         robot.SetProblem(target)
-        random_reach = (self.Reach(int(rng.integers(self.space.num_states)))
-                        if reach_rewards == "random" else -1)
+        random_reach = (
+            self.Reach(int(rng.integers(self.space.num_states)))
+            if reach_rewards == "random"
+            else -1
+        )
         failed = 0
         for action in range(1, self.config.max_actions + 1):
             q, v = self.Values(self.Rewards(target, reach_rewards, histories, random_reach))
@@ -250,11 +286,20 @@ class ReachLearner:
                 failed += reward < 0
             histories.Record(sa, target, estimate, reward)
             if learn:
-                self.log.append((int(self.problem_tries.sum()), problem, sa, state, outcome,
-                                 estimate, reward, *target))
+                self.log.append(
+                    (
+                        int(self.problem_tries.sum()),
+                        problem,
+                        sa,
+                        state,
+                        outcome,
+                        estimate,
+                        reward,
+                        *target,
+                    )
+                )
             if self.reaching[sa]:
-                return TryResult(problem, action, reward, sa, failed,
-                                 [float(c) for c in reached])
+                return TryResult(problem, action, reward, sa, failed, [float(c) for c in reached])
         return TryResult(problem, self.config.max_actions, None, -1, failed)
 
     def Explore(self, robot: Robot) -> TryResult:
@@ -271,10 +316,12 @@ class ReachLearner:
         self.babbler.Record(goal, start, result.reached)
         return result
 
-    def _Explore(self, robot: Robot, problem: int, target: np.ndarray,
-                 reach_rewards: str) -> TryResult:
-        result = self._Try(robot, problem, target, reach_rewards, self.histories, self.rng,
-                           learn=True)
+    def _Explore(
+        self, robot: Robot, problem: int, target: np.ndarray, reach_rewards: str
+    ) -> TryResult:
+        result = self._Try(
+            robot, problem, target, reach_rewards, self.histories, self.rng, learn=True
+        )
         self.problem_tries[problem] += 1
         return result
 
@@ -283,17 +330,27 @@ class ReachLearner:
         state, then every problem, shuffled, greedily; the learner's state is not changed."""
         rng = np.random.default_rng(seed)
         start = int(rng.integers(self.space.num_states))
-        into_start = np.append((self.space.action_goal == start).astype(float),
-                               np.zeros(self.space.num_states))
+        into_start = np.append(
+            (self.space.action_goal == start).astype(float), np.zeros(self.space.num_states)
+        )
         q, _ = self.Values(into_start)
         for _ in range(self.config.max_actions):
             state = robot.State()
             if state == start:
                 break
             robot.Transition(int(self.space.action_goal[self._Greedy(q, state, rng)]))
-        return [self._Try(robot, int(problem), self.targets[problem], "greedy",
-                          self.histories.Copy(), rng, learn=False)
-                for problem in rng.permutation(len(self.targets))]
+        return [
+            self._Try(
+                robot,
+                int(problem),
+                self.targets[problem],
+                "greedy",
+                self.histories.Copy(),
+                rng,
+                learn=False,
+            )
+            for problem in rng.permutation(len(self.targets))
+        ]
 
     # ------------------------------------------------------------------------------------------
     # Saving and resuming.
@@ -301,28 +358,35 @@ class ReachLearner:
     def ToArrays(self) -> tuple[dict[str, np.ndarray], dict]:
         """The learner's state as arrays (the log, tries and, with ``learn_mdp``, the MDP's
         counts) and JSON-able data (configuration, generator state)."""
-        arrays = dict(log=np.array(self.log, dtype=float).reshape(-1, len(LOG_COLUMNS)),
-                      problem_tries=self.problem_tries)
+        arrays = dict(
+            log=np.array(self.log, dtype=float).reshape(-1, len(LOG_COLUMNS)),
+            problem_tries=self.problem_tries,
+        )
         if self.config.learn_mdp:
             arrays["transition_counts"] = self.model.counts
         if self.babbler is not None:
             arrays.update(self.babbler.ToArrays())
-        return arrays, dict(config=dc.asdict(self.config),
-                            generator=self.rng.bit_generator.state)
+        return arrays, dict(config=dc.asdict(self.config), generator=self.rng.bit_generator.state)
 
     def LoadArrays(self, arrays, data: dict) -> None:
         """Restores :meth:`ToArrays`' state into this (fresh) learner: the histories are rebuilt
         from the log, record by record; a learned MDP is restored from its counts."""
         if self.log:
             raise ValueError("load a saved state into a fresh learner only")
-        saved, mine = (json.loads(json.dumps(c)) for c in (data["config"],
-                                                            dc.asdict(self.config)))
+        saved, mine = (json.loads(json.dumps(c)) for c in (data["config"], dc.asdict(self.config)))
         if saved != mine:
-            raise ValueError(f"the saved learner's configuration {saved} is not this one's "
-                             f"{mine}")
+            raise ValueError(f"the saved learner's configuration {saved} is not this one's {mine}")
         for row in np.asarray(arrays["log"]):
-            entry = (int(row[0]), int(row[1]), int(row[2]), int(row[3]), int(row[4]),
-                     float(row[5]), float(row[6]), *map(float, row[7:]))
+            entry = (
+                int(row[0]),
+                int(row[1]),
+                int(row[2]),
+                int(row[3]),
+                int(row[4]),
+                float(row[5]),
+                float(row[6]),
+                *map(float, row[7:]),
+            )
             self.log.append(entry)
             self.histories.Record(entry[2], np.array(entry[7:]), entry[5], entry[6])
         self.problem_tries[...] = arrays["problem_tries"]

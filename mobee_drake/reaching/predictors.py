@@ -48,14 +48,17 @@ class PredictorConfig:
 
     def Validate(self) -> None:
         if self.kind not in PREDICTORS:
-            raise ValueError(f"unknown reward predictor '{self.kind}'; predictors are "
-                             + ", ".join(PREDICTORS))
+            raise ValueError(
+                f"unknown reward predictor '{self.kind}'; predictors are " + ", ".join(PREDICTORS)
+            )
         if not self.distance_unit > 0:
-            raise ValueError(f"the predictor's distance_unit must be > 0, got "
-                             f"{self.distance_unit}")
+            raise ValueError(f"the predictor's distance_unit must be > 0, got {self.distance_unit}")
         if not (self.length_scale > 0 and self.noise_ratio > 0):
-            raise ValueError(f"the predictor's length_scale and noise_ratio must be > 0, got "
-                             f"{self.length_scale} and {self.noise_ratio}")
+            raise ValueError(
+                f"the predictor's length_scale and noise_ratio must be > 0, got "
+                f"{self.length_scale} and {self.noise_ratio}"
+            )
+
 
 # The reward of a state transition that does not climb the value function (ch. 8.1).
 FAILED_TRANSITION_REWARD = -10.0
@@ -77,8 +80,9 @@ def TransitionReward(value_before: float, value_after: float) -> float:
     return 0.0 if value_after > value_before else FAILED_TRANSITION_REWARD
 
 
-def WeightedEstimate(target: np.ndarray, targets: np.ndarray, values: np.ndarray,
-                     prior: float, unit: float = 1.0) -> float:
+def WeightedEstimate(
+    target: np.ndarray, targets: np.ndarray, values: np.ndarray, prior: float, unit: float = 1.0
+) -> float:
     """``(prior + sum w_i v_i) / (prior + sum w_i)`` with ``w_i = 1 / (1 + |x* - x*_i|)``, the
     distance counted in ``unit`` (m); with ``prior`` 0 this is eq. 8.1 (0 with no history,
     eq. 8.3), with 1 eq. 8.5 and 8.7."""
@@ -91,11 +95,13 @@ def WeightedEstimate(target: np.ndarray, targets: np.ndarray, values: np.ndarray
 class GaussianProcessFit:
     """The posterior mean of a GP with constant prior mean fitted to (targets, values)."""
 
-    def __init__(self, targets: np.ndarray, values: np.ndarray, prior: float,
-                 config: PredictorConfig):
-        self.prior, self._scale = prior, 2.0 * config.length_scale ** 2
-        unique, inverse, counts = np.unique(targets, axis=0, return_inverse=True,
-                                            return_counts=True)
+    def __init__(
+        self, targets: np.ndarray, values: np.ndarray, prior: float, config: PredictorConfig
+    ):
+        self.prior, self._scale = prior, 2.0 * config.length_scale**2
+        unique, inverse, counts = np.unique(
+            targets, axis=0, return_inverse=True, return_counts=True
+        )
         means = np.bincount(inverse.ravel(), weights=values) / counts
         gram = self._Kernel(unique, unique) + np.diag(config.noise_ratio / counts)
         self._points = unique
@@ -127,12 +133,14 @@ class RewardHistories:
         # Gaussian-process fits by (state-action, intrinsic?), dropped when a history grows.
         self._fits: dict[tuple[int, bool], GaussianProcessFit] = {}
 
-    def _Estimate(self, state_action: int, target, values: np.ndarray, prior: float,
-                  intrinsic: bool) -> float:
+    def _Estimate(
+        self, state_action: int, target, values: np.ndarray, prior: float, intrinsic: bool
+    ) -> float:
         target = np.asarray(target, dtype=float)
         if self.predictor.kind == "weighted" or len(values) == 0:
-            return WeightedEstimate(target, self._targets[state_action], values, prior,
-                                    self.predictor.distance_unit)
+            return WeightedEstimate(
+                target, self._targets[state_action], values, prior, self.predictor.distance_unit
+            )
         fit = self._fits.get((state_action, intrinsic))
         if fit is None:
             fit = GaussianProcessFit(self._targets[state_action], values, prior, self.predictor)
@@ -152,8 +160,11 @@ class RewardHistories:
 
     def History(self, state_action: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(targets, estimates, rewards) of one state-action, oldest first."""
-        return (self._targets[state_action], self._estimates[state_action],
-                self._rewards[state_action])
+        return (
+            self._targets[state_action],
+            self._estimates[state_action],
+            self._rewards[state_action],
+        )
 
     def Predict(self, state_action: int, target) -> float:
         """The expected reward (eq. 8.1 for transitions, 8.5 for reaches)."""
@@ -167,8 +178,9 @@ class RewardHistories:
 
     def Record(self, state_action: int, target, estimate: float, reward: float) -> None:
         """Appends ``{x*, e, r}`` to ``H_{s,a}`` (eq. 8.2)."""
-        self._targets[state_action] = np.vstack([self._targets[state_action],
-                                                  np.asarray(target, dtype=float)[None]])
+        self._targets[state_action] = np.vstack(
+            [self._targets[state_action], np.asarray(target, dtype=float)[None]]
+        )
         self._estimates[state_action] = np.append(self._estimates[state_action], estimate)
         self._rewards[state_action] = np.append(self._rewards[state_action], reward)
         self._fits.pop((state_action, False), None)

@@ -27,8 +27,15 @@ class SimulatedRobot:
     rest of MoBeE's joints stay at home. With ``meshcat`` the robot is shown there, in real time.
     """
 
-    def __init__(self, scenario: Scenario, joints: list[str], space: StateActionSpace,
-                 target_radius: float, poll: float = 0.1, meshcat=None):
+    def __init__(
+        self,
+        scenario: Scenario,
+        joints: list[str],
+        space: StateActionSpace,
+        target_radius: float,
+        poll: float = 0.1,
+        meshcat=None,
+    ):
         if not isinstance(scenario.attractor, StateActionAttractor):
             raise ValueError("the reach learner's scenario needs a StateActionAttractor")
         self.simulation = simulation = BuildSimulation(scenario, meshcat)
@@ -42,8 +49,9 @@ class SimulatedRobot:
         mobee = simulation.mobee
         unknown = [j for j in joints if j not in mobee.joints]
         if unknown:
-            raise ValueError(f"the MDP's joints {unknown} are not MoBeE's: "
-                             + ", ".join(mobee.joints))
+            raise ValueError(
+                f"the MDP's joints {unknown} are not MoBeE's: " + ", ".join(mobee.joints)
+            )
         self.space, self._poll, self._radius = space, poll, target_radius
         self._columns = np.array([mobee.joints.index(j) for j in joints])
         self._lower, self._upper = mobee.position_limits
@@ -54,20 +62,25 @@ class SimulatedRobot:
         self._marker = mobee.marker_index(marker)
         # The current problem's target (None before the first problem).
         self.target: np.ndarray | None = None
-        self._hand = [g for g, frame in simulation.robot.geometry_frames.items()
-                      if plant.get_frame(frame).body().name() == hand]
+        self._hand = [
+            g
+            for g, frame in simulation.robot.geometry_frames.items()
+            if plant.get_frame(frame).body().name() == hand
+        ]
 
     # The configuration of a state's centre, and the state of the robot's configuration.
     def _Centre(self, state: int) -> np.ndarray:
         q = self._home.copy()
-        q[self._columns] = self.space.Centre(state, self._lower[self._columns],
-                                             self._upper[self._columns])
+        q[self._columns] = self.space.Centre(
+            state, self._lower[self._columns], self._upper[self._columns]
+        )
         return q
 
     def State(self) -> int:
-        q = self.simulation.robot_state.Eval(self.context)[:len(self._home)]
-        return self.space.StateOfConfiguration(q[self._columns], self._lower[self._columns],
-                                               self._upper[self._columns])
+        q = self.simulation.robot_state.Eval(self.context)[: len(self._home)]
+        return self.space.StateOfConfiguration(
+            q[self._columns], self._lower[self._columns], self._upper[self._columns]
+        )
 
     def SetProblem(self, target: np.ndarray) -> None:
         self.target = np.asarray(target, dtype=float)
@@ -89,10 +102,13 @@ class SimulatedRobot:
     def Reach(self, target: np.ndarray) -> np.ndarray:
         scene_graph = self.simulation.scene_graph
         filters = scene_graph.collision_filter_manager(
-            scene_graph.GetMyMutableContextFromRoot(self.context))
-        touch = filters.ApplyTransient(CollisionFilterDeclaration().ExcludeBetween(
-            GeometrySet(self._hand),
-            GeometrySet(self.simulation.world.geometry_id(TARGET_NAME))))
+            scene_graph.GetMyMutableContextFromRoot(self.context)
+        )
+        touch = filters.ApplyTransient(
+            CollisionFilterDeclaration().ExcludeBetween(
+                GeometrySet(self._hand), GeometrySet(self.simulation.world.geometry_id(TARGET_NAME))
+            )
+        )
         self.executor.StartReach(self._executor_context, self._Centre(self.State()), target)
         self._Finish()
         filters.RemoveDeclaration(touch)
@@ -105,8 +121,9 @@ class SimulatedRobot:
         """Where the reaching marker (the palm) is now (world, m)."""
         mobee = self.simulation.mobee
         positions = mobee.GetOutputPort("marker_positions").Eval(
-            mobee.GetMyContextFromRoot(self.context))
-        return positions[3 * self._marker:3 * self._marker + 3].copy()
+            mobee.GetMyContextFromRoot(self.context)
+        )
+        return positions[3 * self._marker : 3 * self._marker + 3].copy()
 
     @property
     def simulated_seconds(self) -> float:

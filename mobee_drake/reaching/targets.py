@@ -5,11 +5,11 @@ import itertools
 
 import numpy as np
 
-from mobee_drake.robots.overlay import MODELS_DIR
+from mobee_drake.resources import ResolveModelFile
 from mobee_drake.simulation.scenario import SceneObject, Sphere
 from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
 
-DEFAULT_TARGETS = MODELS_DIR / "reach_targets.yaml"
+DEFAULT_TARGETS = "package://mobee_drake/reach_targets.yaml"
 # The name of the target object while it is in the world.
 TARGET_NAME = "reach_target"
 
@@ -30,7 +30,7 @@ class TargetGrid:
 
 def LoadTargetGrid(filename=DEFAULT_TARGETS) -> TargetGrid:
     """Loads a target grid; errors name the file and the key."""
-    grid = LoadYamlFile(schema=TargetGrid, filename=filename)
+    grid = LoadYamlFile(schema=TargetGrid, filename=ResolveModelFile(filename))
     for axis in "xyz":
         if not getattr(grid, axis):
             raise YamlFileError(f"{filename}: '{axis}' needs at least one level")
@@ -41,5 +41,9 @@ def LoadTargetGrid(filename=DEFAULT_TARGETS) -> TargetGrid:
 
 def TargetObject(centre, radius: float) -> SceneObject:
     """The target as an object of the robot's world: an obstacle (see docs/reaching.md)."""
-    return SceneObject(name=TARGET_NAME, shape=Sphere(radius=radius),
-                       position=[float(c) for c in centre], role="obstacle")
+    return SceneObject(
+        name=TARGET_NAME,
+        shape=Sphere(radius=radius),
+        position=[float(c) for c in centre],
+        role="obstacle",
+    )

@@ -83,8 +83,10 @@ class ReflexRobot:
 
     def __init__(self, scenario: Scenario, *, meshcat=None, timeout: float = 60.0):
         if scenario.controller != "reflex" or not isinstance(scenario.attractor, FixedAttractor):
-            raise ValueError("ReflexRobot needs a scenario with controller: reflex and a "
-                             "FixedAttractor (its value becomes the commands)")
+            raise ValueError(
+                "ReflexRobot needs a scenario with controller: reflex and a "
+                "FixedAttractor (its value becomes the commands)"
+            )
         self.simulation = BuildSimulation(scenario, meshcat)
         self.simulator = Simulator(self.simulation.diagram)
         self.context = self.simulator.get_mutable_context()
@@ -95,8 +97,11 @@ class ReflexRobot:
         self._period, self._timeout = scenario.time_step, timeout
 
     def Status(self) -> np.ndarray:
-        return self._reflex.GetOutputPort("status").Eval(
-            self._reflex.GetMyContextFromRoot(self.context)).copy()
+        return (
+            self._reflex.GetOutputPort("status")
+            .Eval(self._reflex.GetMyContextFromRoot(self.context))
+            .copy()
+        )
 
     def Positions(self) -> np.ndarray:
         n = len(self.simulation.mobee.joints)
@@ -110,10 +115,13 @@ class ReflexRobot:
         """
         before = self.Status()
         command = self._source.get_mutable_source_value(
-            self._source.GetMyMutableContextFromRoot(self.context))
+            self._source.GetMyMutableContextFromRoot(self.context)
+        )
         if np.array_equal(command.value(), q):
-            raise ValueError("the same command twice in a row is one command to MoBeE 1.0; "
-                             "command another pose in between")
+            raise ValueError(
+                "the same command twice in a row is one command to MoBeE 1.0; "
+                "command another pose in between"
+            )
         command.set_value(q)
         t_end = self.context.get_time() + self._timeout
         while self.context.get_time() < t_end:
@@ -140,8 +148,14 @@ class ExplorationRecord:
     path: list = dc.field(default_factory=list)  # the vertices visited, in order
 
 
-def ExploreRoadmap(roadmap: AdaptiveRoadmap, robot: ReflexRobot, start: int,
-                   rng: np.random.Generator, *, max_commands: int = 10000) -> ExplorationRecord:
+def ExploreRoadmap(
+    roadmap: AdaptiveRoadmap,
+    robot: ReflexRobot,
+    start: int,
+    rng: np.random.Generator,
+    *,
+    max_commands: int = 10000,
+) -> ExplorationRecord:
     """Tries edges until every edge out of every vertex reachable from ``start`` is known.
 
     From the current vertex an untried edge out of it is tried at random; if there is none, the

@@ -64,8 +64,14 @@ class ReflexController(LeafSystem):
     poses back to the waypoint, then the status, then the last command).
     """
 
-    def __init__(self, *, initial_positions: np.ndarray, period: float, params: ReflexParams,
-                 clauses: ClauseSet):
+    def __init__(
+        self,
+        *,
+        initial_positions: np.ndarray,
+        period: float,
+        params: ReflexParams,
+        clauses: ClauseSet,
+    ):
         super().__init__()
         n = len(initial_positions)
         self._n, self._period, self._clauses = n, period, clauses
@@ -75,24 +81,31 @@ class ReflexController(LeafSystem):
         q0 = np.asarray(initial_positions, dtype=float)
         self._command_port = self.DeclareVectorInputPort("command", n)
         self._pairs_port = self.DeclareAbstractInputPort(
-            "field_pairs", AbstractValue.Make(NO_FIELD_PAIRS))
+            "field_pairs", AbstractValue.Make(NO_FIELD_PAIRS)
+        )
         self._motion = self.DeclareDiscreteState(BasicVector(np.concatenate([q0, np.zeros(n)])))
         history = np.zeros(self._size * n)
         history[:n] = q0
         self._history = self.DeclareDiscreteState(BasicVector(history))
         # head = 0 holds q0; one pose held; waypoint 0 poses back; status: holding, counters 0.
-        self._book = self.DeclareDiscreteState(BasicVector(np.concatenate(
-            [[0, 1, 0], [HOLDING, 0, 0, 0, 0], q0])))
+        self._book = self.DeclareDiscreteState(
+            BasicVector(np.concatenate([[0, 1, 0], [HOLDING, 0, 0, 0, 0], q0]))
+        )
         self.DeclareStateOutputPort("state", self._motion)
-        self.DeclareVectorOutputPort("status", 5, self._CalcStatus,
-                                     prerequisites_of_calc={self.discrete_state_ticket(
-                                         self._book)})
-        self.DeclarePeriodicDiscreteUpdateEvent(period_sec=period, offset_sec=0.0,
-                                                update=self._Update)
+        self.DeclareVectorOutputPort(
+            "status",
+            5,
+            self._CalcStatus,
+            prerequisites_of_calc={self.discrete_state_ticket(self._book)},
+        )
+        self.DeclarePeriodicDiscreteUpdateEvent(
+            period_sec=period, offset_sec=0.0, update=self._Update
+        )
 
     def _Trouble(self, context, q: np.ndarray) -> bool:
-        return bool(len(self._pairs_port.Eval(context))
-                    or self._clauses.ActiveClauses(q, 0.0).any())
+        return bool(
+            len(self._pairs_port.Eval(context)) or self._clauses.ActiveClauses(q, 0.0).any()
+        )
 
     def _Update(self, context, discrete_state) -> None:
         n = self._n
@@ -120,7 +133,7 @@ class ReflexController(LeafSystem):
                 status[STUCK_COUNT] += 1
             else:
                 head, held, back = (head - 1) % self._size, held - 1, back - 1
-                q_next = history[head * n:(head + 1) * n].copy()
+                q_next = history[head * n : (head + 1) * n].copy()
         elif mode == MOVING:
             error = command - q
             largest = np.max(np.abs(error))
@@ -132,12 +145,14 @@ class ReflexController(LeafSystem):
                 head = (head + 1) % self._size
                 # Drake hands the update the current state: only the new row is written.
                 discrete_state.get_mutable_vector(self._history).get_mutable_value()[
-                    head * n:(head + 1) * n] = q_next
+                    head * n : (head + 1) * n
+                ] = q_next
                 held, back = min(held + 1, self._size), min(back + 1, self._size)
         book[:3] = head, held, back
         status[MODE] = mode
         discrete_state.get_mutable_vector(self._motion).SetFromVector(
-            np.concatenate([q_next, (q_next - q) / self._period]))
+            np.concatenate([q_next, (q_next - q) / self._period])
+        )
         discrete_state.get_mutable_vector(self._book).SetFromVector(book)
 
     def _CalcStatus(self, context, output) -> None:

@@ -46,17 +46,22 @@ from mobee_drake.simulation.scenario import (
 
 TABLE = SceneObject(name="table", shape=Box(size=[0.5, 0.9, 0.04]), position=[-0.38, 0.0, -0.17])
 BALL_CENTRE = np.array([-0.32, 0.2, -0.02])
-BALL = SceneObject(name="ball", shape=Sphere(radius=0.05), position=list(BALL_CENTRE),
-                   role="ghost")
+BALL = SceneObject(name="ball", shape=Sphere(radius=0.05), position=list(BALL_CENTRE), role="ghost")
 # Palm positions of A, B (either side of the ball) and D, E (above A and B).
 SIDE, ABOVE = 0.17, 0.26
 PALM_OFFSETS = np.array([[0, -SIDE, 0], [0, SIDE, 0], [0, -SIDE, ABOVE], [0, SIDE, ABOVE]])
 
 
 def _Scenario(objects: list[SceneObject], seed: int, meshcat: bool) -> Scenario:
-    return Scenario(robot=IcubConfig(), objects=objects, attractor=FixedAttractor(),
-                    controller="reflex", time_step=0.02, random_seed=seed,
-                    visualization=Visualization(meshcat=meshcat, show_attractor=False))
+    return Scenario(
+        robot=IcubConfig(),
+        objects=objects,
+        attractor=FixedAttractor(),
+        controller="reflex",
+        time_step=0.02,
+        random_seed=seed,
+        visualization=Visualization(meshcat=meshcat, show_attractor=False),
+    )
 
 
 @dc.dataclass
@@ -73,8 +78,9 @@ class ScratchResult:
     wall_seconds: float
 
 
-def RoadmapFromScratch(seed: int = 0, *, samples: int = 20, k: int = 10,
-                       meshcat=None) -> tuple[ScratchResult, AdaptiveRoadmap]:
+def RoadmapFromScratch(
+    seed: int = 0, *, samples: int = 20, k: int = 10, meshcat=None
+) -> tuple[ScratchResult, AdaptiveRoadmap]:
     rng = np.random.default_rng(seed)
     robot = ReflexRobot(_Scenario([TABLE], seed, meshcat is not None), meshcat=meshcat)
     mobee = robot.simulation.mobee
@@ -93,36 +99,46 @@ def RoadmapFromScratch(seed: int = 0, *, samples: int = 20, k: int = 10,
     wall = time.perf_counter() - began
     reachable = roadmap.Reachable(0)
     return ScratchResult(
-        vertices=len(poses), edges=len(roadmap.edges),
+        vertices=len(poses),
+        edges=len(roadmap.edges),
         feasible=int(np.sum(roadmap.status == FEASIBLE)),
         infeasible=int(np.sum(roadmap.status == INFEASIBLE)),
         untried=int(np.sum(roadmap.status == UNTRIED)),
-        unreachable_vertices=int(np.sum(~reachable)), commands=record.commands,
-        reflexes=record.reflexes, simulated_minutes=robot.context.get_time() / 60,
-        wall_seconds=wall), roadmap
+        unreachable_vertices=int(np.sum(~reachable)),
+        commands=record.commands,
+        reflexes=record.reflexes,
+        simulated_minutes=robot.context.get_time() / 60,
+        wall_seconds=wall,
+    ), roadmap
 
 
 def BallPoses(seed: int = 0) -> np.ndarray:
     """Poses A, B, D, E of the torso and right arm (palm beside the ball, and above those
     points), found by NGIK with no pair inside MoBeE's fields, such that along the edge A-B the
     hand enters the ball's field and along A-D, D-E, E-B nothing does."""
-    model = KinematicModel(IcubConfig(), [dc.replace(BALL, role="obstacle")],
-                           inside_fields=True)
+    model = KinematicModel(IcubConfig(), [dc.replace(BALL, role="obstacle")], inside_fields=True)
     palm = model.MarkerIndex("r_palm")
     rng = np.random.default_rng(seed)
     poses = []
     for offset in PALM_OFFSETS:
-        problem = IkProblem(model, [MarkerPositionCost(palm, BALL_CENTRE + offset),
-                                    HomeCost(model.home, weight=0.05), CollisionCost()],
-                            joints=list(TORSO_JOINTS + RIGHT_ARM_JOINTS))
+        problem = IkProblem(
+            model,
+            [
+                MarkerPositionCost(palm, BALL_CENTRE + offset),
+                HomeCost(model.home, weight=0.05),
+                CollisionCost(),
+            ],
+            joints=list(TORSO_JOINTS + RIGHT_ARM_JOINTS),
+        )
         solution = SolveNgik(problem, model.home, 0.2, NesConfig(max_evaluations=6000), rng)
         if not solution.solved:
             raise RuntimeError(f"NGIK found no pose with the palm at {BALL_CENTRE + offset}")
         poses.append(solution.q)
 
     def Blocked(a, b) -> bool:
-        return any(model.Evaluate((1 - s) * a + s * b).collision_pairs
-                   for s in np.linspace(0, 1, 41))
+        return any(
+            model.Evaluate((1 - s) * a + s * b).collision_pairs for s in np.linspace(0, 1, 41)
+        )
 
     A, B, D, E = poses
     if not Blocked(A, B) or Blocked(A, D) or Blocked(D, E) or Blocked(E, B):
@@ -171,13 +187,13 @@ def AdaptiveReplanning(seed: int = 0, *, meshcat=None) -> ReplanningResult:
     direct = Travel(first)
     replanned = roadmap.Plan(B, A)
     arrived = Travel(replanned)
-    return ReplanningResult(ghost_path, ghost_arrived, first, direct, replanned, arrived,
-                            reflexes)
+    return ReplanningResult(ghost_path, ghost_arrived, first, direct, replanned, arrived, reflexes)
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(prog="mobee-drake experiment roadmaps",
-                                     description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="mobee-drake experiment roadmaps", description=__doc__.split("\n")[0]
+    )
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--meshcat", action="store_true", help="watch the robot in Meshcat")
     args = parser.parse_args(argv)
@@ -188,11 +204,15 @@ def main(argv: list[str] | None = None) -> None:
         meshcat = StartMeshcat()
     scratch, _ = RoadmapFromScratch(args.seed, meshcat=meshcat)
     print("Roadmap from scratch (ch. 4.3.1):")
-    print(f"  {scratch.vertices} vertices, {scratch.edges} directed edges: {scratch.feasible} "
-          f"feasible, {scratch.infeasible} infeasible, {scratch.untried} never reachable "
-          f"({scratch.unreachable_vertices} vertices unreachable)")
-    print(f"  {scratch.commands} commands, {scratch.reflexes} reflexes, "
-          f"{scratch.simulated_minutes:.1f} simulated minutes, {scratch.wall_seconds:.1f} s wall")
+    print(
+        f"  {scratch.vertices} vertices, {scratch.edges} directed edges: {scratch.feasible} "
+        f"feasible, {scratch.infeasible} infeasible, {scratch.untried} never reachable "
+        f"({scratch.unreachable_vertices} vertices unreachable)"
+    )
+    print(
+        f"  {scratch.commands} commands, {scratch.reflexes} reflexes, "
+        f"{scratch.simulated_minutes:.1f} simulated minutes, {scratch.wall_seconds:.1f} s wall"
+    )
     names = {HOME: "home", A: "A", B: "B", D: "D", E: "E"}
     replanning = AdaptiveReplanning(args.seed, meshcat=meshcat)
 
@@ -200,11 +220,15 @@ def main(argv: list[str] | None = None) -> None:
         return " -> ".join(names[v] for v in path)
 
     print("Adaptive re-planning (ch. 4.3.2):")
-    print(f"  ball a ghost: planned {Named(replanning.ghost_path)}, arrived: "
-          f"{replanning.ghost_arrived}")
-    print(f"  ball solid: planned {Named(replanning.first_solid_path)}, arrived: "
-          f"{replanning.direct_arrived}; re-planned {Named(replanning.replanned_path)}, "
-          f"arrived: {replanning.arrived_home}; {replanning.reflexes} reflex(es)")
+    print(
+        f"  ball a ghost: planned {Named(replanning.ghost_path)}, arrived: "
+        f"{replanning.ghost_arrived}"
+    )
+    print(
+        f"  ball solid: planned {Named(replanning.first_solid_path)}, arrived: "
+        f"{replanning.direct_arrived}; re-planned {Named(replanning.replanned_path)}, "
+        f"arrived: {replanning.arrived_home}; {replanning.reflexes} reflex(es)"
+    )
     if meshcat is not None:
         input("Press Enter to quit (Meshcat stops with this process).")
 

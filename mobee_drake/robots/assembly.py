@@ -20,11 +20,17 @@ from mobee_drake.robots.overlay import (
 )
 
 
-def AddRobotWithOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, *,
-                        model_file: str | pathlib.Path, overlay_file: str | pathlib.Path,
-                        controlled_joints: Iterable[str], home: Mapping[str, float] | None = None,
-                        X_WRoot: RigidTransform | None = None,
-                        model_name: str | None = None) -> RobotOverlay:
+def AddRobotWithOverlay(
+    plant: MultibodyPlant,
+    scene_graph: SceneGraph,
+    *,
+    model_file: str | pathlib.Path,
+    overlay_file: str | pathlib.Path,
+    controlled_joints: Iterable[str],
+    home: Mapping[str, float] | None = None,
+    X_WRoot: RigidTransform | None = None,
+    model_name: str | None = None,
+) -> RobotOverlay:
     """Adds the robot of ``model_file`` (URDF or SDFormat) with its MoBeE overlay to ``plant``.
 
     The overlay's ``reference_link`` is the robot's root: unless the model already fixes it, it is
@@ -37,35 +43,67 @@ def AddRobotWithOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, *,
     """
     model_file = str(model_file)
     return AddModelWithOverlay(
-        plant, scene_graph, add_model=lambda p: Parser(p, model_name).AddModels(model_file)[0],
-        overlay=LoadOverlay(overlay_file), controlled_joints=controlled_joints, home=home,
-        X_WRoot=X_WRoot, model_source=model_file, overlay_source=str(overlay_file))
+        plant,
+        scene_graph,
+        add_model=lambda p: Parser(p, model_name).AddModels(model_file)[0],
+        overlay=LoadOverlay(overlay_file),
+        controlled_joints=controlled_joints,
+        home=home,
+        X_WRoot=X_WRoot,
+        model_source=model_file,
+        overlay_source=str(overlay_file),
+    )
 
 
-def AddModelWithOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, *,
-                        add_model: Callable[[MultibodyPlant], ModelInstanceIndex],
-                        overlay: Overlay, controlled_joints: Iterable[str],
-                        home: Mapping[str, float] | None, X_WRoot: RigidTransform | None,
-                        model_source: str, overlay_source: str) -> RobotOverlay:
+def AddModelWithOverlay(
+    plant: MultibodyPlant,
+    scene_graph: SceneGraph,
+    *,
+    add_model: Callable[[MultibodyPlant], ModelInstanceIndex],
+    overlay: Overlay,
+    controlled_joints: Iterable[str],
+    home: Mapping[str, float] | None,
+    X_WRoot: RigidTransform | None,
+    model_source: str,
+    overlay_source: str,
+) -> RobotOverlay:
     """:func:`AddRobotWithOverlay` for a model that ``add_model(plant)`` adds (to the plant and to
     the scratch plant that finds the links' poses at zero) and an overlay already loaded."""
     instance = add_model(plant)
     if not plant.HasBodyNamed(overlay.reference_link, instance):
-        raise ValueError(f"{overlay_source}: reference_link '{overlay.reference_link}' is not a "
-                         f"link of {model_source}")
+        raise ValueError(
+            f"{overlay_source}: reference_link '{overlay.reference_link}' is not a "
+            f"link of {model_source}"
+        )
     root = plant.GetBodyByName(overlay.reference_link, instance)
-    if not any(plant.get_joint(j).child_body().index() == root.index()
-               for j in plant.GetJointIndices(instance)):
+    if not any(
+        plant.get_joint(j).child_body().index() == root.index()
+        for j in plant.GetJointIndices(instance)
+    ):
         plant.WeldFrames(plant.world_frame(), root.body_frame(), X_WRoot or RigidTransform())
     reference = ZeroConfigurationPoses(add_model, overlay.reference_link)
-    frozen = FreezeJoints(plant, instance, keep=controlled_joints, home=home or {},
-                          source=model_source)
-    return ApplyOverlay(plant, scene_graph, instance, overlay, reference, frozen_joints=frozen,
-                        source=overlay_source)
+    frozen = FreezeJoints(
+        plant, instance, keep=controlled_joints, home=home or {}, source=model_source
+    )
+    return ApplyOverlay(
+        plant,
+        scene_graph,
+        instance,
+        overlay,
+        reference,
+        frozen_joints=frozen,
+        source=overlay_source,
+    )
 
 
-def FreezeJoints(plant: MultibodyPlant, instance: ModelInstanceIndex, *, keep: Iterable[str],
-                 home: Mapping[str, float], source: str) -> dict[str, float]:
+def FreezeJoints(
+    plant: MultibodyPlant,
+    instance: ModelInstanceIndex,
+    *,
+    keep: Iterable[str],
+    home: Mapping[str, float],
+    source: str,
+) -> dict[str, float]:
     """Welds every joint of ``instance`` not named in ``keep`` at its ``home`` angle (radians).
 
     The kept joints get their ``home`` angle as default position and an actuator (if the model
@@ -80,13 +118,15 @@ def FreezeJoints(plant: MultibodyPlant, instance: ModelInstanceIndex, *, keep: I
             joint's limits.
     """
     keep = list(keep)
-    joints = {plant.get_joint(i).name(): plant.get_joint(i)
-              for i in plant.GetJointIndices(instance)}
+    joints = {
+        plant.get_joint(i).name(): plant.get_joint(i) for i in plant.GetJointIndices(instance)
+    }
     movable = sorted(n for n, j in joints.items() if j.num_positions() > 0)
     for name in list(keep) + list(home):
         if name not in joints or joints[name].num_positions() == 0:
-            raise ValueError(f"{source}: unknown joint '{name}'; its joints are: "
-                             + ", ".join(movable))
+            raise ValueError(
+                f"{source}: unknown joint '{name}'; its joints are: " + ", ".join(movable)
+            )
     if len(set(keep)) != len(keep):
         raise ValueError(f"{source}: controlled joints listed twice in {keep}")
     for name, angle in home.items():
@@ -95,20 +135,25 @@ def FreezeJoints(plant: MultibodyPlant, instance: ModelInstanceIndex, *, keep: I
         if not (np.isfinite(angle) and lower <= angle <= upper):
             raise ValueError(
                 f"{source}: home angle of joint '{name}' is {np.degrees(angle):.6g} deg, outside "
-                f"its limits [{np.degrees(lower):.6g}, {np.degrees(upper):.6g}] deg")
+                f"its limits [{np.degrees(lower):.6g}, {np.degrees(upper):.6g}] deg"
+            )
     frozen = {}
     for name in movable:
         joint = joints[name]
         if name in keep and not isinstance(joint, RevoluteJoint):
-            raise ValueError(f"{source}: joint '{name}' is a {joint.type_name()} joint; MoBeE "
-                             "controls revolute joints only")
+            raise ValueError(
+                f"{source}: joint '{name}' is a {joint.type_name()} joint; MoBeE "
+                "controls revolute joints only"
+            )
         lower, upper = joint.position_lower_limits()[0], joint.position_upper_limits()[0]
         # A joint without a home angle starts at zero, or at the limit nearest to zero.
         angle = home.get(name, float(np.clip(0.0, lower, upper)))
         if name in keep:
             joint.set_default_angle(angle)
-            if not any(plant.get_joint_actuator(a).joint().index() == joint.index()
-                       for a in plant.GetJointActuatorIndices(instance)):
+            if not any(
+                plant.get_joint_actuator(a).joint().index() == joint.index()
+                for a in plant.GetJointActuatorIndices(instance)
+            ):
                 plant.AddJointActuator(f"{name}_actuator", joint)
             continue
         frame_on_parent, frame_on_child = joint.frame_on_parent(), joint.frame_on_child()
@@ -119,8 +164,9 @@ def FreezeJoints(plant: MultibodyPlant, instance: ModelInstanceIndex, *, keep: I
     return frozen
 
 
-def JointStateSelector(plant: MultibodyPlant, joints: list[str],
-                       instance: ModelInstanceIndex | None = None) -> np.ndarray:
+def JointStateSelector(
+    plant: MultibodyPlant, joints: list[str], instance: ModelInstanceIndex | None = None
+) -> np.ndarray:
     """The matrix S with ``x_plant = S [q; v]`` for (q, v) of one-DOF ``joints`` (of model
     ``instance``, if given) in that order.
 
@@ -130,8 +176,9 @@ def JointStateSelector(plant: MultibodyPlant, joints: list[str],
     n = len(joints)
     S = np.zeros((plant.num_multibody_states(), 2 * n))
     for i, name in enumerate(joints):
-        joint = (plant.GetJointByName(name) if instance is None
-                 else plant.GetJointByName(name, instance))
+        joint = (
+            plant.GetJointByName(name) if instance is None else plant.GetJointByName(name, instance)
+        )
         S[joint.position_start(), i] = 1.0
         S[plant.num_positions() + joint.velocity_start(), n + i] = 1.0
     return S

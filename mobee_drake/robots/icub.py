@@ -15,9 +15,10 @@ from pydrake.geometry import SceneGraph
 from pydrake.math import RigidTransform
 from pydrake.multibody.plant import MultibodyPlant
 
+from mobee_drake.resources import ResolveModelFile
 from mobee_drake.robots.assembly import AddRobotWithOverlay
 from mobee_drake.robots.model_cache import PreparedIcubModel
-from mobee_drake.robots.overlay import MODELS_DIR, RobotOverlay
+from mobee_drake.robots.overlay import RobotOverlay
 
 DEFAULT_ICUB_MODEL = "iCubGazeboV2_5"
 
@@ -55,12 +56,16 @@ class IcubConfig:
     controlled_joints: list[str] = dc.field(default_factory=lambda: list(UPPER_BODY_JOINTS))
     # Home angles in degrees for joints that should not start at zero.
     home_deg: dict[str, float] = dc.field(default_factory=lambda: dict(HOME_POSTURE_DEG))
-    # MoBeE's collision overlay; a relative path is taken from the package's models/ folder.
+    # MoBeE's collision overlay: package://mobee_drake/..., a path, or a shipped model's name.
     overlay: str = "icub_overlay.yaml"
 
 
-def AddIcub(plant: MultibodyPlant, scene_graph: SceneGraph, config: IcubConfig | None = None,
-            X_WRoot: RigidTransform | None = None) -> RobotOverlay:
+def AddIcub(
+    plant: MultibodyPlant,
+    scene_graph: SceneGraph,
+    config: IcubConfig | None = None,
+    X_WRoot: RigidTransform | None = None,
+) -> RobotOverlay:
     """Adds the iCub with its collision overlay to an unfinalized ``plant``.
 
     The root link is welded to the world at ``X_WRoot`` (identity by default); joints that are not
@@ -72,7 +77,12 @@ def AddIcub(plant: MultibodyPlant, scene_graph: SceneGraph, config: IcubConfig |
     """
     config = config or IcubConfig()
     return AddRobotWithOverlay(
-        plant, scene_graph, model_file=PreparedIcubModel(config.model),
-        overlay_file=MODELS_DIR / config.overlay, controlled_joints=config.controlled_joints,
+        plant,
+        scene_graph,
+        model_file=PreparedIcubModel(config.model),
+        overlay_file=ResolveModelFile(config.overlay),
+        controlled_joints=config.controlled_joints,
         home={name: math.radians(value) for name, value in config.home_deg.items()},
-        X_WRoot=X_WRoot, model_name=f"icub_{config.model}")
+        X_WRoot=X_WRoot,
+        model_name=f"icub_{config.model}",
+    )

@@ -68,12 +68,17 @@ def _LeafLinksToFrames(robot: ET.Element) -> None:
     parents = {joint.find("parent").get("link") for joint in robot.findall("joint")}
     for joint in robot.findall("joint"):
         child = links[joint.find("child").get("link")]
-        if (joint.get("type") != "fixed" or child.get("name") in parents
-                or child.find("inertial") is not None or child.find("visual") is not None):
+        if (
+            joint.get("type") != "fixed"
+            or child.get("name") in parents
+            or child.find("inertial") is not None
+            or child.find("visual") is not None
+        ):
             continue
         origin = joint.find("origin")
-        frame = ET.SubElement(robot, "frame", name=child.get("name"),
-                              link=joint.find("parent").get("link"))
+        frame = ET.SubElement(
+            robot, "frame", name=child.get("name"), link=joint.find("parent").get("link")
+        )
         frame.set("xyz", origin.get("xyz", "0 0 0") if origin is not None else "0 0 0")
         frame.set("rpy", origin.get("rpy", "0 0 0") if origin is not None else "0 0 0")
         robot.remove(joint)
@@ -104,9 +109,11 @@ def PreparedIcubModel(model_name: str) -> pathlib.Path:
         for mesh in link.iter("mesh"):
             uri = mesh.get("filename", "")
             if not uri.startswith(_MESH_PACKAGE_PREFIX):
-                raise ValueError(f"{source}: link '{link.get('name')}' has a mesh outside the "
-                                 f"iCub package: {uri}")
-            relative = pathlib.Path(uri[len(_MESH_PACKAGE_PREFIX):])
+                raise ValueError(
+                    f"{source}: link '{link.get('name')}' has a mesh outside the "
+                    f"iCub package: {uri}"
+                )
+            relative = pathlib.Path(uri[len(_MESH_PACKAGE_PREFIX) :])
             converted = mesh_cache / (relative.stem + ".obj")
             if not converted.is_file():
                 _ConvertMesh(mesh_root / relative, converted)

@@ -47,9 +47,6 @@ from pydrake.multibody.tree import FixedOffsetFrame, FrameIndex, ModelInstanceIn
 
 from mobee_drake.yaml_io import LineOf, LoadYamlFile
 
-# The folder of robot descriptions shipped with the package.
-MODELS_DIR = pathlib.Path(__file__).resolve().parents[2] / "models"
-
 
 def _Zeros3() -> list[float]:
     return [0.0, 0.0, 0.0]
@@ -203,8 +200,10 @@ def ValidateOverlay(overlay: Overlay, source: str = "overlay", text: str | None 
         for literal in clause.literals:
             a = np.array(list(literal.coefficients.values()), dtype=float)
             if a.size == 0 or not np.all(np.isfinite(a)) or not np.any(a != 0):
-                raise OverlayError(f"{w}: a literal needs finite, not all zero coefficients, got "
-                                   f"{literal.coefficients}")
+                raise OverlayError(
+                    f"{w}: a literal needs finite, not all zero coefficients, got "
+                    f"{literal.coefficients}"
+                )
             if not math.isfinite(literal.offset):
                 raise OverlayError(f"{w}: offset must be finite, got {literal.offset}")
 
@@ -254,8 +253,8 @@ class RobotOverlay:
 
 
 def ZeroConfigurationPoses(
-        add_model: Callable[[MultibodyPlant], ModelInstanceIndex],
-        reference_link: str) -> dict[str, RigidTransform]:
+    add_model: Callable[[MultibodyPlant], ModelInstanceIndex], reference_link: str
+) -> dict[str, RigidTransform]:
     """Poses ``X_RL`` of every link L in the reference link R with every joint at zero.
 
     ``add_model`` adds the robot to a scratch plant, exactly as it was added to the real one.
@@ -263,22 +262,31 @@ def ZeroConfigurationPoses(
     scratch = MultibodyPlant(0.0)
     instance = add_model(scratch)
     reference = scratch.GetBodyByName(reference_link, instance)
-    has_parent = any(scratch.get_joint(j).child_body().index() == reference.index()
-                     for j in scratch.GetJointIndices(instance))
+    has_parent = any(
+        scratch.get_joint(j).child_body().index() == reference.index()
+        for j in scratch.GetJointIndices(instance)
+    )
     if not has_parent:  # A free root: fix it where the real robot is fixed.
         scratch.WeldFrames(scratch.world_frame(), reference.body_frame())
     scratch.Finalize()
     context = scratch.CreateDefaultContext()
     scratch.SetPositions(context, np.zeros(scratch.num_positions()))
     X_RW = reference.EvalPoseInWorld(context).inverse()
-    return {scratch.get_body(i).name(): X_RW @ scratch.get_body(i).EvalPoseInWorld(context)
-            for i in scratch.GetBodyIndices(instance)}
+    return {
+        scratch.get_body(i).name(): X_RW @ scratch.get_body(i).EvalPoseInWorld(context)
+        for i in scratch.GetBodyIndices(instance)
+    }
 
 
-def ApplyOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, instance: ModelInstanceIndex,
-                 overlay: Overlay, reference_poses: Mapping[str, RigidTransform],
-                 frozen_joints: Mapping[str, float] | None = None,
-                 source: str = "overlay") -> RobotOverlay:
+def ApplyOverlay(
+    plant: MultibodyPlant,
+    scene_graph: SceneGraph,
+    instance: ModelInstanceIndex,
+    overlay: Overlay,
+    reference_poses: Mapping[str, RigidTransform],
+    frozen_joints: Mapping[str, float] | None = None,
+    source: str = "overlay",
+) -> RobotOverlay:
     """Registers the overlay's primitives as proximity geometry of ``instance`` and its exclusions.
 
     Must be called before ``plant.Finalize()``. ``reference_poses`` comes from
@@ -315,22 +323,38 @@ def ApplyOverlay(plant: MultibodyPlant, scene_graph: SceneGraph, instance: Model
         X_BG = X_RL.inverse() @ X_RG
         geometry_id = plant.RegisterCollisionGeometry(body, X_BG, drake_shape, p.name, properties)
         frames[geometry_id] = plant.AddFrame(
-            FixedOffsetFrame(f"{p.name}_geometry", body.body_frame(), X_BG)).index()
+            FixedOffsetFrame(f"{p.name}_geometry", body.body_frame(), X_BG)
+        ).index()
         margins[geometry_id] = overlay.default_field if p.field is None else p.field
         names[geometry_id] = p.name
         by_name[p.name] = geometry_id
 
     manager = scene_graph.collision_filter_manager()
     for group in overlay.exclude:
-        manager.Apply(CollisionFilterDeclaration().ExcludeWithin(
-            GeometrySet([by_name[name] for name in group])))
+        manager.Apply(
+            CollisionFilterDeclaration().ExcludeWithin(
+                GeometrySet([by_name[name] for name in group])
+            )
+        )
 
     markers = []
     for m in overlay.markers:
         X_LR = link_pose(m.link, m.name).inverse()
         u = np.asarray(m.direction, dtype=float)
-        markers.append(BodyMarker(name=m.name, body_name=m.link, p_BM=X_LR @ np.asarray(m.position),
-                                  u_B=X_LR.rotation() @ (u / np.linalg.norm(u))))
-    return RobotOverlay(overlay=overlay, instance=instance, field_margins=margins,
-                        geometry_names=names, geometry_frames=frames, markers=tuple(markers),
-                        frozen_joints=dict(frozen_joints or {}))
+        markers.append(
+            BodyMarker(
+                name=m.name,
+                body_name=m.link,
+                p_BM=X_LR @ np.asarray(m.position),
+                u_B=X_LR.rotation() @ (u / np.linalg.norm(u)),
+            )
+        )
+    return RobotOverlay(
+        overlay=overlay,
+        instance=instance,
+        field_margins=margins,
+        geometry_names=names,
+        geometry_frames=frames,
+        markers=tuple(markers),
+        frozen_joints=dict(frozen_joints or {}),
+    )

@@ -15,17 +15,23 @@ from mobee_drake.robots.zero_position import AddZeroPositionRobot, ZeroPositionC
 RobotConfig = IcubConfig | ZeroPositionConfig
 
 
-def AddScenarioRobot(plant: MultibodyPlant, scene_graph: SceneGraph, config: RobotConfig, *,
-                     X_WRoot: RigidTransform | None = None,
-                     model_name: str | None = None) -> tuple[RobotOverlay, list[str]]:
+def AddScenarioRobot(
+    plant: MultibodyPlant,
+    scene_graph: SceneGraph,
+    config: RobotConfig,
+    *,
+    X_WRoot: RigidTransform | None = None,
+    model_name: str | None = None,
+) -> tuple[RobotOverlay, list[str]]:
     """Adds the configured robot, its root at ``X_WRoot``, to an unfinalized plant; returns its
     overlay and the joints MoBeE controls."""
     if isinstance(config, IcubConfig):
         return AddIcub(plant, scene_graph, config, X_WRoot), list(config.controlled_joints)
     robot = config.Load()
     joints = config.Joints(robot)
-    return AddZeroPositionRobot(plant, scene_graph, robot, controlled_joints=joints,
-                                X_WRoot=X_WRoot, model_name=model_name), joints
+    return AddZeroPositionRobot(
+        plant, scene_graph, robot, controlled_joints=joints, X_WRoot=X_WRoot, model_name=model_name
+    ), joints
 
 
 def RobotModelText(config: RobotConfig, alpha: float) -> tuple[str, str, str, dict[str, float]]:
@@ -33,13 +39,17 @@ def RobotModelText(config: RobotConfig, alpha: float) -> tuple[str, str, str, di
     its format ("urdf" or "sdf"), its root link and its home angles (radians)."""
     if isinstance(config, IcubConfig):
         text = PreparedIcubModel(config.model).read_text()
-        text = re.sub(r'rgba="([\d.]+) ([\d.]+) ([\d.]+) [\d.]+"', rf'rgba="\1 \2 \3 {alpha}"',
-                      text)
+        text = re.sub(
+            r'rgba="([\d.]+) ([\d.]+) ([\d.]+) [\d.]+"', rf'rgba="\1 \2 \3 {alpha}"', text
+        )
         # A model parsed from a string must name its meshes by URI.
         text = text.replace('filename="/', 'filename="file:///')
         home = {name: math.radians(v) for name, v in config.home_deg.items()}
         return text, "urdf", "root_link", home
     robot = config.Load()
-    text = re.sub(r"<diffuse>([\d.]+) ([\d.]+) ([\d.]+) [\d.]+</diffuse>",
-                  rf"<diffuse>\1 \2 \3 {alpha}</diffuse>", robot.sdf)
+    text = re.sub(
+        r"<diffuse>([\d.]+) ([\d.]+) ([\d.]+) [\d.]+</diffuse>",
+        rf"<diffuse>\1 \2 \3 {alpha}</diffuse>",
+        robot.sdf,
+    )
     return text, "sdf", "base", robot.home

@@ -49,9 +49,9 @@ from pydrake.common.eigen_geometry import AngleAxis
 from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.parsing import Parser
 
+from mobee_drake.resources import ResolveModelFile
 from mobee_drake.robots.assembly import AddModelWithOverlay
 from mobee_drake.robots.overlay import (
-    MODELS_DIR,
     Box,
     Capsule,
     Clause,
@@ -127,8 +127,11 @@ class ZeroPositionRobot:
     @property
     def home(self) -> dict[str, float]:
         """Every joint's home angle (radians), from its motor's home."""
-        return {joint: math.radians(angle) for motor in self.motors
-                for joint, angle in zip(motor.joints, motor.JointAngles(motor.home))}
+        return {
+            joint: math.radians(angle)
+            for motor in self.motors
+            for joint, angle in zip(motor.joints, motor.JointAngles(motor.home))
+        }
 
 
 def _ParseXml(text: str, source: str) -> _Element:
@@ -147,8 +150,9 @@ def _ParseXml(text: str, source: str) -> _Element:
     try:
         parser.Parse(text, True)
     except xml.parsers.expat.ExpatError as error:
-        raise ZeroPositionError(f"{source}:{error.lineno}: malformed XML: "
-                                f"{xml.parsers.expat.ErrorString(error.code)}") from None
+        raise ZeroPositionError(
+            f"{source}:{error.lineno}: malformed XML: {xml.parsers.expat.ErrorString(error.code)}"
+        ) from None
     return roots[0]
 
 
@@ -182,13 +186,17 @@ class _Reader:
         try:
             value = float(text.replace(" ", ""))
         except ValueError:
-            self.Fail(element, f"{name}=\"{text}\" is not a number")
+            self.Fail(element, f'{name}="{text}" is not a number')
         if not math.isfinite(value):
-            self.Fail(element, f"{name}=\"{text}\" is not finite")
+            self.Fail(element, f'{name}="{text}" is not finite')
         return value
 
-    def Vector(self, element: _Element, names: tuple[str, str, str],
-               default: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> np.ndarray:
+    def Vector(
+        self,
+        element: _Element,
+        names: tuple[str, str, str],
+        default: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    ) -> np.ndarray:
         return np.array([self.Number(element, n, d) for n, d in zip(names, default)])
 
     def SolidPlacement(self, element: _Element, state: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -198,8 +206,11 @@ class _Reader:
             self.Fail(element, "field volumes are supported for spheres only")
         centre = state["point"] + self.Vector(element, ("px", "py", "pz"))
         names = ("hx", "hy", "hz")
-        axis = (self.Vector(element, names) if any(n in element.attributes for n in names)
-                else np.array([0.0, 0.0, 1.0]))
+        axis = (
+            self.Vector(element, names)
+            if any(n in element.attributes for n in names)
+            else np.array([0.0, 0.0, 1.0])
+        )
         if not np.any(axis):
             self.Fail(element, "its axis (hx, hy, hz) is zero")
         return centre, axis
@@ -207,7 +218,7 @@ class _Reader:
     def Flag(self, element: _Element, name: str) -> bool:
         text = element.attributes.get(name, "false").strip().lower()
         if text not in ("true", "false", "1", "0"):
-            self.Fail(element, f"{name}=\"{text}\" is not a boolean (true or false)")
+            self.Fail(element, f'{name}="{text}" is not a boolean (true or false)')
         return text in ("true", "1")
 
     def Direction(self, element: _Element) -> tuple[np.ndarray, np.ndarray]:
@@ -248,9 +259,16 @@ class _Reader:
             if not name or name in parts:
                 self.Fail(child, f"every bodypart needs a unique name, got '{name}'")
             parts.add(name)
-            state = dict(part=name, point=np.zeros(3), body=ROOT_BODY, direction=np.zeros(3),
-                         motor=None, counters={"joint": 0, "motor": 0}, part_motors=[],
-                         lists=[])
+            state = dict(
+                part=name,
+                point=np.zeros(3),
+                body=ROOT_BODY,
+                direction=np.zeros(3),
+                motor=None,
+                counters={"joint": 0, "motor": 0},
+                part_motors=[],
+                lists=[],
+            )
             self.Children(child, state)
             motors = sorted(state["part_motors"], key=lambda m: m.index)  # document order
             self.motors.extend(motors)
@@ -259,12 +277,18 @@ class _Reader:
 
     def CheckAttributes(self, element: _Element) -> None:
         if element.tag not in _ATTRIBUTES:
-            self.Fail(element, "unknown element; MoBeE's elements are: "
-                      + ", ".join(f"<{t}>" for t in _ATTRIBUTES))
+            self.Fail(
+                element,
+                "unknown element; MoBeE's elements are: "
+                + ", ".join(f"<{t}>" for t in _ATTRIBUTES),
+            )
         unknown = sorted(set(element.attributes) - _ATTRIBUTES[element.tag])
         if unknown:
-            self.Fail(element, f"unknown attribute(s) {unknown}; <{element.tag}> takes: "
-                      + (", ".join(sorted(_ATTRIBUTES[element.tag])) or "none"))
+            self.Fail(
+                element,
+                f"unknown attribute(s) {unknown}; <{element.tag}> takes: "
+                + (", ".join(sorted(_ATTRIBUTES[element.tag])) or "none"),
+            )
 
     def Children(self, element: _Element, state: dict) -> None:
         for child in element.children:
@@ -279,10 +303,12 @@ class _Reader:
         start = state["point"]
         radius = self.Radius(element)
         if radius > 0:
-            self.AddPrimitive(element, state["body"], Capsule(start=start.tolist(),
-                                                               end=(start + b).tolist(),
-                                                               radius=radius),
-                              self.Margin(element, radius))
+            self.AddPrimitive(
+                element,
+                state["body"],
+                Capsule(start=start.tolist(), end=(start + b).tolist(), radius=radius),
+                self.Margin(element, radius),
+            )
         state.update(point=start + b, direction=u)
         self.Children(element, state)
 
@@ -303,9 +329,17 @@ class _Reader:
         if not motor["joints"]:
             self.Fail(element, "a motor must drive at least one joint")
         name = element.attributes.get("name", f"{state['part']}_motor_{index}")
-        state["part_motors"].append(Motor(
-            name=name, bodypart=state["part"], index=index, joints=tuple(motor["joints"]),
-            motor_range=(low, high), joint_ranges=tuple(motor["ranges"]), home=home))
+        state["part_motors"].append(
+            Motor(
+                name=name,
+                bodypart=state["part"],
+                index=index,
+                joints=tuple(motor["joints"]),
+                motor_range=(low, high),
+                joint_ranges=tuple(motor["ranges"]),
+                home=home,
+            )
+        )
 
     def _joint(self, element: _Element, state: dict) -> None:
         if state["motor"] is None:
@@ -329,13 +363,17 @@ class _Reader:
             f'<joint name="{name}" type="revolute"><parent>{parent}</parent>'
             f"<child>{body}</child><axis><xyz>{_Xyz(axis)}</xyz><limit>"
             f"<lower>{math.radians(low)!r}</lower><upper>{math.radians(high)!r}</upper>"
-            "<effort>0</effort></limit></axis></joint>")  # no actuator: FreezeJoints adds them
+            "<effort>0</effort></limit></axis></joint>"
+        )  # no actuator: FreezeJoints adds them
         radius = self.Radius(element)
         if radius > 0 and "length" in element.attributes:
             half = axis * self.Number(element, "length") / 2
-            self.AddPrimitive(element, body, Capsule(start=(point - half).tolist(),
-                                                     end=(point + half).tolist(), radius=radius),
-                              self.Margin(element, radius))
+            self.AddPrimitive(
+                element,
+                body,
+                Capsule(start=(point - half).tolist(), end=(point + half).tolist(), radius=radius),
+                self.Margin(element, radius),
+            )
         state.update(body=body, motor=None)
         self.Children(element, state)
 
@@ -344,9 +382,14 @@ class _Reader:
         if not name or any(m.name == name for m in self.markers):
             self.Fail(element, f"every marker needs a unique name, got '{name}'")
         direction = state["direction"] if np.any(state["direction"]) else np.array([0, 0, 1.0])
-        self.markers.append(Marker(name=name, link=state["body"],
-                                   position=state["point"].tolist(),
-                                   direction=direction.tolist()))
+        self.markers.append(
+            Marker(
+                name=name,
+                link=state["body"],
+                position=state["point"].tolist(),
+                direction=direction.tolist(),
+            )
+        )
         self.Children(element, state)
 
     def _sphere(self, element: _Element, state: dict) -> None:
@@ -355,12 +398,16 @@ class _Reader:
         if radius <= 0:
             self.Fail(element, f"radius must be > 0, got {radius}")
         if self.Flag(element, "field"):
-            self.AddPrimitive(element, state["body"],
-                              Sphere(center=centre.tolist(), radius=FIELD_SPHERE_CORE),
-                              max(radius - FIELD_SPHERE_CORE, 0.0))
+            self.AddPrimitive(
+                element,
+                state["body"],
+                Sphere(center=centre.tolist(), radius=FIELD_SPHERE_CORE),
+                max(radius - FIELD_SPHERE_CORE, 0.0),
+            )
         else:
-            self.AddPrimitive(element, state["body"], Sphere(center=centre.tolist(),
-                                                             radius=radius), None)
+            self.AddPrimitive(
+                element, state["body"], Sphere(center=centre.tolist(), radius=radius), None
+            )
         self.Children(element, state)
 
     def _cylinder(self, element: _Element, state: dict) -> None:
@@ -370,22 +417,33 @@ class _Reader:
             self.Fail(element, f"radius and height must be > 0, got {radius}, {height}")
         # A capsule as long as the cylinder (our overlay's round-ended cylinder).
         half = axis / np.linalg.norm(axis) * max(height / 2 - radius, 1e-4)
-        self.AddPrimitive(element, state["body"], Capsule(start=(centre - half).tolist(),
-                                                          end=(centre + half).tolist(),
-                                                          radius=radius), None)
+        self.AddPrimitive(
+            element,
+            state["body"],
+            Capsule(start=(centre - half).tolist(), end=(centre + half).tolist(), radius=radius),
+            None,
+        )
         self.Children(element, state)
 
     def _box(self, element: _Element, state: dict) -> None:
         centre, axis = self.SolidPlacement(element, state)
-        size = [self.Number(element, "width"), self.Number(element, "depth"),
-                self.Number(element, "height")]
+        size = [
+            self.Number(element, "width"),
+            self.Number(element, "depth"),
+            self.Number(element, "height"),
+        ]
         if min(size) <= 0:
             self.Fail(element, f"width, depth and height must be > 0, got {size}")
         rotation = _ShortestRotation(axis) @ RotationMatrix.MakeZRotation(
-            math.radians(self.Number(element, "angle", 0.0)))
+            math.radians(self.Number(element, "angle", 0.0))
+        )
         rpy = np.degrees(RollPitchYaw(rotation).vector())
-        self.AddPrimitive(element, state["body"], Box(center=centre.tolist(), size=size,
-                                                      rpy_deg=rpy.tolist()), None)
+        self.AddPrimitive(
+            element,
+            state["body"],
+            Box(center=centre.tolist(), size=size, rpy_deg=rpy.tolist()),
+            None,
+        )
         self.Children(element, state)
 
     def _constraintList(self, element: _Element, state: dict) -> None:
@@ -409,8 +467,11 @@ class _Reader:
             offset = b
             for a_i, index in zip(a, q):
                 if not 0 <= index < len(motors):
-                    self.Fail(child, f"q names motor {index}, but this bodypart has "
-                              f"{len(motors)} motors (0..{len(motors) - 1})")
+                    self.Fail(
+                        child,
+                        f"q names motor {index}, but this bodypart has "
+                        f"{len(motors)} motors (0..{len(motors) - 1})",
+                    )
                 motor = motors[index]
                 # a . m < b with m = m_low + (joint - j_low) * (m_high - m_low) / (j_high - j_low)
                 (m_low, m_high), (j_low, j_high) = motor.motor_range, motor.joint_ranges[0]
@@ -430,8 +491,10 @@ class _Reader:
         try:
             return [kind(v) for v in text.replace(",", " ").split()]
         except ValueError:
-            self.Fail(element, f"{name}=\"{text}\" is not a list of "
-                      f"{'integers' if kind is int else 'numbers'}")
+            self.Fail(
+                element,
+                f'{name}="{text}" is not a list of {"integers" if kind is int else "numbers"}',
+            )
 
     def LinkSdf(self, body: str) -> str:
         """A body as an SDFormat <link>: its pose at zero (parallel to its parent's, at its
@@ -442,10 +505,12 @@ class _Reader:
         if body == ROOT_BODY:
             return f'<link name="{body}">{visuals}</link>'
         parent = self.parents[body]
-        return (f'<link name="{body}"><pose relative_to="{parent}">'
-                f"{_Xyz(origin - self.joint_points[parent])} 0 0 0</pose>{visuals}"
-                "<inertial><mass>0.1</mass><inertia><ixx>1e-4</ixx><iyy>1e-4</iyy>"
-                "<izz>1e-4</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial></link>")
+        return (
+            f'<link name="{body}"><pose relative_to="{parent}">'
+            f"{_Xyz(origin - self.joint_points[parent])} 0 0 0</pose>{visuals}"
+            "<inertial><mass>0.1</mass><inertia><ixx>1e-4</ixx><iyy>1e-4</iyy>"
+            "<izz>1e-4</izz><ixy>0</ixy><ixz>0</ixz><iyz>0</iyz></inertia></inertial></link>"
+        )
 
     def Exclusions(self) -> list[list[str]]:
         """Per body, its primitives with those of its parent and grandparent (see the module)."""
@@ -477,18 +542,24 @@ def _Visual(primitive: Primitive, body_origin: np.ndarray) -> str:
         geometry = f"<sphere><radius>{shape.radius!r}</radius></sphere>"
     elif isinstance(shape, Capsule):
         start, end = np.asarray(shape.start), np.asarray(shape.end)
-        X = RigidTransform(RotationMatrix.MakeFromOneVector(end - start, 2),
-                           (start + end) / 2 - body_origin)
-        geometry = (f"<capsule><radius>{shape.radius!r}</radius>"
-                    f"<length>{float(np.linalg.norm(end - start))!r}</length></capsule>")
+        X = RigidTransform(
+            RotationMatrix.MakeFromOneVector(end - start, 2), (start + end) / 2 - body_origin
+        )
+        geometry = (
+            f"<capsule><radius>{shape.radius!r}</radius>"
+            f"<length>{float(np.linalg.norm(end - start))!r}</length></capsule>"
+        )
     else:
-        X = RigidTransform(RollPitchYaw(np.radians(shape.rpy_deg)),
-                           np.asarray(shape.center) - body_origin)
+        X = RigidTransform(
+            RollPitchYaw(np.radians(shape.rpy_deg)), np.asarray(shape.center) - body_origin
+        )
         geometry = f"<box><size>{_Xyz(np.asarray(shape.size))}</size></box>"
     rpy = RollPitchYaw(X.rotation()).vector()
-    return (f'<visual name="{primitive.name}"><pose>{_Xyz(X.translation())} {_Xyz(rpy)}</pose>'
-            f"<geometry>{geometry}</geometry><material><diffuse>{VISUAL_COLOR}</diffuse>"
-            "</material></visual>")
+    return (
+        f'<visual name="{primitive.name}"><pose>{_Xyz(X.translation())} {_Xyz(rpy)}</pose>'
+        f"<geometry>{geometry}</geometry><material><diffuse>{VISUAL_COLOR}</diffuse>"
+        "</material></visual>"
+    )
 
 
 def _Xyz(v: np.ndarray) -> str:
@@ -522,37 +593,60 @@ def LoadZeroPositionTree(filename: str | pathlib.Path) -> ZeroPositionRobot:
     reader = _Reader(source)
     reader.Read(root)
     name = root.attributes.get("robotName", pathlib.Path(source).stem)
-    overlay = Overlay(reference_link=ROOT_BODY, primitives=reader.primitives,
-                      exclude=reader.Exclusions(), markers=reader.markers,
-                      clauses=reader.clauses)
+    overlay = Overlay(
+        reference_link=ROOT_BODY,
+        primitives=reader.primitives,
+        exclude=reader.Exclusions(),
+        markers=reader.markers,
+        clauses=reader.clauses,
+    )
     ValidateOverlay(overlay, source)
-    sdf = (f'<?xml version="1.0"?><sdf version="1.9"><model name="{name}">'
-           + "".join(reader.LinkSdf(body) for body in reader.joint_points)
-           + "".join(reader.joints_sdf) + "</model></sdf>")
-    return ZeroPositionRobot(name=name, source=source, sdf=sdf, overlay=overlay,
-                             motors=tuple(reader.motors), joints=tuple(reader.joints))
+    sdf = (
+        f'<?xml version="1.0"?><sdf version="1.9"><model name="{name}">'
+        + "".join(reader.LinkSdf(body) for body in reader.joint_points)
+        + "".join(reader.joints_sdf)
+        + "</model></sdf>"
+    )
+    return ZeroPositionRobot(
+        name=name,
+        source=source,
+        sdf=sdf,
+        overlay=overlay,
+        motors=tuple(reader.motors),
+        joints=tuple(reader.joints),
+    )
 
 
-def AddZeroPositionRobot(plant, scene_graph, robot: ZeroPositionRobot, *,
-                         controlled_joints: list[str] | None = None,
-                         X_WRoot: RigidTransform | None = None, model_name: str | None = None):
+def AddZeroPositionRobot(
+    plant,
+    scene_graph,
+    robot: ZeroPositionRobot,
+    *,
+    controlled_joints: list[str] | None = None,
+    X_WRoot: RigidTransform | None = None,
+    model_name: str | None = None,
+):
     """Adds ``robot`` with its overlay to an unfinalized ``plant``, its root body welded at
     ``X_WRoot``; joints not in ``controlled_joints`` (all, by default) are welded at home."""
     name = model_name or robot.name
     return AddModelWithOverlay(
-        plant, scene_graph,
+        plant,
+        scene_graph,
         add_model=lambda p: Parser(p, name).AddModelsFromString(robot.sdf, "sdf")[0],
         overlay=robot.overlay,
         controlled_joints=robot.joints if controlled_joints is None else controlled_joints,
-        home=robot.home, X_WRoot=X_WRoot, model_source=robot.source,
-        overlay_source=robot.source)
+        home=robot.home,
+        X_WRoot=X_WRoot,
+        model_source=robot.source,
+        overlay_source=robot.source,
+    )
 
 
 @dc.dataclass
 class ZeroPositionConfig:
     """A robot of a scenario read from a MoBeE XML file (e.g. ``katana.xml``)."""
 
-    # The file; a relative path is taken from the package's models/ folder.
+    # The file: package://mobee_drake/..., a path, or a shipped model's name.
     file: str = "katana.xml"
     # The controlled joints; empty: every joint of a motor that drives one joint. (Motors that
     # drive several joints, like the Katana's gripper, are held at home: MoBeE 2.0 here controls
@@ -560,9 +654,9 @@ class ZeroPositionConfig:
     controlled_joints: list[str] = dc.field(default_factory=list)
 
     def Load(self) -> ZeroPositionRobot:
-        path = pathlib.Path(self.file)
-        return LoadZeroPositionTree(path if path.is_absolute() else MODELS_DIR / path)
+        return LoadZeroPositionTree(ResolveModelFile(self.file))
 
     def Joints(self, robot: ZeroPositionRobot) -> list[str]:
-        return list(self.controlled_joints) or [m.joints[0] for m in robot.motors
-                                                if len(m.joints) == 1]
+        return list(self.controlled_joints) or [
+            m.joints[0] for m in robot.motors if len(m.joints) == 1
+        ]

@@ -18,8 +18,17 @@ class RandomAttractorSource(LeafSystem):
     Joints not in ``babbling`` (a boolean mask) stay at ``home``.
     """
 
-    def __init__(self, *, lower: np.ndarray, upper: np.ndarray, home: np.ndarray,
-                 babbling: np.ndarray, range_fraction: float, period: float, seed: int):
+    def __init__(
+        self,
+        *,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        home: np.ndarray,
+        babbling: np.ndarray,
+        range_fraction: float,
+        period: float,
+        seed: int,
+    ):
         super().__init__()
         center, half = (lower + upper) / 2, range_fraction * (upper - lower) / 2
         self._low, self._high = center - half, center + half
@@ -27,8 +36,9 @@ class RandomAttractorSource(LeafSystem):
         self._period, self._seed = period, seed
         state = self.DeclareDiscreteState(BasicVector(self._Draw(0)))
         self.DeclareStateOutputPort("attractor", state)
-        self.DeclarePeriodicDiscreteUpdateEvent(period_sec=period, offset_sec=period,
-                                                update=self._Update)
+        self.DeclarePeriodicDiscreteUpdateEvent(
+            period_sec=period, offset_sec=period, update=self._Update
+        )
 
     def _Draw(self, k: int) -> np.ndarray:
         rng = np.random.default_rng([self._seed, k])
@@ -50,17 +60,27 @@ class SliderAttractorSource(LeafSystem):
         - attractor
     """
 
-    def __init__(self, *, meshcat, joints: list[str], lower: np.ndarray, upper: np.ndarray,
-                 home: np.ndarray, period: float):
+    def __init__(
+        self,
+        *,
+        meshcat,
+        joints: list[str],
+        lower: np.ndarray,
+        upper: np.ndarray,
+        home: np.ndarray,
+        period: float,
+    ):
         super().__init__()
         self._meshcat, self._joints = meshcat, list(joints)
-        for name, lo, hi, value in zip(self._joints, np.degrees(lower), np.degrees(upper),
-                                       np.degrees(home)):
+        for name, lo, hi, value in zip(
+            self._joints, np.degrees(lower), np.degrees(upper), np.degrees(home)
+        ):
             meshcat.AddSlider(name, lo, hi, 0.1, value)
         state = self.DeclareDiscreteState(BasicVector(np.asarray(home, dtype=float)))
         self.DeclareStateOutputPort("attractor", state)
-        self.DeclarePeriodicDiscreteUpdateEvent(period_sec=period, offset_sec=0.0,
-                                                update=self._Read)
+        self.DeclarePeriodicDiscreteUpdateEvent(
+            period_sec=period, offset_sec=0.0, update=self._Read
+        )
 
     def _Read(self, context, discrete_state) -> None:
         degrees = [self._meshcat.GetSliderValue(name) for name in self._joints]

@@ -62,16 +62,18 @@ def SaveCheckpoint(simulation: Simulation, context, folder: str | pathlib.Path) 
     """Saves the state of ``context`` (the diagram's root context) into ``folder``."""
 
     def Write(staging: pathlib.Path) -> None:
-        np.savez(staging / "simulation.npz", time=context.get_time(),
-                 **{key: value for key, value in _DiscreteStates(simulation, context)})
+        np.savez(
+            staging / "simulation.npz",
+            time=context.get_time(),
+            **{key: value for key, value in _DiscreteStates(simulation, context)},
+        )
         supervisor = _Supervisor(simulation)
         if supervisor is not None:
             records = supervisor.Records(supervisor.GetMyContextFromRoot(context))
             for name, record in zip(supervisor.agent_names, records):
                 arrays, data = ExplorerToArrays(record.explorer)
                 np.savez(staging / f"{name}.npz", **arrays)
-                data["record"] = {k: v for k, v in dc.asdict(record).items()
-                                  if k != "explorer"}
+                data["record"] = {k: v for k, v in dc.asdict(record).items() if k != "explorer"}
                 data["record"]["slow_since"] = float(record.slow_since)
                 (staging / f"{name}.json").write_text(json.dumps(data, indent=1))
 
@@ -94,15 +96,19 @@ def LoadCheckpoint(simulation: Simulation, context, folder: str | pathlib.Path) 
         if key not in saved.files:
             if system_name in _VIEWER_SYSTEMS:
                 continue
-            raise ValueError(f"{folder}: no saved state for '{system_name}': a checkpoint of "
-                             "another scenario?")
+            raise ValueError(
+                f"{folder}: no saved state for '{system_name}': a checkpoint of another scenario?"
+            )
         value = saved[key]
         if value.shape != current.shape:
-            raise ValueError(f"{folder}: the saved state of '{system_name}' has shape "
-                             f"{value.shape}, the scenario's {current.shape}")
+            raise ValueError(
+                f"{folder}: the saved state of '{system_name}' has shape "
+                f"{value.shape}, the scenario's {current.shape}"
+            )
         system = simulation.diagram.GetSubsystemByName(system_name)
         system.GetMyMutableContextFromRoot(context).get_mutable_discrete_state(
-            int(group)).SetFromVector(value)
+            int(group)
+        ).SetFromVector(value)
     supervisor = _Supervisor(simulation)
     if supervisor is not None:
         records = []

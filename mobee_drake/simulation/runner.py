@@ -28,13 +28,17 @@ class RunSummary:
         return self.simulated_time / self.wall_time if self.wall_time > 0 else float("inf")
 
     def Format(self) -> str:
-        lines = [f"simulated {self.simulated_time:.2f} s in {self.wall_time:.2f} s "
-                 f"({self.realtime_factor:.1f}x real time)"]
+        lines = [
+            f"simulated {self.simulated_time:.2f} s in {self.wall_time:.2f} s "
+            f"({self.realtime_factor:.1f}x real time)"
+        ]
         lines.append("closest approach of the robot's solids (m; '-' = never inside a field):")
         for name, distance in self.safety.closest_approach.items():
             lines.append(f"  {name:20s} {'-' if distance is None else f'{distance:+.4f}'}")
-        lines.append(f"penetrations of solid geometry: {self.safety.penetrating_steps} control "
-                     f"periods, deepest {1000 * self.safety.deepest_penetration:.2f} mm")
+        lines.append(
+            f"penetrations of solid geometry: {self.safety.penetrating_steps} control "
+            f"periods, deepest {1000 * self.safety.deepest_penetration:.2f} mm"
+        )
         if self.recording:
             lines.append(f"recording: {self.recording}")
         return "\n".join(lines)
@@ -47,8 +51,14 @@ def _WriteAtomically(path: pathlib.Path, text: str) -> None:
     os.replace(temporary, path)
 
 
-def Advance(simulation: Simulation, simulator: Simulator, until: float, *,
-            progress: bool = False, after_chunk=None) -> None:
+def Advance(
+    simulation: Simulation,
+    simulator: Simulator,
+    until: float,
+    *,
+    progress: bool = False,
+    after_chunk=None,
+) -> None:
     """Advances to ``until``, applying the scenario's world events whose time is in [now, until).
 
     ``after_chunk(context)``, if given, is called after each of the (at most 500) chunks the run is
@@ -56,24 +66,28 @@ def Advance(simulation: Simulation, simulator: Simulator, until: float, *,
     """
     context = simulator.get_mutable_context()
     start = context.get_time()
-    events = sorted((e for e in simulation.scenario.world_events if start <= e.time < until),
-                    key=lambda e: e.time)
+    events = sorted(
+        (e for e in simulation.scenario.world_events if start <= e.time < until),
+        key=lambda e: e.time,
+    )
     # Progress is reported in at most 500 chunks.
     chunks = max(1, min(500, int(round((until - start) / simulation.scenario.time_step))))
     bar = None
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=round(until - start, 3), leave=False,
-                   bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} s simulated "
-                              "[{elapsed}<{remaining}]")
+        bar = tqdm(
+            total=round(until - start, 3),
+            leave=False,
+            bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} s simulated [{elapsed}<{remaining}]",
+        )
     requests = SupervisorEventPorts(simulation.diagram)
 
     def ApplyRequests():
         for port in requests:  # Supervisors' requests, applied once each, in order.
             name = port.get_system().get_name()
             issued = port.Eval(port.get_system().GetMyContextFromRoot(context))
-            for event in issued[simulation.applied_requests.get(name, 0):]:
+            for event in issued[simulation.applied_requests.get(name, 0) :]:
                 simulation.world.Apply(context, event)
             simulation.applied_requests[name] = len(issued)
 
@@ -103,9 +117,15 @@ def _ActionsDone(simulation: Simulation, context) -> int:
     return sum(r.actions_done for r in supervisor.Records(supervisor.GetMyContextFromRoot(context)))
 
 
-def RunScenario(scenario: Scenario, *, meshcat: Meshcat | None = None, record: str | None = None,
-                realtime_rate: float = 0.0, progress: bool = False,
-                checkpoint: str | None = None) -> RunSummary:
+def RunScenario(
+    scenario: Scenario,
+    *,
+    meshcat: Meshcat | None = None,
+    record: str | None = None,
+    realtime_rate: float = 0.0,
+    progress: bool = False,
+    checkpoint: str | None = None,
+) -> RunSummary:
     """Runs ``scenario`` until its duration; with ``record`` saves a Meshcat recording (HTML).
 
     With ``checkpoint`` (a folder), a run resumes from the checkpoint there if there is one, and
@@ -152,5 +172,9 @@ def RunScenario(scenario: Scenario, *, meshcat: Meshcat | None = None, record: s
         _WriteAtomically(path, meshcat.StaticHtml())
         recording = str(path.resolve())
     report = simulation.monitor.Report(simulation.monitor.GetMyContextFromRoot(context))
-    return RunSummary(simulated_time=context.get_time() - simulated_before, wall_time=wall,
-                      safety=report, recording=recording)
+    return RunSummary(
+        simulated_time=context.get_time() - simulated_before,
+        wall_time=wall,
+        safety=report,
+        recording=recording,
+    )

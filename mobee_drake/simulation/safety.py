@@ -44,13 +44,16 @@ class SafetyMonitor(LeafSystem):
         self._index = {name: i for i, name in enumerate(names)}
         self._self_index, self._others_index = len(names), len(names) + 1
         self._pairs_port = self.DeclareAbstractInputPort(
-            "field_pairs", AbstractValue.Make(NO_FIELD_PAIRS))
+            "field_pairs", AbstractValue.Make(NO_FIELD_PAIRS)
+        )
         self._query_port = self.DeclareAbstractInputPort(
-            "geometry_query", AbstractValue.Make(QueryObject()))
+            "geometry_query", AbstractValue.Make(QueryObject())
+        )
         initial = np.concatenate([np.full(len(self._names), np.inf), [0.0, 0.0]])
         self._state = self.DeclareDiscreteState(BasicVector(initial))
-        self.DeclarePeriodicDiscreteUpdateEvent(period_sec=period, offset_sec=0.0,
-                                                update=self._Update)
+        self.DeclarePeriodicDiscreteUpdateEvent(
+            period_sec=period, offset_sec=0.0, update=self._Update
+        )
 
     def _Update(self, context, discrete_state) -> None:
         pairs = self._pairs_port.Eval(context)
@@ -59,10 +62,12 @@ class SafetyMonitor(LeafSystem):
         x = context.get_discrete_state(self._state).value().copy()
         n = len(self._names)
         inspector = self._query_port.Eval(context).inspector()
-        for geometry_id, distance, robot in zip(pairs.geometry_B, pairs.distance,
-                                                pairs.b_is_robot):
-            i = self._self_index if robot else self._index.get(inspector.GetName(geometry_id),
-                                                               self._others_index)
+        for geometry_id, distance, robot in zip(pairs.geometry_B, pairs.distance, pairs.b_is_robot):
+            i = (
+                self._self_index
+                if robot
+                else self._index.get(inspector.GetName(geometry_id), self._others_index)
+            )
             x[i] = min(x[i], distance)
         deepest_now = -pairs.distance.min()
         if deepest_now > 0:
@@ -74,6 +79,10 @@ class SafetyMonitor(LeafSystem):
         x = context.get_discrete_state(self._state).value()
         n = len(self._names)
         return SafetyReport(
-            closest_approach={name: (None if np.isinf(x[i]) else float(x[i]))
-                              for i, name in enumerate(self._names)},
-            penetrating_steps=int(x[n]), deepest_penetration=float(x[n + 1]))
+            closest_approach={
+                name: (None if np.isinf(x[i]) else float(x[i]))
+                for i, name in enumerate(self._names)
+            },
+            penetrating_steps=int(x[n]),
+            deepest_penetration=float(x[n + 1]),
+        )

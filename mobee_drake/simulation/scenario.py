@@ -183,8 +183,13 @@ class Scenario:
     # The dynamic robot's plant step (s).
     plant_time_step: float = 0.001
     duration: float = 10.0
-    attractor: (FixedAttractor | RandomAttractors | SliderAttractor | ExploreAttractor
-                | StateActionAttractor) = dc.field(default_factory=FixedAttractor)
+    attractor: (
+        FixedAttractor
+        | RandomAttractors
+        | SliderAttractor
+        | ExploreAttractor
+        | StateActionAttractor
+    ) = dc.field(default_factory=FixedAttractor)
     world_events: list[WorldEvent] = dc.field(default_factory=list)
     visualization: Visualization = dc.field(default_factory=Visualization)
     random_seed: int = 0
@@ -197,49 +202,95 @@ def _Check(condition: bool, source: str, message: str) -> None:
 
 def ValidateScenario(scenario: Scenario, source: str = "scenario") -> None:
     """Checks the choices and numbers that the schema's types cannot."""
-    _Check(scenario.robot_model in ROBOT_MODELS, source,
-           f"robot_model must be one of {ROBOT_MODELS}, got '{scenario.robot_model}'")
-    _Check(scenario.controller in CONTROLLERS, source,
-           f"controller must be one of {CONTROLLERS}, got '{scenario.controller}'")
-    _Check(scenario.controller == "mobee2" or scenario.robot_model == "kinematic", source,
-           "the reflex controller (MoBeE 1.0) moves the kinematic robot only")
-    _Check(scenario.reflex.speed_deg > 0 and scenario.reflex.history >= 2
-           and scenario.reflex.tolerance_deg > 0, source,
-           "reflex: speed_deg and tolerance_deg must be > 0 and history >= 2")
-    _Check(scenario.control in CONTROL_MODALITIES, source,
-           f"control must be one of {CONTROL_MODALITIES}, got '{scenario.control}'")
+    _Check(
+        scenario.robot_model in ROBOT_MODELS,
+        source,
+        f"robot_model must be one of {ROBOT_MODELS}, got '{scenario.robot_model}'",
+    )
+    _Check(
+        scenario.controller in CONTROLLERS,
+        source,
+        f"controller must be one of {CONTROLLERS}, got '{scenario.controller}'",
+    )
+    _Check(
+        scenario.controller == "mobee2" or scenario.robot_model == "kinematic",
+        source,
+        "the reflex controller (MoBeE 1.0) moves the kinematic robot only",
+    )
+    _Check(
+        scenario.reflex.speed_deg > 0
+        and scenario.reflex.history >= 2
+        and scenario.reflex.tolerance_deg > 0,
+        source,
+        "reflex: speed_deg and tolerance_deg must be > 0 and history >= 2",
+    )
+    _Check(
+        scenario.control in CONTROL_MODALITIES,
+        source,
+        f"control must be one of {CONTROL_MODALITIES}, got '{scenario.control}'",
+    )
     for key in ("time_step", "plant_time_step", "duration"):
         value = getattr(scenario, key)
         _Check(value > 0, source, f"{key} must be > 0, got {value}")
     names = set()
     for obj in scenario.objects:
-        _Check(bool(obj.name) and obj.name not in names, source,
-               f"every object needs a unique name, got '{obj.name}'")
+        _Check(
+            bool(obj.name) and obj.name not in names,
+            source,
+            f"every object needs a unique name, got '{obj.name}'",
+        )
         names.add(obj.name)
-        _Check(obj.role in OBJECT_ROLES, source,
-               f"object '{obj.name}': role must be one of {OBJECT_ROLES}, got '{obj.role}'")
-        _Check(len(obj.position) == 3 and len(obj.rpy_deg) == 3, source,
-               f"object '{obj.name}': position and rpy_deg need three numbers")
+        _Check(
+            obj.role in OBJECT_ROLES,
+            source,
+            f"object '{obj.name}': role must be one of {OBJECT_ROLES}, got '{obj.role}'",
+        )
+        _Check(
+            len(obj.position) == 3 and len(obj.rpy_deg) == 3,
+            source,
+            f"object '{obj.name}': position and rpy_deg need three numbers",
+        )
     for event in scenario.world_events:
-        _Check(event.object in names, source,
-               f"world event at {event.time} s names unknown object '{event.object}'")
-        _Check(event.role in OBJECT_ROLES + ("",), source,
-               f"world event at {event.time} s: role must be one of {OBJECT_ROLES}, "
-               f"got '{event.role}'")
-        _Check(len(event.position) in (0, 3), source,
-               f"world event at {event.time} s: position needs three numbers")
+        _Check(
+            event.object in names,
+            source,
+            f"world event at {event.time} s names unknown object '{event.object}'",
+        )
+        _Check(
+            event.role in OBJECT_ROLES + ("",),
+            source,
+            f"world event at {event.time} s: role must be one of {OBJECT_ROLES}, "
+            f"got '{event.role}'",
+        )
+        _Check(
+            len(event.position) in (0, 3),
+            source,
+            f"world event at {event.time} s: position needs three numbers",
+        )
     for companion in scenario.companions:
-        _Check(scenario.robot_model == "kinematic", source,
-               f"companion '{companion.name}': other robots run in kinematic scenarios only")
-        _Check(bool(companion.name) and companion.name not in names, source,
-               f"every companion needs a unique name, not an object's, got '{companion.name}'")
+        _Check(
+            scenario.robot_model == "kinematic",
+            source,
+            f"companion '{companion.name}': other robots run in kinematic scenarios only",
+        )
+        _Check(
+            bool(companion.name) and companion.name not in names,
+            source,
+            f"every companion needs a unique name, not an object's, got '{companion.name}'",
+        )
         names.add(companion.name)
-        _Check(len(companion.position) == 3 and len(companion.rpy_deg) == 3, source,
-               f"companion '{companion.name}': position and rpy_deg need three numbers")
+        _Check(
+            len(companion.position) == 3 and len(companion.rpy_deg) == 3,
+            source,
+            f"companion '{companion.name}': position and rpy_deg need three numbers",
+        )
     if isinstance(scenario.attractor, RandomAttractors):
         _Check(scenario.attractor.period > 0, source, "attractor period must be > 0")
-        _Check(0 < scenario.attractor.range_fraction <= 1, source,
-               "attractor range_fraction must be in (0, 1]")
+        _Check(
+            0 < scenario.attractor.range_fraction <= 1,
+            source,
+            "attractor range_fraction must be in (0, 1]",
+        )
 
 
 def LoadScenario(filename: str | pathlib.Path, overrides: str | None = None) -> Scenario:

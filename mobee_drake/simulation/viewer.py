@@ -45,7 +45,8 @@ class ForceDrawer(LeafSystem):
         super().__init__()
         self._meshcat = meshcat
         self._contacts_port = self.DeclareAbstractInputPort(
-            "field_contacts", AbstractValue.Make([]))
+            "field_contacts", AbstractValue.Make([])
+        )
         self._positions_port = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
         self._forces_port = self.DeclareVectorInputPort("marker_forces", 3 * num_markers)
         self.DeclarePeriodicPublishEvent(period_sec=period, offset_sec=0.0, publish=self._Draw)
@@ -59,9 +60,15 @@ class ForceDrawer(LeafSystem):
 
     def _Draw(self, context) -> None:
         contacts = self._contacts_port.Eval(context)
-        self._Segments("/field_forces", [c.p_WCa for c in contacts],
-                       [c.p_WCa + ARROW_LENGTH_PER_PENETRATION * c.penetration * c.nhat_BA_W
-                        for c in contacts], CONTACT_FORCE_COLOR)
+        self._Segments(
+            "/field_forces",
+            [c.p_WCa for c in contacts],
+            [
+                c.p_WCa + ARROW_LENGTH_PER_PENETRATION * c.penetration * c.nhat_BA_W
+                for c in contacts
+            ],
+            CONTACT_FORCE_COLOR,
+        )
         starts, ends = [], []
         if self._forces_port.HasValue(context):
             points = self._positions_port.Eval(context).reshape(-1, 3)
@@ -80,24 +87,33 @@ class TrailDrawer(LeafSystem):
     ring buffer and its count); a periodic publish sends them to Meshcat.
     """
 
-    def __init__(self, *, meshcat: Meshcat, marker_index: int, num_markers: int, period: float,
-                 capacity: int = 600, path: str = "/trail"):
+    def __init__(
+        self,
+        *,
+        meshcat: Meshcat,
+        marker_index: int,
+        num_markers: int,
+        period: float,
+        capacity: int = 600,
+        path: str = "/trail",
+    ):
         super().__init__()
         self._meshcat, self._path, self._capacity = meshcat, path, capacity
         self._marker_index = marker_index
         self._positions_port = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
         self._state = self.DeclareDiscreteState(BasicVector(np.zeros(3 * capacity + 1)))
-        self.DeclarePeriodicDiscreteUpdateEvent(period_sec=period, offset_sec=0.0,
-                                                update=self._Append)
+        self.DeclarePeriodicDiscreteUpdateEvent(
+            period_sec=period, offset_sec=0.0, update=self._Append
+        )
         self.DeclarePeriodicPublishEvent(period_sec=period, offset_sec=0.0, publish=self._Draw)
 
     def _Append(self, context, discrete_state) -> None:
         x = context.get_discrete_state(self._state).value().copy()
         count = int(x[-1])
         i = 3 * self._marker_index
-        p = self._positions_port.Eval(context)[i:i + 3]
+        p = self._positions_port.Eval(context)[i : i + 3]
         slot = count % self._capacity
-        x[3 * slot:3 * slot + 3] = p
+        x[3 * slot : 3 * slot + 3] = p
         x[-1] = count + 1
         discrete_state.get_mutable_vector(self._state).SetFromVector(x)
 
@@ -115,8 +131,13 @@ class TrailDrawer(LeafSystem):
         self._meshcat.SetLine(self._path, points.T, 3.0, TRAIL_COLOR)
 
 
-def _AddAttractorRobot(builder: DiagramBuilder, scenario: Scenario, scene_graph: SceneGraph,
-                       mobee: Mobee, attractor: OutputPort) -> None:
+def _AddAttractorRobot(
+    builder: DiagramBuilder,
+    scenario: Scenario,
+    scene_graph: SceneGraph,
+    mobee: Mobee,
+    attractor: OutputPort,
+) -> None:
     """A second, translucent robot (illustration only) posed at the attractor."""
     text, extension, root, home = RobotModelText(scenario.robot, ATTRACTOR_ALPHA)
     ghost = MultibodyPlant(0.0)
@@ -124,24 +145,33 @@ def _AddAttractorRobot(builder: DiagramBuilder, scenario: Scenario, scene_graph:
     parser = Parser(ghost, "attractor")
     (instance,) = parser.AddModelsFromString(text, extension)
     ghost.RenameModelInstance(instance, "attractor")
-    ghost.WeldFrames(ghost.world_frame(), ghost.GetFrameByName(root, instance),
-                     RigidTransform())
+    ghost.WeldFrames(ghost.world_frame(), ghost.GetFrameByName(root, instance), RigidTransform())
     FreezeJoints(ghost, instance, keep=mobee.joints, home=home, source="attractor robot")
     ghost.Finalize()
     builder.AddNamedSystem("attractor_robot_owner", SharedPointerSystem(ghost))
-    positions = JointStateSelector(ghost, mobee.joints)[:ghost.num_positions(), :len(mobee.joints)]
+    positions = JointStateSelector(ghost, mobee.joints)[
+        : ghost.num_positions(), : len(mobee.joints)
+    ]
     to_ghost = builder.AddNamedSystem("attractor_to_robot", MatrixGain(positions))
     to_pose = builder.AddNamedSystem("attractor_pose", MultibodyPositionToGeometryPose(ghost))
     builder.Connect(attractor, to_ghost.get_input_port())
     builder.Connect(to_ghost.get_output_port(), to_pose.get_input_port())
-    builder.Connect(to_pose.get_output_port(),
-                    scene_graph.get_source_pose_port(ghost.get_source_id()))
+    builder.Connect(
+        to_pose.get_output_port(), scene_graph.get_source_pose_port(ghost.get_source_id())
+    )
 
 
-def AddViewer(builder: DiagramBuilder, *, scenario: Scenario, meshcat: Meshcat,
-              plant: MultibodyPlant, scene_graph: SceneGraph, mobee: Mobee,
-              attractor: OutputPort,
-              marker_forces: OutputPort | str | None = None) -> MeshcatVisualizer:
+def AddViewer(
+    builder: DiagramBuilder,
+    *,
+    scenario: Scenario,
+    meshcat: Meshcat,
+    plant: MultibodyPlant,
+    scene_graph: SceneGraph,
+    mobee: Mobee,
+    attractor: OutputPort,
+    marker_forces: OutputPort | str | None = None,
+) -> MeshcatVisualizer:
     """Adds the Meshcat viewer of a scenario; returns the illustration visualizer.
 
     ``marker_forces`` is the port, or names the diagram input, that carries the client's marker
@@ -151,26 +181,48 @@ def AddViewer(builder: DiagramBuilder, *, scenario: Scenario, meshcat: Meshcat,
     if settings.show_attractor:
         _AddAttractorRobot(builder, scenario, scene_graph, mobee, attractor)
     visualizer = MeshcatVisualizer.AddToBuilder(
-        builder, scene_graph, meshcat, MeshcatVisualizerParams(role=Role.kIllustration,
-                                                               prefix="illustration"))
+        builder,
+        scene_graph,
+        meshcat,
+        MeshcatVisualizerParams(role=Role.kIllustration, prefix="illustration"),
+    )
     # MoBeE's primitives, hidden by default (toggle "collision" in Meshcat's controls).
     MeshcatVisualizer.AddToBuilder(
-        builder, scene_graph, meshcat,
-        MeshcatVisualizerParams(role=Role.kProximity, prefix="collision",
-                                default_color=Rgba(0.2, 0.5, 0.9, 0.4), visible_by_default=False))
-    forces = builder.AddNamedSystem("force_drawer", ForceDrawer(
-        meshcat=meshcat, num_markers=len(mobee.marker_names),
-        period=max(scenario.time_step, 1 / 30)))
+        builder,
+        scene_graph,
+        meshcat,
+        MeshcatVisualizerParams(
+            role=Role.kProximity,
+            prefix="collision",
+            default_color=Rgba(0.2, 0.5, 0.9, 0.4),
+            visible_by_default=False,
+        ),
+    )
+    forces = builder.AddNamedSystem(
+        "force_drawer",
+        ForceDrawer(
+            meshcat=meshcat,
+            num_markers=len(mobee.marker_names),
+            period=max(scenario.time_step, 1 / 30),
+        ),
+    )
     builder.Connect(mobee.GetOutputPort("field_contacts"), forces.GetInputPort("field_contacts"))
-    builder.Connect(mobee.GetOutputPort("marker_positions"),
-                    forces.GetInputPort("marker_positions"))
+    builder.Connect(
+        mobee.GetOutputPort("marker_positions"), forces.GetInputPort("marker_positions")
+    )
     if isinstance(marker_forces, str):
         builder.ConnectInput(marker_forces, forces.GetInputPort("marker_forces"))
     elif marker_forces is not None:
         builder.Connect(marker_forces, forces.GetInputPort("marker_forces"))
     if settings.trail_marker:
-        trail = builder.AddNamedSystem("trail", TrailDrawer(
-            meshcat=meshcat, marker_index=mobee.marker_index(settings.trail_marker),
-            num_markers=len(mobee.marker_names), period=max(scenario.time_step, 0.02)))
+        trail = builder.AddNamedSystem(
+            "trail",
+            TrailDrawer(
+                meshcat=meshcat,
+                marker_index=mobee.marker_index(settings.trail_marker),
+                num_markers=len(mobee.marker_names),
+                period=max(scenario.time_step, 0.02),
+            ),
+        )
         builder.Connect(mobee.GetOutputPort("marker_positions"), trail.get_input_port())
     return visualizer

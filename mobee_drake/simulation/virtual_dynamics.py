@@ -27,8 +27,9 @@ class VirtualDynamics(LeafSystem):
     The state (q, v) is the output, in MoBeE's joint order.
     """
 
-    def __init__(self, *, mass: np.ndarray, damping: np.ndarray, period: float,
-                 initial_positions: np.ndarray):
+    def __init__(
+        self, *, mass: np.ndarray, damping: np.ndarray, period: float, initial_positions: np.ndarray
+    ):
         super().__init__()
         n = len(mass)
         mass, damping = np.asarray(mass, dtype=float), np.asarray(damping, dtype=float)
@@ -38,10 +39,12 @@ class VirtualDynamics(LeafSystem):
         self._total_port = self.DeclareVectorInputPort("total", n)
         self._damping_port = self.DeclareVectorInputPort("damping", n)
         state = self.DeclareDiscreteState(
-            BasicVector(np.concatenate([initial_positions, np.zeros(n)])))
+            BasicVector(np.concatenate([initial_positions, np.zeros(n)]))
+        )
         self.DeclareStateOutputPort("state", state)
-        self.DeclarePeriodicDiscreteUpdateEvent(period_sec=period, offset_sec=0.0,
-                                                update=self._Update)
+        self.DeclarePeriodicDiscreteUpdateEvent(
+            period_sec=period, offset_sec=0.0, update=self._Update
+        )
 
     def _Update(self, context, discrete_state) -> None:
         x = context.get_discrete_state_vector().value()
@@ -49,4 +52,5 @@ class VirtualDynamics(LeafSystem):
         undamped = self._total_port.Eval(context) - self._damping_port.Eval(context)
         v_next = (x[n:] + self._h_over_mass * undamped) * self._damping_factor
         discrete_state.get_mutable_vector().SetFromVector(
-            np.concatenate([x[:n] + self._period * v_next, v_next]))
+            np.concatenate([x[:n] + self._period * v_next, v_next])
+        )

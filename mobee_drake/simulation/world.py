@@ -87,8 +87,9 @@ class LiveWorld:
         """Adds ``obj`` to the plant before it is finalized (the scenario's initial objects)."""
         shape, X_WO = MakeShape(obj.shape), ObjectPose(obj.position, obj.rpy_deg)
         world = self._plant.world_body()
-        geometry_id = self._plant.RegisterVisualGeometry(world, X_WO, shape, obj.name,
-                                                         ROLE_COLORS[obj.role])
+        geometry_id = self._plant.RegisterVisualGeometry(
+            world, X_WO, shape, obj.name, ROLE_COLORS[obj.role]
+        )
         # The same geometry carries the proximity role while it is an obstacle.
         if obj.role == "obstacle":
             self._scene_graph.AssignRole(self._source_id, geometry_id, _ProximityProperties())
@@ -107,8 +108,9 @@ class LiveWorld:
 
     def _Get(self, name: str) -> list:
         if name not in self._objects:
-            raise ValueError(f"unknown world object '{name}'; objects are: "
-                             + ", ".join(self._objects))
+            raise ValueError(
+                f"unknown world object '{name}'; objects are: " + ", ".join(self._objects)
+            )
         return self._objects[name]
 
     def _SceneGraphContext(self, root_context):
@@ -120,23 +122,31 @@ class LiveWorld:
             raise ValueError(f"world object '{obj.name}' exists already")
         if obj.role not in schema.OBJECT_ROLES:
             raise ValueError(f"world object '{obj.name}': unknown role '{obj.role}'")
-        self._Register(root_context, obj.name, MakeShape(obj.shape),
-                       ObjectPose(obj.position, obj.rpy_deg), obj.role)
+        self._Register(
+            root_context,
+            obj.name,
+            MakeShape(obj.shape),
+            ObjectPose(obj.position, obj.rpy_deg),
+            obj.role,
+        )
 
-    def _Register(self, root_context, name: str, shape: Shape, X_WO: RigidTransform,
-                  role: str) -> None:
+    def _Register(
+        self, root_context, name: str, shape: Shape, X_WO: RigidTransform, role: str
+    ) -> None:
         instance = GeometryInstance(X_WO, shape, name)
         instance.set_illustration_properties(_IllustrationProperties(role))
         if role == "obstacle":
             instance.set_proximity_properties(_ProximityProperties())
         geometry_id = self._scene_graph.RegisterGeometry(
-            self._SceneGraphContext(root_context), self._source_id, self._frame_id, instance)
+            self._SceneGraphContext(root_context), self._source_id, self._frame_id, instance
+        )
         self._objects[name] = [geometry_id, shape, X_WO, role]
 
     def Remove(self, root_context, name: str) -> None:
         geometry_id = self._Get(name)[0]
-        self._scene_graph.RemoveGeometry(self._SceneGraphContext(root_context), self._source_id,
-                                         geometry_id)
+        self._scene_graph.RemoveGeometry(
+            self._SceneGraphContext(root_context), self._source_id, geometry_id
+        )
         del self._objects[name]
 
     def Move(self, root_context, name: str, position, rpy_deg=(0.0, 0.0, 0.0)) -> None:
@@ -150,18 +160,26 @@ class LiveWorld:
     def SetRole(self, root_context, name: str, role: str) -> None:
         """Switches an object between "obstacle", "target" and "ghost"."""
         if role not in schema.OBJECT_ROLES:
-            raise ValueError(f"world object '{name}': unknown role '{role}'; roles are "
-                             + ", ".join(schema.OBJECT_ROLES))
+            raise ValueError(
+                f"world object '{name}': unknown role '{role}'; roles are "
+                + ", ".join(schema.OBJECT_ROLES)
+            )
         entry = self._Get(name)
         context = self._SceneGraphContext(root_context)
         geometry_id, old = entry[0], entry[3]
         if old == "obstacle" and role != "obstacle":
             self._scene_graph.RemoveRole(context, self._source_id, geometry_id, Role.kProximity)
         elif old != "obstacle" and role == "obstacle":
-            self._scene_graph.AssignRole(context, self._source_id, geometry_id,
-                                         _ProximityProperties())
-        self._scene_graph.AssignRole(context, self._source_id, geometry_id,
-                                     _IllustrationProperties(role), RoleAssign.kReplace)
+            self._scene_graph.AssignRole(
+                context, self._source_id, geometry_id, _ProximityProperties()
+            )
+        self._scene_graph.AssignRole(
+            context,
+            self._source_id,
+            geometry_id,
+            _IllustrationProperties(role),
+            RoleAssign.kReplace,
+        )
         entry[3] = role
 
     def Apply(self, root_context, event: schema.WorldEvent) -> None:
@@ -177,5 +195,8 @@ WORLD_EVENTS_PORT = "world_events"
 
 def SupervisorEventPorts(diagram) -> list:
     """The ``world_events`` output ports of the diagram's systems (see the module)."""
-    return [system.GetOutputPort(WORLD_EVENTS_PORT) for system in diagram.GetSystems()
-            if system.HasOutputPort(WORLD_EVENTS_PORT)]
+    return [
+        system.GetOutputPort(WORLD_EVENTS_PORT)
+        for system in diagram.GetSystems()
+        if system.HasOutputPort(WORLD_EVENTS_PORT)
+    ]

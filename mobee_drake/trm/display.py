@@ -13,20 +13,23 @@ def MarkerCloud(model: KinematicModel, roadmap: TaskRelevantRoadmap, marker: int
     return np.array([model.Evaluate(q).marker_positions[marker] for q in roadmap.q])
 
 
-def ShowRoadmap(meshcat: Meshcat, points: np.ndarray, roadmap: TaskRelevantRoadmap,
-                path: str = "trm") -> None:
+def ShowRoadmap(
+    meshcat: Meshcat, points: np.ndarray, roadmap: TaskRelevantRoadmap, path: str = "trm"
+) -> None:
     """Draws the vertices' marker positions as points and the edges as line segments."""
     cloud = PointCloud(len(points), Fields(BaseField.kXYZs))
     cloud.mutable_xyzs()[:] = points.T
     meshcat.SetObject(f"{path}/vertices", cloud, point_size=0.012, rgba=Rgba(0.1, 0.3, 0.9, 1))
     if len(roadmap.edges):
         a, b = roadmap.edges.T
-        meshcat.SetLineSegments(f"{path}/edges", points[a].T, points[b].T, 1.0,
-                                Rgba(0.4, 0.4, 0.4, 0.6))
+        meshcat.SetLineSegments(
+            f"{path}/edges", points[a].T, points[b].T, 1.0, Rgba(0.4, 0.4, 0.4, 0.6)
+        )
 
 
-def PathMotion(roadmap: TaskRelevantRoadmap, path: list[int], steps_per_edge: int = 10
-               ) -> np.ndarray:
+def PathMotion(
+    roadmap: TaskRelevantRoadmap, path: list[int], steps_per_edge: int = 10
+) -> np.ndarray:
     """Poses along ``path``, each edge interpolated linearly in joint space."""
     poses = [roadmap.q[path[0]]]
     for a, b in zip(path[:-1], path[1:]):

@@ -44,16 +44,23 @@ def OpenBox() -> list[SceneObject]:
     zc = (BOX_FLOOR + BOX_RIM) / 2
     outer = BOX_INSIDE + 2 * WALL
     return [
-        SceneObject(name="box_floor", shape=Box(size=[outer, outer, WALL]),
-                    position=[cx, cy, BOX_FLOOR - WALL / 2]),
-        SceneObject(name="box_front", shape=Box(size=[WALL, outer, height]),
-                    position=[cx - half, cy, zc]),
-        SceneObject(name="box_back", shape=Box(size=[WALL, outer, height]),
-                    position=[cx + half, cy, zc]),
-        SceneObject(name="box_left", shape=Box(size=[outer, WALL, height]),
-                    position=[cx, cy - half, zc]),
-        SceneObject(name="box_right", shape=Box(size=[outer, WALL, height]),
-                    position=[cx, cy + half, zc]),
+        SceneObject(
+            name="box_floor",
+            shape=Box(size=[outer, outer, WALL]),
+            position=[cx, cy, BOX_FLOOR - WALL / 2],
+        ),
+        SceneObject(
+            name="box_front", shape=Box(size=[WALL, outer, height]), position=[cx - half, cy, zc]
+        ),
+        SceneObject(
+            name="box_back", shape=Box(size=[WALL, outer, height]), position=[cx + half, cy, zc]
+        ),
+        SceneObject(
+            name="box_left", shape=Box(size=[outer, WALL, height]), position=[cx, cy - half, zc]
+        ),
+        SceneObject(
+            name="box_right", shape=Box(size=[outer, WALL, height]), position=[cx, cy + half, zc]
+        ),
     ]
 
 
@@ -70,8 +77,9 @@ class TrmExample:
 
 
 def _Home(model: KinematicModel) -> HomeCost:
-    return HomeCost(model.home, joints=np.array([model.JointIndex(j) for j in JOINTS]),
-                    weight=HOME_WEIGHT)
+    return HomeCost(
+        model.home, joints=np.array([model.JointIndex(j) for j in JOINTS]), weight=HOME_WEIGHT
+    )
 
 
 def ReachInto(meshcat: Meshcat | None = None) -> TrmExample:
@@ -83,21 +91,27 @@ def ReachInto(meshcat: Meshcat | None = None) -> TrmExample:
     upper = np.array([*(BOX_CENTRE + inside), BOX_RIM])
     terms = [_Home(model), CollisionCost(), MarkerInBox(palm, lower, upper, weight=10.0)]
     problem = IkProblem(model, terms, joints=JOINTS)
-    return TrmExample("reach_into", model, problem, TaskSpace((MarkerCoordinates(palm),)),
-                      model.home, palm)
+    return TrmExample(
+        "reach_into", model, problem, TaskSpace((MarkerCoordinates(palm),)), model.home, palm
+    )
 
 
 def RaiseAGlass(meshcat: Meshcat | None = None) -> TrmExample:
     model = KinematicModel(IcubConfig(), meshcat=meshcat)
     palm, hand = model.MarkerIndex("r_palm"), model.MarkerIndex("r_hand")
-    terms = [_Home(model), CollisionCost(),
-             MarkerOrientationCost(palm, np.array([0.0, -1.0, 0.0])),
-             MarkerOrientationCost(hand, np.array([-1.0, 0.0, 0.0])),
-             MarkerInBox(palm, np.array([-0.45, 0.0, -0.05]), np.array([-0.15, 0.35, 0.25]),
-                         weight=10.0)]
+    terms = [
+        _Home(model),
+        CollisionCost(),
+        MarkerOrientationCost(palm, np.array([0.0, -1.0, 0.0])),
+        MarkerOrientationCost(hand, np.array([-1.0, 0.0, 0.0])),
+        MarkerInBox(
+            palm, np.array([-0.45, 0.0, -0.05]), np.array([-0.15, 0.35, 0.25]), weight=10.0
+        ),
+    ]
     problem = IkProblem(model, terms, joints=JOINTS)
-    return TrmExample("raise_a_glass", model, problem, TaskSpace((MarkerCoordinates(palm),)),
-                      model.home, palm)
+    return TrmExample(
+        "raise_a_glass", model, problem, TaskSpace((MarkerCoordinates(palm),)), model.home, palm
+    )
 
 
 EXAMPLES = {"reach_into": ReachInto, "raise_a_glass": RaiseAGlass}

@@ -40,8 +40,9 @@ def FarthestPair(roadmap: TaskRelevantRoadmap) -> tuple[int, int]:
     return int(a), int(b)
 
 
-def Plot(points: np.ndarray, roadmap: TaskRelevantRoadmap, title: str, path: pathlib.Path,
-         boxes: bool) -> None:
+def Plot(
+    points: np.ndarray, roadmap: TaskRelevantRoadmap, title: str, path: pathlib.Path, boxes: bool
+) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -75,12 +76,18 @@ def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) ->
 
     meshcat = Meshcat()
     example = EXAMPLES[name](meshcat)
-    roadmap = BuildTrm(example.problem, example.task_space, example.q_init, config,
-                       np.random.default_rng(seed))
+    roadmap = BuildTrm(
+        example.problem, example.task_space, example.q_init, config, np.random.default_rng(seed)
+    )
     roadmap.Save(output / name)
     points = MarkerCloud(example.model, roadmap, example.marker)
-    Plot(points, roadmap, f"{name}: {roadmap.num_vertices} vertices", output / f"{name}.png",
-         boxes=name == "reach_into")
+    Plot(
+        points,
+        roadmap,
+        f"{name}: {roadmap.num_vertices} vertices",
+        output / f"{name}.png",
+        boxes=name == "reach_into",
+    )
     start, goal = FarthestPair(roadmap)
     path = roadmap.Path(start, goal)
     ShowRoadmap(meshcat, points, roadmap)
@@ -89,25 +96,29 @@ def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) ->
     colliding = EdgeCollisions(example, roadmap)
     seconds = roadmap.build_seconds
     extent = roadmap.y.max(axis=0) - roadmap.y.min(axis=0)
-    return "\n".join([
-        f"## {name}",
-        "",
-        f"- {roadmap.num_vertices} vertices, {len(roadmap.edges)} edges, "
-        f"{len(roadmap.simplices)} simplices in R; {roadmap.searches} NGIK searches "
-        f"({roadmap.searches - roadmap.num_vertices} rejected)",
-        f"- built in {seconds:.1f} s: {roadmap.num_vertices / seconds:.2f} vertices/s, "
-        f"{roadmap.searches / seconds:.2f} searches/s",
-        f"- task-space extent {np.round(extent, 3).tolist()} m; spacing d = {config.spacing} m",
-        f"- edges colliding along their interpolation ({EDGE_SAMPLES} samples): {colliding} of "
-        f"{len(roadmap.edges)}",
-        f"- path shown: {len(path)} vertices from {start} to {goal}",
-        f"- figure `{name}.png`, Meshcat recording `{name}.html`, roadmap `{name}/`",
-        ""])
+    return "\n".join(
+        [
+            f"## {name}",
+            "",
+            f"- {roadmap.num_vertices} vertices, {len(roadmap.edges)} edges, "
+            f"{len(roadmap.simplices)} simplices in R; {roadmap.searches} NGIK searches "
+            f"({roadmap.searches - roadmap.num_vertices} rejected)",
+            f"- built in {seconds:.1f} s: {roadmap.num_vertices / seconds:.2f} vertices/s, "
+            f"{roadmap.searches / seconds:.2f} searches/s",
+            f"- task-space extent {np.round(extent, 3).tolist()} m; spacing d = {config.spacing} m",
+            f"- edges colliding along their interpolation ({EDGE_SAMPLES} samples): {colliding} of "
+            f"{len(roadmap.edges)}",
+            f"- path shown: {len(path)} vertices from {start} to {goal}",
+            f"- figure `{name}.png`, Meshcat recording `{name}.html`, roadmap `{name}/`",
+            "",
+        ]
+    )
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(prog="mobee-drake experiment trm",
-                                     description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="mobee-drake experiment trm", description=__doc__.split("\n")[0]
+    )
     parser.add_argument("--output", required=True)
     parser.add_argument("--examples", nargs="+", choices=sorted(EXAMPLES), default=list(EXAMPLES))
     parser.add_argument("--max-vertices", type=int, default=TrmConfig.max_vertices)

@@ -43,8 +43,11 @@ class TrmConfig:
     spacing: float = 0.03  # d of eq. 3.6, in task-space units
     delta: float = 0.25  # decay of a vertex's expansion weight per failed search
     sigma: float = 0.15  # NES's initial spread around the expanding vertex (rad)
-    nes: NesConfig = dc.field(default_factory=lambda: NesConfig(
-        variant="snes", max_evaluations=800, target_cost=-1.0, tolerance=2e-3))
+    nes: NesConfig = dc.field(
+        default_factory=lambda: NesConfig(
+            variant="snes", max_evaluations=800, target_cost=-1.0, tolerance=2e-3
+        )
+    )
     max_vertices: int = 5000
 
     def __post_init__(self):
@@ -106,12 +109,27 @@ class TaskRelevantRoadmap:
 
     def Save(self, folder: str | pathlib.Path) -> None:
         """Writes ``roadmap.npz`` and ``roadmap.json`` into ``folder`` atomically."""
+
         def Write(staging: pathlib.Path) -> None:
-            np.savez(staging / "roadmap.npz", q=self.q, y=self.y, weights=self.weights,
-                     edges=self.edges, simplices=np.array(self.simplices, dtype=int))
-            (staging / "roadmap.json").write_text(json.dumps(
-                {"joints": self.joints, "build_seconds": self.build_seconds,
-                 "searches": self.searches}, indent=1))
+            np.savez(
+                staging / "roadmap.npz",
+                q=self.q,
+                y=self.y,
+                weights=self.weights,
+                edges=self.edges,
+                simplices=np.array(self.simplices, dtype=int),
+            )
+            (staging / "roadmap.json").write_text(
+                json.dumps(
+                    {
+                        "joints": self.joints,
+                        "build_seconds": self.build_seconds,
+                        "searches": self.searches,
+                    },
+                    indent=1,
+                )
+            )
+
         WriteFolderAtomically(pathlib.Path(folder), Write)
 
     @staticmethod
@@ -123,14 +141,26 @@ class TaskRelevantRoadmap:
         arrays = np.load(folder / "roadmap.npz")
         info = json.loads((folder / "roadmap.json").read_text())
         return TaskRelevantRoadmap(
-            joints=info["joints"], q=arrays["q"], y=arrays["y"], weights=arrays["weights"],
+            joints=info["joints"],
+            q=arrays["q"],
+            y=arrays["y"],
+            weights=arrays["weights"],
             edges=arrays["edges"].reshape(-1, 2),
             simplices=[tuple(s) for s in arrays["simplices"].tolist()],
-            build_seconds=info["build_seconds"], searches=info["searches"])
+            build_seconds=info["build_seconds"],
+            searches=info["searches"],
+        )
 
 
-def BuildTrm(problem: IkProblem, task_space: TaskSpace, q_init: np.ndarray, config: TrmConfig,
-             rng: np.random.Generator, *, progress=None) -> TaskRelevantRoadmap:
+def BuildTrm(
+    problem: IkProblem,
+    task_space: TaskSpace,
+    q_init: np.ndarray,
+    config: TrmConfig,
+    rng: np.random.Generator,
+    *,
+    progress=None,
+) -> TaskRelevantRoadmap:
     """Alg. 4: grows the roadmap of ``problem``'s poses over ``task_space`` from ``q_init``.
 
     ``progress(roadmap_size)``, if given, is called after each search.
@@ -146,8 +176,9 @@ def BuildTrm(problem: IkProblem, task_space: TaskSpace, q_init: np.ndarray, conf
     def Nearest(y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # Alg. 2
         """The (up to) n vertices nearest to y, nearest first, and their distances."""
         distances = np.linalg.norm(ys - y, axis=1)
-        nearest = (np.argpartition(distances, n)[:n] if len(distances) > n
-                   else np.arange(len(distances)))
+        nearest = (
+            np.argpartition(distances, n)[:n] if len(distances) > n else np.arange(len(distances))
+        )
         nearest = nearest[np.argsort(distances[nearest], kind="stable")]
         return nearest, distances[nearest]
 
@@ -164,8 +195,12 @@ def BuildTrm(problem: IkProblem, task_space: TaskSpace, q_init: np.ndarray, conf
         y = task_space(evaluation)
         neighbours, distances = Nearest(y)
         far_enough = not len(neighbours) or distances[0] >= config.spacing / 2
-        if (problem.IsSolved(evaluation) and not evaluation.collision_pairs and far_enough
-                and not region.Contains(y)):
+        if (
+            problem.IsSolved(evaluation)
+            and not evaluation.collision_pairs
+            and far_enough
+            and not region.Contains(y)
+        ):
             new = len(qs)
             qs.append(evaluation.q)
             ys = np.vstack([ys, y])
@@ -175,8 +210,10 @@ def BuildTrm(problem: IkProblem, task_space: TaskSpace, q_init: np.ndarray, conf
         elif expanding is not None:
             weights[expanding] = max(0.0, weights[expanding] - config.delta)
         else:
-            raise RuntimeError("TRM: NGIK found no valid first pose from q_init; the problem's "
-                               "terms cannot be met near it")
+            raise RuntimeError(
+                "TRM: NGIK found no valid first pose from q_init; the problem's "
+                "terms cannot be met near it"
+            )
         if progress is not None:
             progress(len(qs))
         w = np.asarray(weights)
@@ -185,7 +222,12 @@ def BuildTrm(problem: IkProblem, task_space: TaskSpace, q_init: np.ndarray, conf
         expanding = len(w) - 1 - int(np.argmax(w[::-1]))  # the newest of the heaviest
         start = qs[expanding]
     return TaskRelevantRoadmap(
-        joints=list(model.joints), q=np.asarray(qs), y=ys,
-        weights=np.asarray(weights), edges=np.asarray(edges, dtype=int).reshape(-1, 2),
-        simplices=list(region.simplices), build_seconds=time.perf_counter() - began,
-        searches=searches)
+        joints=list(model.joints),
+        q=np.asarray(qs),
+        y=ys,
+        weights=np.asarray(weights),
+        edges=np.asarray(edges, dtype=int).reshape(-1, 2),
+        simplices=list(region.simplices),
+        build_seconds=time.perf_counter() - began,
+        searches=searches,
+    )

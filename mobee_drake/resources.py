@@ -1,0 +1,64 @@
+"""Where the shipped models and scenarios are, in a source checkout and in an installed wheel.
+
+The repository keeps ``models/`` and ``diagrams/`` at its top level; the wheel ships them inside
+the package as ``mobee_drake.models`` and ``mobee_drake.diagrams`` (``pyproject.toml`` maps the
+folders), so both are found through :mod:`importlib.resources` wherever the package is installed.
+``models/package.xml`` names the models folder ``mobee_drake`` for Drake's
+:class:`~pydrake.multibody.parsing.PackageMap`: a model file is written
+``package://mobee_drake/katana.xml``; a plain relative name (``katana.xml``) means the same file.
+A scenario is a file path or the name of a shipped one (``reach_around_ball``).
+"""
+
+import functools
+import importlib.resources
+import pathlib
+
+from pydrake.multibody.parsing import PackageMap
+
+PACKAGE_NAME = "mobee_drake"
+_PACKAGE_URL = f"package://{PACKAGE_NAME}/"
+
+
+def ModelsDirectory() -> pathlib.Path:
+    """The folder of the shipped models (``models/`` in the repository)."""
+    return pathlib.Path(str(importlib.resources.files("mobee_drake.models")))
+
+
+def ScenariosDirectory() -> pathlib.Path:
+    """The folder of the shipped scenarios (``diagrams/`` in the repository)."""
+    return pathlib.Path(str(importlib.resources.files("mobee_drake.diagrams")))
+
+
+@functools.cache
+def MobeePackageMap() -> PackageMap:
+    """A package map that resolves ``package://mobee_drake/...``."""
+    package_map = PackageMap.MakeEmpty()
+    package_map.AddPackageXml(str(ModelsDirectory() / "package.xml"))
+    return package_map
+
+
+def ResolveModelFile(name: str | pathlib.Path) -> pathlib.Path:
+    """The file of a model: ``package://mobee_drake/...``, an absolute path, or a path relative
+    to the shipped models folder."""
+    text = str(name)
+    if text.startswith(_PACKAGE_URL):
+        return pathlib.Path(MobeePackageMap().ResolveUrl(text))
+    path = pathlib.Path(text)
+    return path if path.is_absolute() else ModelsDirectory() / path
+
+
+def ScenarioNames() -> list[str]:
+    """The names of the shipped scenarios."""
+    return sorted(p.stem for p in ScenariosDirectory().glob("*.yaml"))
+
+
+def ResolveScenarioFile(name: str | pathlib.Path) -> pathlib.Path:
+    """A scenario file: ``name`` if it is an existing file, else the shipped scenario of that name
+    (with or without ``.yaml``); an unknown name is returned as given, for the loader to report."""
+    path = pathlib.Path(name)
+    if path.is_file():
+        return path
+    shipped = ScenariosDirectory() / (path.stem + ".yaml")
+    if path.parent == pathlib.Path(".") and shipped.is_file():
+        return shipped
+    return path
