@@ -2,20 +2,40 @@
 
 import argparse
 import importlib
+import pathlib
 import sys
 
+import numpy as np
+from pydrake.geometry import Meshcat, StartMeshcat
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+from pydrake.systems.framework import DiagramBuilder
+
 from mobee_drake import __version__
+from mobee_drake.mobee.system import Mobee
+from mobee_drake.resources import ScenarioNames
+from mobee_drake.robots.icub import AddIcub, IcubConfig
+from mobee_drake.robots.model_cache import IcubModelNames
+from mobee_drake.scenario import BuildScenario, LoadScenario
+from mobee_drake.station.runner import RunStation
+
+
+def _Fail(message: str) -> None:
+    """Ends the command on a user's mistake: one line on stderr, exit code 2."""
+    print(f"error: {message}", file=sys.stderr)
+    sys.exit(2)
 
 
 def _Run(args: list[str]) -> None:
-    """Runs a scenario file and prints its summary."""
+    """Runs a scenario and prints its summary."""
     parser = argparse.ArgumentParser(
         prog="mobee-drake run",
-        description="Simulate a scenario (diagrams/*.yaml). Headless by default: the run is "
-        "recorded to results/<scenario>.html unless --record or --no-record says "
-        "otherwise; --meshcat serves the live view.",
+        description="Simulate a scenario: a file, or the name of a shipped one ("
+        + ", ".join(ScenarioNames())
+        + "). Headless by default: the run is recorded to results/<scenario>.html unless "
+        "--record or --no-record says otherwise; --meshcat serves the live view.",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
-    parser.add_argument("scenario", help="a scenario file, e.g. diagrams/reach_around_ball.yaml")
+    parser.add_argument("scenario", help="a scenario file or a shipped scenario's name")
     parser.add_argument("--duration", type=float, help="seconds to simulate (default: the file's)")
     parser.add_argument("--record", help="save a replayable Meshcat recording to this HTML file")
     parser.add_argument("--no-record", action="store_true", help="do not save a recording")
@@ -26,7 +46,11 @@ def _Run(args: list[str]) -> None:
         "--no-meshcat", action="store_true", help="no viewer at all (fastest; implies --no-record)"
     )
     parser.add_argument(
-        "--set", default=None, help="YAML overrides of the scenario, e.g. '{robot_model: dynamic}'"
+        "--set",
+        action="append",
+        default=[],
+        help="YAML overrides of the scenario, applied in order, e.g. "
+        "'{mover: !Dynamic {control: force}}'",
     )
     parser.add_argument(
         "--checkpoint",
@@ -34,20 +58,12 @@ def _Run(args: list[str]) -> None:
         help="a folder: resume from the checkpoint there, and save one after "
         "every completed action of the exploring agents",
     )
+    parser.add_argument("--graphviz", help="write the diagram's Graphviz (dot) text to this file")
     known = parser.parse_args(args)
 
-    import pathlib
-
-    from mobee_drake.simulation.runner import RunScenario
-    from mobee_drake.simulation.scenario import LoadScenario
-    from mobee_drake.yaml_io import YamlFileError
-
-    try:
-        scenario = LoadScenario(known.scenario, known.set)
-    except (YamlFileError, ValueError) as e:
-        sys.exit(f"error: {e}")
+    overrides = list(known.set)
     if known.duration is not None:
-        scenario.duration = known.duration
+        overrides.append(f"{{duration: {known.duration}}}")
     record = None
     if not (known.no_record or known.no_meshcat):
         record = known.record or str(
@@ -55,20 +71,26 @@ def _Run(args: list[str]) -> None:
         )
     meshcat = None
     if known.meshcat and not known.no_meshcat:
-        from pydrake.geometry import StartMeshcat
-
         meshcat = StartMeshcat()
+    elif record:
+        meshcat = Meshcat()
+    # A user's mistakes surface while the scenario is read and built; the run's own errors are
+    # bugs, and keep their traceback.
     try:
-        summary = RunScenario(
-            scenario,
-            meshcat=meshcat,
-            record=record,
-            realtime_rate=1.0 if meshcat else 0.0,
-            progress=True,
-            checkpoint=known.checkpoint,
-        )
-    except ValueError as e:
-        sys.exit(f"error: {known.scenario}: {e}")
+        scenario = LoadScenario(known.scenario, overrides)
+        station = BuildScenario(scenario, meshcat)
+    except ValueError as e:  # YamlFileError included
+        _Fail(str(e))
+    if known.graphviz:
+        pathlib.Path(known.graphviz).write_text(station.diagram.GetGraphvizString())
+    summary = RunStation(
+        station,
+        scenario.duration,
+        record=record,
+        realtime_rate=1.0 if known.meshcat and not known.no_meshcat else 0.0,
+        progress=True,
+        checkpoint=known.checkpoint,
+    )
     print(summary.Format())
 
 
@@ -87,10 +109,10 @@ def _Bench(args: list[str]) -> None:
         "mobee-drake bench",
         args,
         {
-            "babbling": "mobee_drake.bench.babbling",
-            "forces": "mobee_drake.bench.forces",
-            "ik": "mobee_drake.bench.ik",
-            "simulation": "mobee_drake.bench.simulation",
+            "babbling": "mobee_drake.experiments.bench_babbling",
+            "forces": "mobee_drake.experiments.bench_forces",
+            "ik": "mobee_drake.experiments.bench_ik",
+            "simulation": "mobee_drake.experiments.bench_simulation",
         },
     )
 
@@ -104,11 +126,11 @@ def _Experiment(args: list[str]) -> None:
         "mobee-drake experiment",
         args,
         {
-            "ch7": "mobee_drake.planning.experiments",
-            "ch8": "mobee_drake.reaching.experiments",
-            "saggriac": "mobee_drake.goal_babbling.experiments",
-            "roadmaps": "mobee_drake.reflex.demos",
-            "trm": "mobee_drake.trm.experiments",
+            "ch7": "mobee_drake.experiments.ch7_model_learning",
+            "ch8": "mobee_drake.experiments.ch8_reaching",
+            "saggriac": "mobee_drake.experiments.saggriac",
+            "roadmaps": "mobee_drake.experiments.ch4_roadmaps",
+            "trm": "mobee_drake.experiments.trm_roadmaps",
         },
     )
 
@@ -118,14 +140,6 @@ def _Info(args: list[str]) -> None:
     parser = argparse.ArgumentParser(prog="mobee-drake info")
     parser.add_argument("--model", default=None, help="an icub-models robot name")
     known = parser.parse_args(args)
-
-    from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-    from pydrake.systems.framework import DiagramBuilder
-
-    from mobee_drake.mobee.system import Mobee
-    from mobee_drake.robots.icub import AddIcub, IcubConfig
-    from mobee_drake.robots.model_cache import IcubModelNames
-
     config = IcubConfig() if known.model is None else IcubConfig(model=known.model)
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
@@ -135,8 +149,6 @@ def _Info(args: list[str]) -> None:
     print(f"model: {config.model} (available: {', '.join(IcubModelNames())})")
     print(f"bodies: {plant.num_bodies()}, controlled joints: {len(mobee.joints)}")
     lower, upper = mobee.position_limits
-    import numpy as np
-
     for name, lo, hi, home in zip(
         mobee.joints, np.degrees(lower), np.degrees(upper), np.degrees(mobee.home)
     ):

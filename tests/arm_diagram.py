@@ -10,8 +10,8 @@ from pydrake.systems.framework import DiagramBuilder
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.assembly import AddRobotWithOverlay
-from mobee_drake.simulation.scenario import Box, SceneObject
-from mobee_drake.simulation.world import LiveWorld
+from mobee_drake.world.live_world import LiveWorld
+from mobee_drake.world.objects import Box, SceneObject
 
 MODELS = pathlib.Path(__file__).parent / "models"
 JOINTS = ["joint1", "joint2", "joint3"]

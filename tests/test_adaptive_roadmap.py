@@ -4,14 +4,12 @@ import unittest
 
 import numpy as np
 
-from mobee_drake.reflex.adaptive_roadmap import (
-    FEASIBLE,
-    INFEASIBLE,
-    UNTRIED,
+from mobee_drake.experiments.ch4_roadmaps import A, AdaptiveReplanning, B, D, E, RoadmapFromScratch
+from mobee_drake.roadmaps.adaptive_roadmap import (
     AdaptiveRoadmap,
+    EdgeStatus,
     ExploreRoadmap,
 )
-from mobee_drake.reflex.demos import A, AdaptiveReplanning, B, D, E, RoadmapFromScratch
 
 # Four poses on a line and one off it: 0 - 1 - 2 - 3, and 4 near 1.
 POSES = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0], [1.0, 0.5]])
@@ -38,7 +36,7 @@ class AdaptiveRoadmapTest(unittest.TestCase):
         roadmap = AdaptiveRoadmap.KNearest(POSES, 1)
         pairs = {tuple(e) for e in roadmap.edges.tolist()}
         self.assertEqual(pairs, {(0, 1), (1, 0), (1, 4), (4, 1), (2, 1), (1, 2), (3, 2), (2, 3)})
-        np.testing.assert_array_equal(roadmap.status, UNTRIED)
+        np.testing.assert_array_equal(roadmap.status, EdgeStatus.UNTRIED)
 
     def test_plans_around_infeasible_edges(self):
         roadmap = AdaptiveRoadmap(POSES, [(0, 1), (1, 2), (0, 4), (4, 2), (2, 3)])
@@ -62,9 +60,11 @@ class AdaptiveRoadmapTest(unittest.TestCase):
         reachable = roadmap.Reachable(0)
         for (a, b), status in zip(roadmap.edges.tolist(), roadmap.status):
             if reachable[a]:
-                self.assertEqual(status, INFEASIBLE if (a, b) in blocked else FEASIBLE)
+                self.assertEqual(
+                    status, EdgeStatus.INFEASIBLE if (a, b) in blocked else EdgeStatus.FEASIBLE
+                )
             else:
-                self.assertEqual(status, UNTRIED)
+                self.assertEqual(status, EdgeStatus.UNTRIED)
         self.assertEqual(record.reflexes, sum(c in blocked for c in robot.commands))
         self.assertEqual(record.commands, len(robot.commands))
         # Each edge was tried once, and travel used known feasible edges only.
@@ -88,7 +88,9 @@ class IcubDemosTest(unittest.TestCase):
         self.assertEqual(result.vertices, 7)
         self.assertEqual(result.feasible + result.infeasible + result.untried, result.edges)
         reachable = roadmap.Reachable(0)
-        self.assertFalse(np.any((roadmap.status == UNTRIED) & reachable[roadmap.edges[:, 0]]))
+        self.assertFalse(
+            np.any((roadmap.status == EdgeStatus.UNTRIED) & reachable[roadmap.edges[:, 0]])
+        )
         self.assertEqual(result.reflexes, result.infeasible)
         self.assertGreater(result.feasible, 0)
 

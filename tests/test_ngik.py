@@ -19,7 +19,7 @@ from mobee_drake.ngik.nes import DefaultPopulation, Minimize, NesConfig, Utiliti
 from mobee_drake.ngik.solver import IkProblem, SolveNgik
 from mobee_drake.robots.icub import RIGHT_ARM_JOINTS, TORSO_JOINTS, IcubConfig
 from mobee_drake.robots.overlay import Clause, Literal
-from mobee_drake.simulation.scenario import Box, SceneObject, Sphere
+from mobee_drake.world.objects import Box, SceneObject, Sphere
 
 
 class NesTest(unittest.TestCase):

@@ -1,5 +1,6 @@
 """The curious MDP planner's core against the dissertation's tables and closed forms."""
 
+import json
 import unittest
 
 import numpy as np
@@ -7,6 +8,7 @@ import numpy as np
 from mobee_drake.planning.curiosity import KlDivergence, TransitionCounts
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig
 from mobee_drake.planning.state_space import FromSamples, Lattice
+from mobee_drake.planning.strategies import STRATEGIES, RegisterStrategy
 from mobee_drake.planning.value_iteration import ValueIteration
 
 
@@ -126,7 +128,7 @@ class TestExplorers(unittest.TestCase):
     def _Explore(self, strategy, steps, seed=0, fail=()):
         """Explores the hypercube in a world where the state-actions in ``fail`` stay put."""
         space = Lattice([0.25, 0.75], 4)
-        agent = Explorer(space, ExplorerConfig(strategy=strategy, seed=seed))
+        agent = Explorer(space, ExplorerConfig(strategy=strategy), seed)
         state, first_tried = 0, {}
         for step in range(steps):
             sa = agent.ChooseAction(state)
@@ -153,6 +155,26 @@ class TestExplorers(unittest.TestCase):
         agent, _ = self._Explore("random", 50)
         self.assertEqual(agent.tries.sum(), 50)
 
+    def test_a_strategy_of_ones_own(self):
+        class HighestGoal:
+            """Always the action to the state of the highest index."""
+
+            def Scores(self, explorer, actions):
+                return explorer.space.action_goal[actions].astype(float)
+
+        RegisterStrategy("highest_goal", HighestGoal())
+        self.addCleanup(STRATEGIES.pop, "highest_goal")
+        space = Lattice([0.25, 0.75], 3)
+        agent, state = Explorer(space, ExplorerConfig(strategy="highest_goal")), 0
+        for _ in range(5):
+            action = agent.ChooseAction(state)
+            self.assertEqual(
+                space.action_goal[action], space.action_goal[space.Actions(state)].max()
+            )
+            state = int(space.action_goal[action])
+        with self.assertRaisesRegex(ValueError, "named 'random' exists already"):
+            RegisterStrategy("random", HighestGoal())
+
     def test_bad_configuration(self):
         space = Lattice([0.25, 0.75], 2)
         with self.assertRaisesRegex(ValueError, "unknown strategy 'bold'"):
@@ -168,7 +190,7 @@ class TestPlanner(unittest.TestCase):
         # A 3 x 3 lattice (states 0..8, row-major in the first coordinate); the direct step from
         # the middle-left state 3 to the centre 4 was always seen to fail (e.g. an obstacle).
         space = Lattice([0.0, 0.5, 1.0], 2)
-        agent = Explorer(space, ExplorerConfig(seed=0))
+        agent = Explorer(space, ExplorerConfig())
         for sa, (s, g) in enumerate(zip(space.action_state, space.action_goal)):
             blocked = (s, g) == (3, 4)
             for _ in range(10):
@@ -303,14 +325,18 @@ class TestExperimentsSmoke(unittest.TestCase):
         import pathlib
         import tempfile
 
-        from mobee_drake.planning import experiments
+        from mobee_drake.experiments import ch7_model_learning as experiments
 
         output = pathlib.Path(tempfile.mkdtemp())
         experiments.main(
             ["--experiment", "7.2", "--output", str(output), "--runs", "1", "--transitions", "3"]
         )
         for strategy in ("curious", "random", "least_tried"):
-            self.assertTrue((output / f"7.2_{strategy}_run0.json").is_file())
+            result = json.loads(
+                (output / "runs" / f"7.2_{strategy}_run0" / "result.json").read_text()
+            )
+            self.assertEqual(result["strategy"], strategy)
+            self.assertGreaterEqual(result["actions"][0], 3)  # the run's stop condition
         self.assertTrue((output / "7.2_coverage.png").is_file())
         experiments.main(["--experiment", "7.3", "--output", str(output), "--transitions", "2"])
         report = (output / "report_7.3.md").read_text()
@@ -327,7 +353,7 @@ class TestExperimentsSmoke(unittest.TestCase):
         self.assertIn("| moving_box |", (output / "report_7.4.1.md").read_text())
 
     def test_detour_problems(self):
-        from mobee_drake.planning import experiments
+        from mobee_drake.experiments import ch7_model_learning as experiments
 
         # The square 0-1-3-2 (equidistant neighbours): with 0->1 unreliable, 0 -> 3 (over 1 or 2)
         # and 2 -> 1 (over 0 or 3) have one risky and one safe shortest route; 3 -> 0 and 1 -> 2
@@ -336,8 +362,8 @@ class TestExperimentsSmoke(unittest.TestCase):
         unreliable = np.array(
             [(s, g) == (0, 1) for s, g in zip(space.action_state, space.action_goal)]
         )
-        self.assertEqual(experiments._DetourProblems(space, unreliable), [(0, 3), (2, 1)])
-        self.assertEqual(experiments._DetourProblems(space, np.zeros_like(unreliable)), [])
+        self.assertEqual(experiments.DetourProblems(space, unreliable), [(0, 3), (2, 1)])
+        self.assertEqual(experiments.DetourProblems(space, np.zeros_like(unreliable)), [])
 
 
 if __name__ == "__main__":

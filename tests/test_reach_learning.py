@@ -12,7 +12,7 @@ from pydrake.systems.analysis import Simulator
 
 from mobee_drake.mobee.fields import FieldPairs
 from mobee_drake.planning.supervisor import ActionTiming
-from mobee_drake.reaching.executor import Phase, ReachForcing, StateActionExecutor
+from mobee_drake.station.executor import Phase, ReachForcing, StateActionExecutor
 
 
 class TestStateActionExecutor(unittest.TestCase):
@@ -158,7 +158,7 @@ class TestBattery(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        from mobee_drake.reaching.experiments import RunSettings, TrainMdp
+        from mobee_drake.experiments.ch8_reaching import RunSettings, TrainMdp
 
         cls.folder = tempfile.TemporaryDirectory()
         cls.output = pathlib.Path(cls.folder.name)
@@ -171,18 +171,17 @@ class TestBattery(unittest.TestCase):
         cls.folder.cleanup()
 
     def Run(self, name, settings):
-        from mobee_drake.reaching.experiments import RunOne
+        from mobee_drake.experiments.ch8_reaching import RunOne
 
         return RunOne(self.output / name, self.mdp, settings)
 
     def test_watch_in_meshcat(self):
         from pydrake.geometry import Meshcat
 
-        from mobee_drake.reaching.experiments import RIGHT_ARM, ReachScenario
-        from mobee_drake.reaching.robot import SimulatedRobot
+        from mobee_drake.experiments.ch8_reaching import ReachRobot
 
         meshcat = Meshcat()
-        robot = SimulatedRobot(ReachScenario(), RIGHT_ARM, self.model.space, 0.05, meshcat=meshcat)
+        robot = ReachRobot(self.model.space, 0.05, meshcat=meshcat)
         robot.simulator.set_target_realtime_rate(0.0)  # the test need not wait
         robot.SetProblem(np.array([-0.23, 0.22, 0.19]))
         state = robot.State()
@@ -190,11 +189,10 @@ class TestBattery(unittest.TestCase):
         self.assertTrue(meshcat.HasPath("/drake/illustration"))
 
     def test_fields_feel_the_target_in_the_way(self):
-        from mobee_drake.reaching.experiments import RIGHT_ARM, ReachScenario
-        from mobee_drake.reaching.robot import SimulatedRobot
+        from mobee_drake.experiments.ch8_reaching import ReachRobot
 
         space = self.model.space
-        robot = SimulatedRobot(ReachScenario(), RIGHT_ARM, space, 0.05)
+        robot = ReachRobot(space, 0.05)
         start = robot.State()
         goal = int(space.action_goal[space.Actions(start)[0]])
         robot.SetProblem(np.array([1.0, 1.0, 1.0]))  # far away
@@ -207,24 +205,23 @@ class TestBattery(unittest.TestCase):
         self.assertTrue(robot.FeltObject())
 
     def test_weaker_reach_stops_farther(self):
-        from mobee_drake.reaching.experiments import RIGHT_ARM, ReachScenario
-        from mobee_drake.reaching.robot import SimulatedRobot
+        from mobee_drake.experiments.ch8_reaching import ReachRobot
 
         target = np.array([-0.23, 0.22, 0.19])
         misses = {}
         for force in (300.0, 30.0):
-            robot = SimulatedRobot(ReachScenario(force), RIGHT_ARM, self.model.space, 0.05)
+            robot = ReachRobot(self.model.space, 0.05, force)
             robot.SetProblem(target)
             misses[force] = np.linalg.norm(robot.Reach(target) - target)
         # MoBeE's attractor spring holds a weaker push back farther from the target.
         self.assertGreater(misses[30.0], misses[300.0] + 0.02)
         with self.assertRaisesRegex(ValueError, "force and softening must be > 0"):
-            SimulatedRobot(ReachScenario(-1.0), RIGHT_ARM, self.model.space, 0.05)
+            ReachRobot(self.model.space, 0.05, -1.0)
 
     def test_mdp_learned_with_the_reaches(self):
+        from mobee_drake.experiments.ch8_reaching import LEVELS, RIGHT_ARM
         from mobee_drake.planning.explorers import Explorer
         from mobee_drake.planning.state_space import Lattice
-        from mobee_drake.reaching.experiments import LEVELS, RIGHT_ARM
 
         np.testing.assert_array_equal(
             Lattice(LEVELS, len(RIGHT_ARM)).action_goal, self.model.space.action_goal
@@ -250,7 +247,7 @@ class TestBattery(unittest.TestCase):
         self.assertGreaterEqual(self.model.tries.min(), 1)
 
     def test_reduced_battery(self):
-        from mobee_drake.reaching.learner import STRATEGIES
+        from mobee_drake.reaching.strategies import REACH_STRATEGIES as STRATEGIES
         from mobee_drake.reaching.targets import LoadTargetGrid
 
         results = [self.Run(s, self.Settings(s, 0, 12, [0, 12], 1, 5)) for s in STRATEGIES]
@@ -281,7 +278,7 @@ class TestBattery(unittest.TestCase):
                 self.assertEqual(sorted(t["problem"] for t in evaluation[0]), list(range(27)))
         # Fresh learners evaluate alike (same start, same greedy ties from the same seed).
         self.assertEqual(len({json.dumps(r["evaluations"]["0"]) for r in results}), 1)
-        from mobee_drake.reaching.experiments import Report
+        from mobee_drake.experiments.ch8_reaching import Report
 
         report = Report(self.output, results)
         self.assertIn("| intrinsic |", report)
@@ -307,11 +304,13 @@ class TestBattery(unittest.TestCase):
                 raise KeyboardInterrupt
             return explore(learner, robot)
 
+        from mobee_drake.experiments.ch8_reaching import RunOne
+
+        checkpoints = []
         with mock.patch.object(ReachLearner, "Explore", Dying):
             with self.assertRaises(KeyboardInterrupt):
-                self.Run("killed", settings)
-        saved = json.loads((self.output / "killed" / "progress.json").read_text())
-        self.assertEqual(saved["problem_tries"], 6)
+                RunOne(self.output / "killed", self.mdp, settings, progress=checkpoints.append)
+        self.assertEqual(checkpoints[-1], 6)
         resumed = self.Run("killed", settings)
         self.assertEqual(resumed["log"], whole["log"])
         self.assertEqual(resumed["evaluations"], whole["evaluations"])

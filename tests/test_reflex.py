@@ -9,17 +9,7 @@ from pydrake.systems.analysis import Simulator
 
 from mobee_drake.mobee.constraints import ClauseSet
 from mobee_drake.mobee.fields import NO_FIELD_PAIRS, FieldPairs
-from mobee_drake.reflex.controller import (
-    COMMANDS,
-    COMPLETED,
-    HOLDING,
-    MODE,
-    REFLEXES,
-    STUCK,
-    STUCK_COUNT,
-    ReflexController,
-    ReflexParams,
-)
+from mobee_drake.mobee.reflex import Mode, ReflexController, ReflexParams, Status
 from mobee_drake.robots.overlay import Clause, Literal
 
 H = 0.02
@@ -69,8 +59,13 @@ class ReflexControllerTest(unittest.TestCase):
         np.testing.assert_allclose(self.Q(controller, context), command, atol=1e-12)
         status = self.Status(controller, context)
         self.assertEqual(
-            (status[MODE], status[COMMANDS], status[COMPLETED], status[REFLEXES]),
-            (HOLDING, 1, 1, 0),
+            (
+                status[Status.MODE],
+                status[Status.COMMANDS],
+                status[Status.COMPLETED],
+                status[Status.REFLEXES],
+            ),
+            (Mode.HOLDING, 1, 1, 0),
         )
 
     def test_the_reflex_retraces_the_move_back_to_its_waypoint(self):
@@ -96,12 +91,14 @@ class ReflexControllerTest(unittest.TestCase):
         expected = path[-2::-1] + [first]
         np.testing.assert_allclose(np.array(back[: len(expected)]), np.array(expected), atol=1e-12)
         status = self.Status(controller, context)
-        self.assertEqual((status[COMMANDS], status[COMPLETED], status[REFLEXES]), (2, 1, 1))
+        self.assertEqual(
+            (status[Status.COMMANDS], status[Status.COMPLETED], status[Status.REFLEXES]), (2, 1, 1)
+        )
         # Trouble gone: the suppressed command now runs.
         controller.GetInputPort("field_pairs").FixValue(context, AbstractValue.Make(NO_FIELD_PAIRS))
         simulator.AdvanceTo(3.0)
         np.testing.assert_allclose(self.Q(controller, context), np.zeros(2), atol=1e-12)
-        self.assertEqual(self.Status(controller, context)[COMMANDS], 3)
+        self.assertEqual(self.Status(controller, context)[Status.COMMANDS], 3)
 
     def test_a_short_history_gets_stuck(self):
         controller, simulator, context = self.Make(history=3)
@@ -110,7 +107,7 @@ class ReflexControllerTest(unittest.TestCase):
         controller.GetInputPort("field_pairs").FixValue(context, AbstractValue.Make(ONE_PAIR))
         simulator.AdvanceTo(20 * H)
         status = self.Status(controller, context)
-        self.assertEqual((status[MODE], status[STUCK_COUNT]), (STUCK, 1))
+        self.assertEqual((status[Status.MODE], status[Status.STUCK_COUNT]), (Mode.STUCK, 1))
         # Ten moves of 0.2 deg (the updates at 0 ... 9 H), then back as far as the history
         # allowed (two poses before the current one), and it stays there.
         np.testing.assert_allclose(
@@ -124,7 +121,10 @@ class ReflexControllerTest(unittest.TestCase):
         controller.GetInputPort("command").FixValue(context, np.radians([0.0, 3.0]))
         simulator.AdvanceTo(1.0)
         status = self.Status(controller, context)
-        self.assertEqual((status[MODE], status[REFLEXES], status[COMPLETED]), (HOLDING, 1, 0))
+        self.assertEqual(
+            (status[Status.MODE], status[Status.REFLEXES], status[Status.COMPLETED]),
+            (Mode.HOLDING, 1, 0),
+        )
         np.testing.assert_allclose(self.Q(controller, context), np.zeros(2), atol=1e-12)
 
 

@@ -6,19 +6,22 @@ import unittest
 
 import numpy as np
 from pydrake.common.value import AbstractValue
-from pydrake.systems.analysis import InitializeParams, Simulator
+from pydrake.systems.analysis import InitializeParams
 from pydrake.systems.framework import LeafSystem
 
 from mobee_drake import cli
 from mobee_drake.mobee.fields import FieldPairs
 from mobee_drake.planning.state_space import Lattice
-from mobee_drake.simulation.attractors import RandomAttractorSource
-from mobee_drake.simulation.builder import BuildSimulation
-from mobee_drake.simulation.checkpoint import LoadCheckpoint, SaveCheckpoint
-from mobee_drake.simulation.runner import Advance, RunScenario
-from mobee_drake.simulation.safety import SafetyMonitor
-from mobee_drake.simulation.scenario import LoadScenario, SceneObject, Sphere, WorldEvent
-from mobee_drake.simulation.virtual_dynamics import VirtualDynamics
+from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario
+from mobee_drake.station.attractors import RandomAttractorSource
+from mobee_drake.station.builder import MakeMobeeStation
+from mobee_drake.station.checkpoint import LoadCheckpoint, SaveCheckpoint
+from mobee_drake.station.config import Dynamic
+from mobee_drake.station.runner import Advance
+from mobee_drake.station.safety import SafetyMonitor
+from mobee_drake.station.virtual_dynamics import VirtualDynamics
+from mobee_drake.station.world_events import MakeSimulator
+from mobee_drake.world.objects import SceneObject, Sphere, WorldEvent
 from mobee_drake.yaml_io import YamlFileError
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[1] / "diagrams"
@@ -37,18 +40,18 @@ def _Palm(simulation, context):
 
 def _RunAgents(scenario):
     """Runs an exploring scenario for its duration; returns it and its agents' records."""
-    simulation = BuildSimulation(scenario)
-    simulator = Simulator(simulation.diagram)
+    simulation = BuildScenario(scenario)
+    simulator = MakeSimulator(simulation)
     simulator.Initialize()
     simulator.AdvanceTo(scenario.duration)
-    supervisor = simulation.diagram.GetSubsystemByName("attractor")
+    supervisor = simulation.client
     records = supervisor.Records(supervisor.GetMyContextFromRoot(simulator.get_context()))
     return simulation, simulator, supervisor, records
 
 
 def _Trajectory(scenario, times):
-    simulation = BuildSimulation(scenario)
-    simulator = Simulator(simulation.diagram)
+    simulation = BuildScenario(scenario)
+    simulator = MakeSimulator(simulation)
     simulator.Initialize()
     palms, states = [], []
     for t in times:
@@ -71,7 +74,7 @@ class TestScenarioFiles(unittest.TestCase):
         return path
 
     def test_unknown_key_names_file_and_line(self):
-        path = self._Write("robot_model: kinematic\nduraton: 3\n")
+        path = self._Write("mover: !Kinematic {}\nduraton: 3\n")
         with self.assertRaisesRegex(YamlFileError, f"{path}:2: .*'duraton'"):
             LoadScenario(path)
 
@@ -79,8 +82,11 @@ class TestScenarioFiles(unittest.TestCase):
         path = self._Write("duration: long\n")
         with self.assertRaisesRegex(YamlFileError, f"{path}:1: .*'long'"):
             LoadScenario(path)
-        path = self._Write("robot_model: quantum\n")
-        with self.assertRaisesRegex(YamlFileError, "robot_model must be one of .* 'quantum'"):
+        path = self._Write("mover: !Dynamic {control: quantum}\n")
+        with self.assertRaisesRegex(YamlFileError, "control must be one of .* 'quantum'"):
+            LoadScenario(path)
+        path = self._Write("mover: !Quantum {}\n")
+        with self.assertRaisesRegex(YamlFileError, f"{path}:1: .*Quantum"):
             LoadScenario(path)
 
     def test_missing_file(self):
@@ -90,19 +96,20 @@ class TestScenarioFiles(unittest.TestCase):
     def test_unknown_model_joint_and_object(self):
         path = self._Write("robot: {model: iCubMars}\n")
         with self.assertRaisesRegex(ValueError, "unknown iCub model 'iCubMars'"):
-            BuildSimulation(LoadScenario(path))
+            BuildScenario(LoadScenario(path))
         path = self._Write("attractor: !FixedAttractor {joints_deg: {r_knee: 10}}\n")
         with self.assertRaisesRegex(ValueError, "unknown joint 'r_knee'"):
-            BuildSimulation(LoadScenario(path))
+            BuildScenario(LoadScenario(path))
         path = self._Write("objects: [{name: a}]\nworld_events: [{time: 1, object: b}]\n")
         with self.assertRaisesRegex(YamlFileError, "unknown object 'b'"):
             LoadScenario(path)
 
     def test_overrides(self):
-        scenario = LoadScenario(REACH, "{robot_model: dynamic, control: force}")
-        self.assertEqual((scenario.robot_model, scenario.control), ("dynamic", "force"))
+        scenario = LoadScenario(REACH, "{mover: !Dynamic {control: force}}")
+        self.assertIsInstance(scenario.mover, Dynamic)
+        self.assertEqual(scenario.mover.control, "force")
         with self.assertRaisesRegex(YamlFileError, "overrides"):
-            LoadScenario(REACH, "{robot_mdl: dynamic}")
+            LoadScenario(REACH, "{mver: !Dynamic {}}")
 
 
 class TestVirtualDynamics(unittest.TestCase):
@@ -260,8 +267,8 @@ class TestClientForces(unittest.TestCase):
 
         scenario = LoadScenario(REACH, "{objects: [], duration: 2}")
         meshcat = Meshcat()
-        simulation = BuildSimulation(scenario, meshcat)
-        simulator = Simulator(simulation.diagram)
+        simulation = BuildScenario(scenario, meshcat)
+        simulator = MakeSimulator(simulation)
         context = simulator.get_mutable_context()
         forces = np.zeros(3 * len(simulation.mobee.marker_names))
         i = simulation.mobee.marker_index("r_palm")
@@ -289,7 +296,7 @@ class TestDynamicRobot(unittest.TestCase):
         _, _, cls.kinematic_palms, cls.kinematic = _Trajectory(LoadScenario(REACH), cls.times)
 
     def _Check(self, control, tolerance_deg):
-        scenario = LoadScenario(REACH, f"{{robot_model: dynamic, control: {control}}}")
+        scenario = LoadScenario(REACH, f"{{mover: !Dynamic {{control: {control}}}}}")
         simulation, simulator, palms, states = _Trajectory(scenario, self.times)
         n = states.shape[1] // 2
         error = np.degrees(np.abs(states[:, :n] - self.kinematic[:, :n])).max()
@@ -313,8 +320,8 @@ class TestDynamicRobot(unittest.TestCase):
 class TestLiveWorld(unittest.TestCase):
     def test_roles_moves_additions_and_removals(self):
         scenario = LoadScenario(REACH, "{duration: 2}")
-        simulation = BuildSimulation(scenario)
-        simulator = Simulator(simulation.diagram)
+        simulation = BuildScenario(scenario)
+        simulator = MakeSimulator(simulation)
         simulator.Initialize()
         context = simulator.get_mutable_context()
         mobee_context = simulation.mobee.GetMyContextFromRoot(context)
@@ -327,7 +334,7 @@ class TestLiveWorld(unittest.TestCase):
         simulator.AdvanceTo(1.0)
         self.assertIn("ball", Touching())
         world.SetRole(context, "ball", "ghost")
-        self.assertEqual(world.role("ball"), "ghost")
+        self.assertEqual(world.Role(context, "ball"), "ghost")
         self.assertNotIn("ball", Touching())
         world.SetRole(context, "ball", "target")
         self.assertNotIn("ball", Touching())
@@ -338,7 +345,7 @@ class TestLiveWorld(unittest.TestCase):
         self.assertNotIn("ball", Touching())
         world.Move(context, "ball", palm)  # Right on the palm: deep inside the hand's field.
         self.assertIn("ball", Touching())
-        self.assertEqual(world.role("ball"), "obstacle")
+        self.assertEqual(world.Role(context, "ball"), "obstacle")
         world.Move(context, "ball", [-0.6, 0.0, 0.3])
         palm = _Palm(simulation, context)
         world.Add(
@@ -367,13 +374,14 @@ class TestLiveWorld(unittest.TestCase):
         scenario = LoadScenario(
             REACH, "{duration: 3, world_events: [{time: 0.1, object: ball, role: ghost}]}"
         )
-        simulation = BuildSimulation(scenario)
-        simulator = Simulator(simulation.diagram)
+        simulation = BuildScenario(scenario)
+        simulator = MakeSimulator(simulation)
         simulator.Initialize()
+        context = simulator.get_context()
         Advance(simulation, simulator, 0.05)
-        self.assertEqual(simulation.world.role("ball"), "obstacle")
+        self.assertEqual(simulation.world.Role(context, "ball"), "obstacle")
         Advance(simulation, simulator, 3.0)
-        self.assertEqual(simulation.world.role("ball"), "ghost")
+        self.assertEqual(simulation.world.Role(context, "ball"), "ghost")
         # The hand was still outside the ball's field at 0.1 s; from then on MoBeE ignores the
         # ball, so the motion is exactly the one without it.
         report = simulation.monitor.Report(
@@ -416,7 +424,7 @@ class TestPlanningOnTheRobot(unittest.TestCase):
         )
         # The goal: the corner of the hypercube opposite the start (4 steps away).
         scenario = LoadScenario(DIAGRAMS / "explore_hypercube.yaml", "{duration: 60}")
-        simulation = BuildSimulation(scenario)
+        simulation = BuildScenario(scenario)
         space = Lattice([0.25, 0.75], 4)
         lower, upper = simulation.mobee.position_limits
         columns = [simulation.mobee.joint_index(j) for j in scenario.attractor.agents[0].joints]
@@ -432,7 +440,7 @@ class TestPlanningOnTheRobot(unittest.TestCase):
         self.assertEqual(record.actions_done, 4)  # the shortest way through the hypercube
         with self.assertRaisesRegex(ValueError, "no saved model of agent 'right_arm'"):
             agent.model = str(folder.parent / "nothing")
-            BuildSimulation(scenario)
+            BuildScenario(scenario)
 
 
 class TestSeveralAgents(unittest.TestCase):
@@ -456,7 +464,7 @@ class TestCheckpoints(unittest.TestCase):
 
         def Final(simulation, simulator):
             context = simulator.get_context()
-            supervisor = simulation.diagram.GetSubsystemByName("attractor")
+            supervisor = simulation.client
             (record,) = supervisor.Records(supervisor.GetMyContextFromRoot(context))
             return (
                 simulation.robot_state.Eval(context).copy(),
@@ -466,20 +474,20 @@ class TestCheckpoints(unittest.TestCase):
             )
 
         # Uninterrupted: 0 to 30 s.
-        simulation = BuildSimulation(scenario)
-        simulator = Simulator(simulation.diagram)
+        simulation = BuildScenario(scenario)
+        simulator = MakeSimulator(simulation)
         simulator.Initialize()
         simulator.AdvanceTo(30.0)
         expected = Final(simulation, simulator)
 
         # Interrupted at 12.34 s (in the middle of an action), saved, resumed in a new diagram.
-        first = BuildSimulation(scenario)
-        simulator = Simulator(first.diagram)
+        first = BuildScenario(scenario)
+        simulator = MakeSimulator(first)
         simulator.Initialize()
         simulator.AdvanceTo(12.34)
         SaveCheckpoint(first, simulator.get_context(), folder / "run")
-        second = BuildSimulation(scenario)
-        simulator = Simulator(second.diagram)
+        second = BuildScenario(scenario)
+        simulator = MakeSimulator(second)
         LoadCheckpoint(second, simulator.get_mutable_context(), folder / "run")
         simulator.Initialize(InitializeParams(suppress_initialization_events=True))
         simulator.AdvanceTo(30.0)
@@ -495,7 +503,7 @@ class TestCheckpoints(unittest.TestCase):
         scenario.duration = 30.0
         second = RunScenario(scenario, checkpoint=str(folder))  # resumes at 20 s
         self.assertAlmostEqual(second.simulated_time, 10.0)
-        other = BuildSimulation(LoadScenario(REACH, "{robot_model: dynamic}"))
+        other = BuildScenario(LoadScenario(REACH, "{mover: !Dynamic {}}"))
         with self.assertRaisesRegex(ValueError, "no saved state for 'plant'"):
             LoadCheckpoint(other, other.diagram.CreateDefaultContext(), folder)
 
@@ -506,10 +514,10 @@ class TestInteractive(unittest.TestCase):
 
         scenario = LoadScenario(DIAGRAMS / "interactive.yaml")
         with self.assertRaisesRegex(ValueError, "slider attractor needs Meshcat"):
-            BuildSimulation(scenario)
+            BuildScenario(scenario)
         meshcat = Meshcat()
-        simulation = BuildSimulation(scenario, meshcat)
-        simulator = Simulator(simulation.diagram)
+        simulation = BuildScenario(scenario, meshcat)
+        simulator = MakeSimulator(simulation)
         simulator.Initialize()
         context = simulator.get_context()
         np.testing.assert_allclose(simulation.attractor.Eval(context), simulation.mobee.home)
@@ -563,22 +571,59 @@ class BallSwitcher(LeafSystem):
 
 
 class TestSupervisorWorldEvents(unittest.TestCase):
-    def test_a_supervisor_switches_the_ball_to_a_ghost(self):
-        scenario = LoadScenario(REACH, "{duration: 4}")
-        ball = next(o for o in scenario.objects if o.name == "ball").position
+    """World events live in the Context: applied by the simulator's monitor after every step,
+    counted in the ledger's state, read from SceneGraph's Context."""
 
-        def Prebuild(parts):
+    @classmethod
+    def setUpClass(cls):
+        cls.scenario = LoadScenario(REACH, "{duration: 4}")
+        ball = next(o for o in cls.scenario.objects if o.name == "ball").position
+
+        def ClientAndSwitcher(parts):
+            client = cls.scenario.attractor.AddToBuilder(parts)
             switcher = parts.builder.AddNamedSystem("switcher", BallSwitcher(parts.mobee, ball))
             parts.builder.Connect(
                 parts.mobee.GetOutputPort("marker_positions"), switcher.get_input_port()
             )
+            return client
 
-        simulation = BuildSimulation(scenario, prebuild=Prebuild)
-        simulator = Simulator(simulation.diagram)
+        cls.station = MakeMobeeStation(cls.scenario, prebuild_callback=ClientAndSwitcher)
+
+    def _Run(self, chunked: bool):
+        simulator = MakeSimulator(self.station)
         simulator.Initialize()
-        Advance(simulation, simulator, 4.0)
-        self.assertEqual(simulation.world.role("ball"), "ghost")
-        self.assertEqual(simulation.applied_requests, {"switcher": 1})
+        if chunked:
+            Advance(self.station, simulator, 4.0)
+        else:
+            simulator.AdvanceTo(4.0)
+        return simulator.get_context()
+
+    def test_a_supervisor_switches_the_ball_to_a_ghost(self):
+        context = self._Run(chunked=True)
+        self.assertEqual(self.station.world.Role(context, "ball"), "ghost")
+        ledger = self.station.event_ledger
+        np.testing.assert_array_equal(ledger.Counts(ledger.GetMyContextFromRoot(context)), [0, 1])
+
+    def test_plain_advance_contexts_and_checkpoints_agree(self):
+        chunked, plain = self._Run(chunked=True), self._Run(chunked=False)
+        world = self.station.world
+        self.assertEqual(world.Snapshot(plain), world.Snapshot(chunked))
+        np.testing.assert_array_equal(
+            self.station.robot_state.Eval(plain), self.station.robot_state.Eval(chunked)
+        )
+        # A fresh context of the same diagram has the world it was built with.
+        fresh = self.station.diagram.CreateDefaultContext()
+        self.assertEqual(world.Role(fresh, "ball"), "obstacle")
+        # A checkpoint restores the world and the ledger into a fresh context.
+        folder = pathlib.Path(tempfile.mkdtemp()) / "checkpoint"
+        SaveCheckpoint(self.station, plain, folder)
+        LoadCheckpoint(self.station, fresh, folder)
+        self.assertEqual(world.Snapshot(fresh), world.Snapshot(plain))
+        ledger = self.station.event_ledger
+        np.testing.assert_array_equal(
+            ledger.Counts(ledger.GetMyContextFromRoot(fresh)),
+            ledger.Counts(ledger.GetMyContextFromRoot(plain)),
+        )
 
 
 class TestRunner(unittest.TestCase):
@@ -614,9 +659,16 @@ class TestRunner(unittest.TestCase):
             cli.main(["run", str(REACH), "--duration", "0.5", "--no-meshcat"])
         self.assertIn("simulated 0.50 s", out.getvalue())
         self.assertIn("ball", out.getvalue())
-        with self.assertRaises(SystemExit) as raised:
+        err = io.StringIO()
+        with self.assertRaises(SystemExit) as raised, contextlib.redirect_stderr(err):
             cli.main(["run", str(DIAGRAMS / "missing.yaml"), "--no-meshcat"])
-        self.assertIn("no such file", str(raised.exception))
+        self.assertEqual(raised.exception.code, 2)
+        self.assertRegex(err.getvalue(), r"^error: .*missing.yaml: no such file\n$")
+        # A shipped scenario by its name.
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            cli.main(["run", "reach_around_ball", "--duration", "0.1", "--no-meshcat"])
+        self.assertIn("simulated 0.10 s", out.getvalue())
 
 
 if __name__ == "__main__":

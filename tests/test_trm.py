@@ -9,7 +9,10 @@ from mobee_drake.ngik.costs import CollisionCost, HomeCost, MarkerInBox
 from mobee_drake.ngik.kinematic_model import KinematicModel, PoseEvaluation
 from mobee_drake.ngik.nes import NesConfig
 from mobee_drake.ngik.solver import IkProblem
+from mobee_drake.planning.supervisor import ExploreAttractor, ExploringAgent
 from mobee_drake.robots.icub import IcubConfig
+from mobee_drake.scenario import BuildScenario, Scenario
+from mobee_drake.station.world_events import MakeSimulator
 from mobee_drake.trm.display import PathMotion
 from mobee_drake.trm.examples import JOINTS, ReachInto
 from mobee_drake.trm.roadmap import BuildTrm, CoveredRegion, TaskRelevantRoadmap, TrmConfig
@@ -139,29 +142,18 @@ class IcubTrmTest(unittest.TestCase):
             TaskRelevantRoadmap.Load(folder)
 
     def test_a_roadmap_as_the_mdp_state_space(self):
-        from pydrake.systems.analysis import Simulator
-
-        from mobee_drake.simulation.builder import BuildSimulation
-        from mobee_drake.simulation.scenario import (
-            ExploreAttractor,
-            ExploringAgent,
-            Scenario,
-            Visualization,
-        )
-
         r = self.roadmap
         with tempfile.TemporaryDirectory() as folder:
             r.Save(folder)
             scenario = Scenario(
                 attractor=ExploreAttractor(agents=[ExploringAgent(joints=JOINTS, roadmap=folder)]),
                 time_step=0.02,
-                visualization=Visualization(meshcat=False),
             )
-            simulation = BuildSimulation(scenario)
-        space = simulation.diagram.GetSubsystemByName("attractor").agents[0].space
+            simulation = BuildScenario(scenario)
+        space = simulation.client.agents[0].space
         self.assertEqual(space.num_states, r.num_vertices)
         self.assertEqual(space.num_state_actions, 2 * len(r.edges))
-        simulator = Simulator(simulation.diagram)
+        simulator = MakeSimulator(simulation)
         simulator.AdvanceTo(2.0)
         # The agent's first action sets the attractor to one of the roadmap's poses.
         q_star = simulation.attractor.Eval(simulator.get_context())

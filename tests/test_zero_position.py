@@ -16,6 +16,9 @@ from mobee_drake.robots.zero_position import (
     LoadZeroPositionTree,
     ZeroPositionError,
 )
+from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario
+from mobee_drake.station.world_events import MakeSimulator
+from mobee_drake.yaml_io import YamlFileError
 
 MODELS = pathlib.Path(__file__).resolve().parents[1] / "models"
 
@@ -201,13 +204,7 @@ class TestErrors(unittest.TestCase):
 
 class TestKatanaScenario(unittest.TestCase):
     def test_babbles_among_obstacles_without_touching_them(self):
-        from mobee_drake.simulation.runner import RunScenario
-        from mobee_drake.simulation.scenario import LoadScenario
-
-        scenario = LoadScenario(
-            MODELS.parent / "diagrams" / "katana.yaml",
-            "{duration: 30.0, visualization: {meshcat: false}}",
-        )
+        scenario = LoadScenario("katana", "{duration: 30.0}")
         summary = RunScenario(scenario)
         self.assertEqual(summary.safety.penetrating_steps, 0)
         # The arm came inside the field of at least one obstacle, and MoBeE kept it out.
@@ -224,16 +221,9 @@ class TestTwoRobots(unittest.TestCase):
     """The iCub and the Katana in one world, each with its own MoBeE (ch. 4.1.2)."""
 
     def test_each_mobee_keeps_its_robot_off_the_other(self):
-        from pydrake.systems.analysis import Simulator
-
-        from mobee_drake.simulation.builder import BuildSimulation
-        from mobee_drake.simulation.scenario import LoadScenario
-
-        scenario = LoadScenario(
-            MODELS.parent / "diagrams" / "icub_and_katana.yaml", "{visualization: {meshcat: false}}"
-        )
-        simulation = BuildSimulation(scenario)
-        simulator = Simulator(simulation.diagram)
+        scenario = LoadScenario("icub_and_katana")
+        simulation = BuildScenario(scenario)
+        simulator = MakeSimulator(simulation)
         simulator.Initialize()
         context = simulator.get_context()
         katana = simulation.diagram.GetSubsystemByName("katana_mobee")
@@ -257,14 +247,12 @@ class TestTwoRobots(unittest.TestCase):
         self.assertGreater(report.closest_approach["(other objects)"], 0.0)
 
     def test_companions_need_the_kinematic_robot(self):
-        from mobee_drake.simulation.scenario import LoadScenario
-        from mobee_drake.yaml_io import YamlFileError
 
         with self.assertRaisesRegex(
-            YamlFileError, "companion 'katana': other robots run in kinematic scenarios only"
+            YamlFileError, "companion 'katana': other robots run with the kinematic robot only"
         ):
             LoadScenario(
-                MODELS.parent / "diagrams" / "icub_and_katana.yaml", "{robot_model: dynamic}"
+                MODELS.parent / "diagrams" / "icub_and_katana.yaml", "{mover: !Dynamic {}}"
             )
 
 

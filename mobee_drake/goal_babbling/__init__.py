@@ -2,5 +2,5 @@
 
 Modules: config (typed parameters), planar_arm, competence (eq. 1, 2, 7), regions (interest, splits,
 modes), low_level (memory-based local models and the SSA-like low level), sagg_riac, baselines,
-evaluation, experiments.
+evaluation. The Sec. IV experiments are in :mod:`mobee_drake.experiments.saggriac`.
 """

@@ -25,7 +25,7 @@ def ReachingCost(
 
 
 def Competence(cost: float, tolerance: float, min_competence: float) -> float:
-    """gamma = min_C if C <= min_C; C if min_C < C <= eps_C; 0 otherwise (Sec. II-D-1).
+    """Gamma = min_C if C <= min_C; C if min_C < C <= eps_C; 0 otherwise (Sec. II-D-1).
 
     Args:
         cost: C of the attempt.
@@ -43,7 +43,7 @@ def Competence(cost: float, tolerance: float, min_competence: float) -> float:
 
 
 def LocalCompetence(competences: np.ndarray) -> float:
-    """gamma'' = mean of the competences of the goals in a region (eq. 1).
+    """Gamma'' = mean of the competences of the goals in a region (eq. 1).
 
     Args:
         competences: The region's competences.

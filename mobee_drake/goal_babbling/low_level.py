@@ -200,7 +200,7 @@ def DesiredDisplacements(positions: np.ndarray, goals: np.ndarray, velocity: flo
 def ReachingJointSteps(
     jacobians: np.ndarray, desired: np.ndarray, max_joint_step: float
 ) -> np.ndarray:
-    """dtheta = J^+ dx (eq. 6), scaled down so no joint moves more than max_joint_step (our choice).
+    """Dtheta = J^+ dx (eq. 6), scaled down so no joint moves more than max_joint_step (our choice).
 
     Args:
         jacobians: (m, 2, n) estimated Jacobians.

@@ -8,7 +8,7 @@ from mobee_drake.goal_babbling.config import ArmConfig
 
 
 def ForwardKinematics(joint_angles: np.ndarray, link_lengths: np.ndarray) -> np.ndarray:
-    """x = f(theta) of a planar serial arm, relative joint angles, base at the origin (Sec. III-A).
+    """X = f(theta) of a planar serial arm, relative joint angles, base at the origin (Sec. III-A).
 
     Link i points along the sum of joint angles 0..i, so theta = 0 is the straight arm along +x.
 
@@ -26,7 +26,7 @@ def ForwardKinematics(joint_angles: np.ndarray, link_lengths: np.ndarray) -> np.
 
 
 def LinkLengths(config: ArmConfig) -> np.ndarray:
-    """n equal links of total length L (equal lengths: our choice; the paper gives n and L)."""
+    """N equal links of total length L (equal lengths: our choice; the paper gives n and L)."""
     return np.full(config.num_joints, config.total_length / config.num_joints)
 
 

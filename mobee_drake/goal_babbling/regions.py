@@ -43,7 +43,7 @@ class Region:
     children: tuple["Region", "Region"] | None = None
 
     def MeanCompetence(self) -> float:
-        """gamma'' of the region (eq. 1); 0 while empty."""
+        """Gamma'' of the region (eq. 1); 0 while empty."""
         return float(np.mean(self.values)) if self.values else 0.0
 
     def Sample(self, rng: np.random.Generator) -> np.ndarray:

@@ -21,8 +21,8 @@ from mobee_drake.mobee.constraints import ClauseSet
 from mobee_drake.mobee.fields import FindFieldPairs
 from mobee_drake.robots.overlay import MarkerStates
 from mobee_drake.robots.scenario_robot import AddScenarioRobot, RobotConfig
-from mobee_drake.simulation.scenario import SceneObject
-from mobee_drake.simulation.world import LiveWorld
+from mobee_drake.world.live_world import LiveWorld
+from mobee_drake.world.objects import SceneObject
 
 
 @dc.dataclass(frozen=True)

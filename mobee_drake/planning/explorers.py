@@ -1,13 +1,11 @@
 """Agents that explore a state-action space (dissertation Alg. 8, ch. 7.2.1).
 
-- ``curious`` (AC, Alg. 8): transition counts initialised optimistically (each action observed
-  once failing, leaving the agent where it was, and once succeeding; the 60-40 initialisation of
-  Table 7.1 observes one more success), intrinsic reward = the last observation's information gain
-  (Alg. 6), value iteration (Alg. 7) after every action, greedy on V(s, a).
-- ``random`` (RAND): a uniformly random action of the current state.
-- ``least_tried`` (LT): the action of the current state tried least often, random among ties.
-- ``planner``: exploits the learned model (ch. 6.5): greedy on the values of a reward for arriving
-  in ``goal_state`` (see :mod:`mobee_drake.planning.planner`); it keeps learning from outcomes.
+Every agent learns the same model: transition counts initialised optimistically (each action
+observed once failing, leaving the agent where it was, and once succeeding; the 60-40
+initialisation of Table 7.1 observes one more success) and the intrinsic reward of each
+state-action, the last observation's information gain (Alg. 6). Agents differ in how they choose
+the next action: their strategy (see :mod:`mobee_drake.planning.strategies`). A planner keeps
+learning from outcomes too.
 
 Every agent draws from its own seeded generator; ties of the greedy choice are broken at random
 too, so a run is reproducible from its seed.
@@ -22,9 +20,9 @@ import numpy as np
 
 from mobee_drake.planning.curiosity import TransitionCounts
 from mobee_drake.planning.state_space import StateActionSpace
+from mobee_drake.planning.strategies import STRATEGIES
 from mobee_drake.planning.value_iteration import ValueIteration
 
-STRATEGIES = ("curious", "random", "least_tried", "planner")
 INITIALIZATIONS = {"50-50": 1, "60-40": 2}  # successes observed after the one failure
 
 
@@ -35,15 +33,16 @@ class ExplorerConfig:
     initialization: str = "50-50"
     gamma: float = 0.9
     delta: float = 1e-3
-    seed: int = 0
     # The state the "planner" strategy heads for.
     goal_state: int = -1
 
 
 class Explorer:
-    """One agent exploring one state-action space."""
+    """One agent exploring one state-action space, its generator seeded with ``seed``."""
 
-    def __init__(self, space: StateActionSpace, config: ExplorerConfig | None = None):
+    def __init__(
+        self, space: StateActionSpace, config: ExplorerConfig | None = None, seed: int = 0
+    ):
         config = config or ExplorerConfig()
         if config.strategy not in STRATEGIES:
             raise ValueError(
@@ -60,7 +59,7 @@ class Explorer:
                 + " or ".join(INITIALIZATIONS)
             )
         self.space, self.config = space, config
-        self.rng = np.random.default_rng(config.seed)
+        self.rng = np.random.default_rng(seed)
         self.transitions = TransitionCounts(space.num_state_actions, space.num_states)
         self.rewards = np.zeros(space.num_state_actions)
         self.tries = np.zeros(space.num_state_actions, dtype=int)
@@ -93,18 +92,7 @@ class Explorer:
         actions = self.space.Actions(state)
         if len(actions) == 0:
             raise ValueError(f"state {state} has no actions")
-        if self.config.strategy == "random":
-            return int(self.rng.choice(actions))
-        if self.config.strategy == "least_tried":
-            scores = -self.tries[actions].astype(float)
-        elif self.config.strategy == "planner":
-            from mobee_drake.planning.planner import PlanValues  # (planner imports this module)
-
-            scores = PlanValues(self, {self.config.goal_state: 1.0}, gamma=self.config.gamma)[0][
-                actions
-            ]
-        else:
-            scores = self.Values()[0][actions]
+        scores = STRATEGIES[self.config.strategy].Scores(self, actions)
         best = actions[np.flatnonzero(scores >= scores.max() - 1e-12)]
         return int(self.rng.choice(best))
 
@@ -132,15 +120,18 @@ def ExplorerToArrays(explorer: Explorer) -> tuple[dict[str, np.ndarray], dict]:
     )
 
 
-def ExplorerFromArrays(arrays, data: dict, config: ExplorerConfig | None = None) -> Explorer:
+def ExplorerFromArrays(
+    arrays, data: dict, config: ExplorerConfig | None = None, seed: int = 0
+) -> Explorer:
     """The inverse of :func:`ExplorerToArrays`; with ``config``, the saved model under another
-    configuration (e.g. a planner reusing what an explorer learned)."""
+    configuration (e.g. a planner reusing what an explorer learned) with a generator seeded with
+    ``seed``."""
     space = StateActionSpace(
         np.asarray(arrays["centres"]),
         np.asarray(arrays["action_state"]),
         np.asarray(arrays["action_goal"]),
     )
-    explorer = Explorer(space, config or ExplorerConfig(**data["config"]))
+    explorer = Explorer(space, config or ExplorerConfig(**data["config"]), seed)
     explorer.transitions.counts[...] = arrays["counts"]
     explorer.rewards[...] = arrays["rewards"]
     explorer.tries[...] = arrays["tries"]
@@ -149,8 +140,9 @@ def ExplorerFromArrays(arrays, data: dict, config: ExplorerConfig | None = None)
     return explorer
 
 
-def LoadAgentModel(folder: str, name: str, config: ExplorerConfig) -> Explorer:
-    """Agent ``name``'s model from a checkpoint folder, under ``config``.
+def LoadAgentModel(folder: str, name: str, config: ExplorerConfig, seed: int = 0) -> Explorer:
+    """Agent ``name``'s model from a checkpoint folder, under ``config``, its generator seeded
+    with ``seed``.
 
     Raises:
         ValueError: naming the file, when the folder has no model for that agent.
@@ -160,5 +152,8 @@ def LoadAgentModel(folder: str, name: str, config: ExplorerConfig) -> Explorer:
         if not base.with_suffix(suffix).is_file():
             raise ValueError(f"{base.with_suffix(suffix)}: no saved model of agent '{name}'")
     return ExplorerFromArrays(
-        np.load(base.with_suffix(".npz")), json.loads(base.with_suffix(".json").read_text()), config
+        np.load(base.with_suffix(".npz")),
+        json.loads(base.with_suffix(".json").read_text()),
+        config,
+        seed,
     )

@@ -6,14 +6,28 @@ iteration (Alg. 7) on R and T, and the greedy choice of V(s, a), plan a path tha
 that reliably reach the goal, around those that were seen to fail (an obstacle, a constraint).
 """
 
+from typing import Protocol
+
 import numpy as np
 
-from mobee_drake.planning.explorers import Explorer
+from mobee_drake.planning.curiosity import TransitionCounts
+from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.planning.value_iteration import ValueIteration
 
 
+class LearnedModel(Protocol):
+    """What a plan needs of an agent: its state-action space and its transition counts."""
+
+    space: StateActionSpace
+    transitions: TransitionCounts
+
+
 def PlanValues(
-    explorer: Explorer, goal_rewards: dict[int, float], *, gamma: float = 0.9, delta: float = 1e-6
+    explorer: LearnedModel,
+    goal_rewards: dict[int, float],
+    *,
+    gamma: float = 0.9,
+    delta: float = 1e-6,
 ) -> tuple[np.ndarray, np.ndarray]:
     """V(s, a) and V(s) for rewards on arriving in goal states (state index -> reward)."""
     space = explorer.space
@@ -29,7 +43,7 @@ def PlanValues(
 
 
 def GreedyPlan(
-    explorer: Explorer, start: int, goal: int, *, gamma: float = 0.9, max_steps: int = 100
+    explorer: LearnedModel, start: int, goal: int, *, gamma: float = 0.9, max_steps: int = 100
 ) -> list[int]:
     """The states of the most likely path from ``start`` to ``goal`` following the greedy plan.
 

@@ -1,12 +1,11 @@
 """Agents on the robot: the exploration loop of Alg. 8 as a Drake system (dissertation ch. 6.1).
 
-An *action* sets MoBeE's attractor, for the agent's joints, to the centre of the goal state; it
-ends when the robot has settled (every joint of the agent slower than ``settle_speed`` for
-``settle_time``, and at least ``min_duration`` after the start) or after ``timeout``. The outcome
-is the state holding the final configuration; the agent observes it (Alg. 6) and chooses the next
-action (Alg. 7-8). Several agents run at once, each on its own joints and blind to the others
-(ch. 7.4); joints of no agent are held at home. An agent with the "planner" strategy heads for
-its goal state and stops once an action has ended there.
+An *action* sets MoBeE's attractor, for the agent's joints, to the centre of the goal state; it ends
+when the robot has settled (:mod:`mobee_drake.station.settling`, watching the agent's joints) or
+timed out. The outcome is the state holding the final configuration; the agent observes it (Alg. 6)
+and chooses the next action (Alg. 7-8). Several agents run at once, each on its own joints and blind
+to the others (ch. 7.4); joints of no agent are held at home. An agent with the "planner" strategy
+heads for its goal state and stops once an action has ended there.
 
 Where the learned model lives: the supervisor's state is one abstract value, a tuple of
 :class:`AgentRecord`, updated by a periodic unrestricted update (the polling period of the
@@ -17,23 +16,24 @@ of a model.
 """
 
 import dataclasses as dc
+import json
+import pathlib
 
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 
-from mobee_drake.planning.explorers import Explorer, ExplorerConfig
-from mobee_drake.planning.state_space import StateActionSpace
-
-
-@dc.dataclass
-class ActionTiming:
-    """When an action ends (ch. 6.1; the original MoBeE learner's values, in radians)."""
-
-    settle_speed: float = np.radians(2.0)  # rad/s, every joint of the agent
-    settle_time: float = 0.5  # s the robot must stay that slow
-    min_duration: float = 0.5  # s before an action may end
-    timeout: float = 20.0  # s
+from mobee_drake.planning.explorers import (
+    Explorer,
+    ExplorerConfig,
+    ExplorerFromArrays,
+    ExplorerToArrays,
+    LoadAgentModel,
+)
+from mobee_drake.planning.state_space import FromGraph, Lattice, StateActionSpace
+from mobee_drake.station.parts import ClientPorts, StationParts
+from mobee_drake.station.settling import ActionTiming
+from mobee_drake.trm.roadmap import TaskRelevantRoadmap
 
 
 @dc.dataclass(frozen=True)
@@ -63,6 +63,8 @@ class Agent:
     explorer: ExplorerConfig = dc.field(default_factory=ExplorerConfig)
     # A model learned before (its space must be ``space``); None: start afresh.
     model: Explorer | None = None
+    # Seeds the agent's generator (a fresh model's; a given model brings its own).
+    seed: int = 0
 
 
 class ExplorationSupervisor(LeafSystem):
@@ -167,7 +169,9 @@ class ExplorationSupervisor(LeafSystem):
             self._Begin(
                 agent,
                 columns,
-                agent.model.Copy() if agent.model else Explorer(agent.space, agent.explorer),
+                agent.model.Copy()
+                if agent.model
+                else Explorer(agent.space, agent.explorer, agent.seed),
                 q,
                 context.get_time(),
                 0,
@@ -186,13 +190,8 @@ class ExplorationSupervisor(LeafSystem):
             record = records[i]
             if record.arrived:
                 continue
-            slow = np.max(np.abs(v[columns])) < timing.settle_speed
-            slow_since = min(record.slow_since, now) if slow else np.inf
-            elapsed = now - record.started
-            settled = (
-                elapsed >= timing.min_duration and slow and now - slow_since >= timing.settle_time
-            )
-            if settled or elapsed >= timing.timeout:
+            slow_since = timing.SlowSince(record.slow_since, now, v[columns])
+            if timing.Ended(now, record.started, slow_since):
                 explorer = record.explorer.Copy()
                 outcome = self._StateOf(agent, columns, q)
                 explorer.Observe(record.state_action, outcome)
@@ -275,3 +274,115 @@ class ExplorationSupervisor(LeafSystem):
     @property
     def agents(self) -> tuple[Agent, ...]:
         return tuple(self._agents)
+
+    # ----------------------------------------------------------------------------------------
+    # The station's checkpoint protocol (see :mod:`mobee_drake.station.checkpoint`) and the
+    # runner's count of completed actions.
+
+    def CompletedActions(self, context) -> int:
+        return sum(record.actions_done for record in self.Records(context))
+
+    def WriteCheckpoint(self, context, folder: pathlib.Path) -> None:
+        """Writes ``<agent>.npz`` (the learned model) and ``<agent>.json`` (its configuration,
+        its generator's state and the action in flight) for every agent."""
+        for name, record in zip(self.agent_names, self.Records(context)):
+            arrays, data = ExplorerToArrays(record.explorer)
+            np.savez(folder / f"{name}.npz", **arrays)
+            data["record"] = {k: v for k, v in dc.asdict(record).items() if k != "explorer"}
+            data["record"]["slow_since"] = float(record.slow_since)
+            (folder / f"{name}.json").write_text(json.dumps(data, indent=1))
+
+    def ReadCheckpoint(self, context, folder: pathlib.Path) -> None:
+        records = []
+        for name in self.agent_names:
+            data = json.loads((folder / f"{name}.json").read_text())
+            explorer = ExplorerFromArrays(np.load(folder / f"{name}.npz"), data)
+            records.append(AgentRecord(explorer=explorer, **data["record"]))
+        self.SetRecords(context, tuple(records))
+
+
+def RoadmapStateSpace(
+    folder: str, joints: list[str], all_joints: list[str], lower: np.ndarray, upper: np.ndarray
+) -> StateActionSpace:
+    """The state-action space of a saved task-relevant roadmap over an agent's ``joints`` (of
+    ``all_joints``, whose limits are ``lower`` and ``upper``)."""
+    roadmap = TaskRelevantRoadmap.Load(folder)
+    missing = [j for j in joints if j not in roadmap.joints]
+    if missing:
+        raise ValueError(f"{folder}: the roadmap has no joint(s) {', '.join(missing)}")
+    mine = [all_joints.index(j) for j in joints]
+    theirs = [roadmap.joints.index(j) for j in joints]
+    centres = (roadmap.q[:, theirs] - lower[mine]) / (upper[mine] - lower[mine])
+    return FromGraph(centres, roadmap.edges)
+
+
+@dc.dataclass
+class ExploringAgent:
+    """A curious agent on some joints (dissertation ch. 6-7), its states a hyper-lattice."""
+
+    name: str = "agent"
+    joints: list[str] = dc.field(default_factory=list)
+    # The lattice's levels, in fractions of each joint's range (e.g. [0.25, 0.75]: a hypercube).
+    levels: list[float] = dc.field(default_factory=lambda: [0.25, 0.75])
+    # Instead of the lattice: a task-relevant roadmap saved by ``mobee-drake experiment trm`` (its
+    # folder); its vertices become the states and its edges the actions (ch. 9.4.5).
+    roadmap: str = ""
+    # Actions to the k nearest states; 0: to the nearest equidistant ones.
+    nearest: int = 0
+    explorer: ExplorerConfig = dc.field(default_factory=ExplorerConfig)
+    # Start from a model learned before: a checkpoint folder holding ``<name>.npz/json``.
+    model: str = ""
+
+
+@dc.dataclass
+class ExploreAttractor:
+    """The attractor is set by exploring agents (Alg. 8), each on its own joints. Agent i's
+    generator is seeded with the scenario's ``random_seed + i``."""
+
+    agents: list[ExploringAgent] = dc.field(default_factory=list)
+    timing: ActionTiming = dc.field(default_factory=ActionTiming)
+
+    def Validate(self) -> None:
+        names = [agent.name for agent in self.agents]
+        if len(set(names)) != len(names):
+            raise ValueError(f"exploring agents need unique names, got {names}")
+
+    def AddToBuilder(self, parts: StationParts) -> ClientPorts:
+        mobee = parts.mobee
+        lower, upper = mobee.position_limits
+        agents = []
+        for i, config in enumerate(self.agents):
+            seed = parts.random_seed + i
+            space = (
+                RoadmapStateSpace(config.roadmap, config.joints, mobee.joints, lower, upper)
+                if config.roadmap
+                else Lattice(config.levels, len(config.joints), k=config.nearest or None)
+            )
+            model = (
+                LoadAgentModel(config.model, config.name, config.explorer, seed)
+                if config.model
+                else None
+            )
+            agents.append(
+                Agent(
+                    name=config.name,
+                    joints=config.joints,
+                    space=space,
+                    explorer=config.explorer,
+                    model=model,
+                    seed=seed,
+                )
+            )
+        supervisor = parts.builder.AddNamedSystem(
+            f"{parts.prefix}exploration_supervisor",
+            ExplorationSupervisor(
+                agents=agents,
+                joints=mobee.joints,
+                lower=lower,
+                upper=upper,
+                home=mobee.home,
+                timing=self.timing,
+            ),
+        )
+        parts.builder.Connect(parts.robot_state, supervisor.GetInputPort("robot_state"))
+        return ClientPorts(system=supervisor, attractor=supervisor.get_output_port())

@@ -29,6 +29,7 @@ def ValueIteration(
         num_states: m.
         gamma: discount in [0, 1).
         delta: stop when no V(s, a) changes by ``delta`` or more in a sweep.
+        max_sweeps: stop after this many sweeps in any case.
     """
     if not 0 <= gamma < 1:
         raise ValueError(f"gamma must be in [0, 1), got {gamma}")

@@ -7,13 +7,8 @@ states 57 and 77). The MDP's transition probabilities plan the moves and, as in 
 updated; a reach ends the policy (its row of T is empty), so its value is its reward.
 
 Rewards per problem (a reach target x*) come from the state-actions' histories (eq. 8.2):
-transitions predict eq. 8.1 (0 when untried); reaches predict by strategy (ch. 8.3.2):
-
-- ``random``: 1 on one reaching state-action drawn at the start of the problem-try, 0 on the rest;
-- ``greedy`` (greedy optimistic): eq. 8.5;
-- ``intrinsic`` (intrinsically motivated): eq. 8.7, the expected error of eq. 8.5's prediction;
-- ``goal_babbling`` (beyond the source, :mod:`mobee_drake.reaching.goals`): eq. 8.5 toward a goal
-  that SAGG-RIAC chose in the targets' workspace, instead of the least-tried problem.
+transitions predict eq. 8.1 (0 when untried); reaches predict by strategy (ch. 8.3.2; see
+:mod:`mobee_drake.reaching.strategies`).
 
 A *problem-try* (ch. 8.3.1): value iteration on the problem's rewards, the greedy state-action
 of the robot's state, recorded in its history with the prediction of eq. 8.1 or 8.5 made before
@@ -59,8 +54,7 @@ from mobee_drake.reaching.predictors import (
     RewardHistories,
     TransitionReward,
 )
-
-STRATEGIES = ("random", "greedy", "intrinsic", "goal_babbling")
+from mobee_drake.reaching.strategies import REACH_STRATEGIES
 
 
 @dc.dataclass
@@ -83,10 +77,10 @@ class ReachLearningConfig:
     def Validate(self) -> None:
         self.predictor.Validate()
         self.goals.Validate()
-        if self.strategy not in STRATEGIES:
+        if self.strategy not in REACH_STRATEGIES:
             raise ValueError(
                 f"unknown reach-learning strategy '{self.strategy}'; strategies "
-                "are " + ", ".join(STRATEGIES)
+                "are " + ", ".join(REACH_STRATEGIES)
             )
         if not 0 <= self.gamma < 1:
             raise ValueError(f"gamma must be in [0, 1), got {self.gamma}")
@@ -185,7 +179,9 @@ class ReachLearner:
         self.rng = np.random.default_rng(config.seed)
         self.log: list[tuple] = []
         self.babbler = (
-            GoalBabbler(self.targets, config.goals) if config.strategy == "goal_babbling" else None
+            GoalBabbler(self.targets, config.goals)
+            if REACH_STRATEGIES[config.strategy].babbles_goals
+            else None
         )
 
     @property
@@ -203,23 +199,18 @@ class ReachLearner:
     # Planning.
 
     def Rewards(
-        self, target: np.ndarray, reach_rewards: str, histories=None, random_reach: int = -1
+        self, target: np.ndarray, strategy: str, histories=None, drawn: int = -1
     ) -> np.ndarray:
-        """The problem's reward matrix: eq. 8.1 on transitions; on reaches ``reach_rewards``:
-        "random" (1 on ``random_reach``), "greedy" (eq. 8.5) or "intrinsic" (eq. 8.7)."""
+        """The problem's rewards: eq. 8.1 on transitions, ``strategy``'s predictions on reaches
+        (``drawn``: what the strategy drew at the start of the try)."""
         histories = self.histories if histories is None else histories
-        rewards = np.array(
-            [histories.Predict(sa, target) for sa in range(self.num_transitions)]
-            + [0.0] * self.space.num_states
-        )
         reaches = np.arange(self.num_transitions, self.num_state_actions)
-        if reach_rewards == "random":
-            rewards[random_reach] = 1.0
-        elif reach_rewards == "greedy":
-            rewards[reaches] = [histories.Predict(sa, target) for sa in reaches]
-        else:
-            rewards[reaches] = [histories.PredictIntrinsic(sa, target) for sa in reaches]
-        return rewards
+        return np.concatenate(
+            [
+                [histories.Predict(sa, target) for sa in range(self.num_transitions)],
+                REACH_STRATEGIES[strategy].ReachRewards(histories, target, reaches, drawn),
+            ]
+        )
 
     def Values(self, rewards: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """V(s, a) (in state-action numbering) and V(s) by value iteration (Alg. 7)."""
@@ -252,7 +243,7 @@ class ReachLearner:
         robot: Robot,
         problem: int,
         target: np.ndarray,
-        reach_rewards: str,
+        strategy: str,
         histories: RewardHistories,
         rng,
         learn: bool,
@@ -260,14 +251,10 @@ class ReachLearner:
         """One problem-try for ``target``; ``learn`` says whether it is exploration (logged; with
         ``learn_mdp`` the model learns) or an evaluation (``histories`` a scratch copy)."""
         robot.SetProblem(target)
-        random_reach = (
-            self.Reach(int(rng.integers(self.space.num_states)))
-            if reach_rewards == "random"
-            else -1
-        )
+        drawn = REACH_STRATEGIES[strategy].StartTry(self.space.num_states, rng)
         failed = 0
         for action in range(1, self.config.max_actions + 1):
-            q, v = self.Values(self.Rewards(target, reach_rewards, histories, random_reach))
+            q, v = self.Values(self.Rewards(target, strategy, histories, drawn))
             state = robot.State()
             sa = self._Greedy(q, state, rng)
             estimate = histories.Predict(sa, target)  # eq. 8.1 or 8.5, before it runs
@@ -316,12 +303,8 @@ class ReachLearner:
         self.babbler.Record(goal, start, result.reached)
         return result
 
-    def _Explore(
-        self, robot: Robot, problem: int, target: np.ndarray, reach_rewards: str
-    ) -> TryResult:
-        result = self._Try(
-            robot, problem, target, reach_rewards, self.histories, self.rng, learn=True
-        )
+    def _Explore(self, robot: Robot, problem: int, target: np.ndarray, strategy: str) -> TryResult:
+        result = self._Try(robot, problem, target, strategy, self.histories, self.rng, learn=True)
         self.problem_tries[problem] += 1
         return result
 

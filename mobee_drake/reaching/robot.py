@@ -10,43 +10,45 @@ therefore must go around the target, and fails when it cannot.
 
 import numpy as np
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
-from pydrake.systems.analysis import InitializeParams, Simulator
+from pydrake.systems.analysis import InitializeParams
 
 from mobee_drake.planning.state_space import StateActionSpace
-from mobee_drake.reaching.executor import StateActionExecutor
 from mobee_drake.reaching.targets import TARGET_NAME, TargetObject
-from mobee_drake.simulation.builder import BuildSimulation
-from mobee_drake.simulation.checkpoint import LoadCheckpoint, SaveCheckpoint
-from mobee_drake.simulation.scenario import Scenario, StateActionAttractor
+from mobee_drake.station.builder import Station
+from mobee_drake.station.checkpoint import LoadCheckpoint, SaveCheckpoint
+from mobee_drake.station.executor import StateActionExecutor
+from mobee_drake.station.world_events import MakeSimulator
 
 
 class SimulatedRobot:
-    """Runs the learner's state-actions in a scenario with a :class:`StateActionAttractor`.
+    """Runs the learner's state-actions on a built station whose client is a
+    :class:`StateActionExecutor` (a scenario with a ``StateActionAttractor``).
 
     ``joints`` are the MDP's joints (``space``'s dimensions, in fractions of their ranges); the
-    rest of MoBeE's joints stay at home. With ``meshcat`` the robot is shown there, in real time.
+    rest of MoBeE's joints stay at home. With ``realtime`` the robot moves in real time (for a
+    station shown in Meshcat).
     """
 
     def __init__(
         self,
-        scenario: Scenario,
+        station: Station,
         joints: list[str],
         space: StateActionSpace,
         target_radius: float,
         poll: float = 0.1,
-        meshcat=None,
+        realtime: bool = False,
     ):
-        if not isinstance(scenario.attractor, StateActionAttractor):
-            raise ValueError("the reach learner's scenario needs a StateActionAttractor")
-        self.simulation = simulation = BuildSimulation(scenario, meshcat)
-        self.simulator = Simulator(simulation.diagram)
-        if meshcat is not None:
+        if not isinstance(station.client, StateActionExecutor):
+            raise ValueError("the reach learner's station needs a StateActionAttractor client")
+        self.station = station
+        self.simulator = MakeSimulator(station)
+        if realtime:
             self.simulator.set_target_realtime_rate(1.0)
         self.simulator.Initialize()
         self.context = self.simulator.get_mutable_context()
-        self.executor: StateActionExecutor = simulation.diagram.GetSubsystemByName("attractor")
+        self.executor: StateActionExecutor = station.client
         self._executor_context = self.executor.GetMyMutableContextFromRoot(self.context)
-        mobee = simulation.mobee
+        mobee = station.mobee
         unknown = [j for j in joints if j not in mobee.joints]
         if unknown:
             raise ValueError(
@@ -56,15 +58,15 @@ class SimulatedRobot:
         self._columns = np.array([mobee.joints.index(j) for j in joints])
         self._lower, self._upper = mobee.position_limits
         self._home = mobee.home
-        plant = simulation.plant
-        marker = scenario.attractor.forcing.marker
-        hand = [m.body_name for m in simulation.robot.markers if m.name == marker][0]
+        plant = station.plant
+        marker = self.executor.marker_name
+        hand = [m.body_name for m in station.robot.markers if m.name == marker][0]
         self._marker = mobee.marker_index(marker)
         # The current problem's target (None before the first problem).
         self.target: np.ndarray | None = None
         self._hand = [
             g
-            for g, frame in simulation.robot.geometry_frames.items()
+            for g, frame in station.robot.geometry_frames.items()
             if plant.get_frame(frame).body().name() == hand
         ]
 
@@ -77,15 +79,15 @@ class SimulatedRobot:
         return q
 
     def State(self) -> int:
-        q = self.simulation.robot_state.Eval(self.context)[: len(self._home)]
+        q = self.station.robot_state.Eval(self.context)[: len(self._home)]
         return self.space.StateOfConfiguration(
             q[self._columns], self._lower[self._columns], self._upper[self._columns]
         )
 
     def SetProblem(self, target: np.ndarray) -> None:
         self.target = np.asarray(target, dtype=float)
-        world = self.simulation.world
-        if TARGET_NAME in world.names:
+        world = self.station.world
+        if TARGET_NAME in world.Names(self.context):
             world.Move(self.context, TARGET_NAME, [float(c) for c in target])
         else:
             world.Add(self.context, TargetObject(target, self._radius))
@@ -100,13 +102,14 @@ class SimulatedRobot:
         return self.State()
 
     def Reach(self, target: np.ndarray) -> np.ndarray:
-        scene_graph = self.simulation.scene_graph
+        scene_graph = self.station.scene_graph
         filters = scene_graph.collision_filter_manager(
             scene_graph.GetMyMutableContextFromRoot(self.context)
         )
         touch = filters.ApplyTransient(
             CollisionFilterDeclaration().ExcludeBetween(
-                GeometrySet(self._hand), GeometrySet(self.simulation.world.geometry_id(TARGET_NAME))
+                GeometrySet(self._hand),
+                GeometrySet(self.station.world.GeometryIdOf(self.context, TARGET_NAME)),
             )
         )
         self.executor.StartReach(self._executor_context, self._Centre(self.State()), target)
@@ -119,7 +122,7 @@ class SimulatedRobot:
 
     def MarkerPosition(self) -> np.ndarray:
         """Where the reaching marker (the palm) is now (world, m)."""
-        mobee = self.simulation.mobee
+        mobee = self.station.mobee
         positions = mobee.GetOutputPort("marker_positions").Eval(
             mobee.GetMyContextFromRoot(self.context)
         )
@@ -131,12 +134,12 @@ class SimulatedRobot:
 
     def Save(self, folder) -> None:
         """Saves where the robot is (and the executor's state) as a simulation checkpoint."""
-        SaveCheckpoint(self.simulation, self.context, folder)
+        SaveCheckpoint(self.station, self.context, folder)
 
     def Load(self, folder) -> None:
-        LoadCheckpoint(self.simulation, self.context, folder)
+        LoadCheckpoint(self.station, self.context, folder)
         self.simulator.Initialize(InitializeParams(suppress_initialization_events=True))
 
     def PenetratingSteps(self) -> int:
-        monitor = self.simulation.monitor
+        monitor = self.station.monitor
         return monitor.Report(monitor.GetMyContextFromRoot(self.context)).penetrating_steps

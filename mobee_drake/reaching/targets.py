@@ -6,7 +6,7 @@ import itertools
 import numpy as np
 
 from mobee_drake.resources import ResolveModelFile
-from mobee_drake.simulation.scenario import SceneObject, Sphere
+from mobee_drake.world.objects import SceneObject, Sphere
 from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
 
 DEFAULT_TARGETS = "package://mobee_drake/reach_targets.yaml"

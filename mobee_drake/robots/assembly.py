@@ -165,20 +165,13 @@ def FreezeJoints(
 
 
 def JointStateSelector(
-    plant: MultibodyPlant, joints: list[str], instance: ModelInstanceIndex | None = None
+    plant: MultibodyPlant, joints: list[str], instance: ModelInstanceIndex
 ) -> np.ndarray:
-    """The matrix S with ``x_plant = S [q; v]`` for (q, v) of one-DOF ``joints`` (of model
-    ``instance``, if given) in that order.
+    """The matrix S with ``x_plant = S [q; v]`` for (q, v) of one-DOF ``joints`` of model
+    ``instance``, in that order: Drake's state selector, transposed.
 
     Its transpose selects those joints' (q, v) from the plant's state; its upper-left block maps
     their positions into the plant's positions.
     """
-    n = len(joints)
-    S = np.zeros((plant.num_multibody_states(), 2 * n))
-    for i, name in enumerate(joints):
-        joint = (
-            plant.GetJointByName(name) if instance is None else plant.GetJointByName(name, instance)
-        )
-        S[joint.position_start(), i] = 1.0
-        S[plant.num_positions() + joint.velocity_start(), n + i] = 1.0
-    return S
+    indices = [plant.GetJointByName(name, instance).index() for name in joints]
+    return plant.MakeStateSelectorMatrix(indices).T

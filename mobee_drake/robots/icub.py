@@ -36,6 +36,9 @@ ARM_JOINT_SUFFIXES = (
 RIGHT_ARM_JOINTS = tuple(f"r_{s}" for s in ARM_JOINT_SUFFIXES)
 LEFT_ARM_JOINTS = tuple(f"l_{s}" for s in ARM_JOINT_SUFFIXES)
 UPPER_BODY_JOINTS = TORSO_JOINTS + NECK_JOINTS + RIGHT_ARM_JOINTS + LEFT_ARM_JOINTS
+# The shoulder and elbow of each arm: the joints of ch. 7-8's learning agents.
+RIGHT_SHOULDER_ELBOW_JOINTS = RIGHT_ARM_JOINTS[:4]
+LEFT_SHOULDER_ELBOW_JOINTS = LEFT_ARM_JOINTS[:4]
 
 # The home posture of the original MoBeE iCub model (degrees): arms slightly forward and out, elbows
 # bent; all other joints at zero. Joints not listed here start at zero.

@@ -24,8 +24,8 @@ from mobee_drake.ngik.costs import CollisionCost, HomeCost, MarkerInBox, MarkerO
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.ngik.solver import IkProblem
 from mobee_drake.robots.icub import RIGHT_ARM_JOINTS, TORSO_JOINTS, IcubConfig
-from mobee_drake.simulation.scenario import Box, SceneObject
 from mobee_drake.trm.task_space import MarkerCoordinates, TaskSpace
+from mobee_drake.world.objects import Box, SceneObject
 
 JOINTS = list(TORSO_JOINTS + RIGHT_ARM_JOINTS)
 HOME_WEIGHT = 0.1

@@ -29,10 +29,10 @@ import time
 
 import numpy as np
 
+from mobee_drake.atomic_files import WriteFolderAtomically
 from mobee_drake.ngik.nes import Minimize, NesConfig
 from mobee_drake.ngik.solver import IkProblem
-from mobee_drake.planning.graph_paths import ShortestPath
-from mobee_drake.simulation.checkpoint import WriteFolderAtomically
+from mobee_drake.roadmaps.graph_paths import ShortestPath
 from mobee_drake.trm.task_space import TaskSpace
 
 

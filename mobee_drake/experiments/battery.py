@@ -1,0 +1,474 @@
+"""The battery runner: every experiment's runs (seeds, strategies, settings) go through
+:func:`RunBattery`, on local processes or on Ray, with the same files on disk.
+
+A battery is a list of jobs (:class:`Job`), each a module-level function called as
+``function(run, **kwargs)`` in a worker, returning a JSON-able dict, its result. ``output`` holds:
+
+- ``runs/<name>/result.json``: the job's result, checked as strict JSON (a NaN or an infinity
+  fails the job, naming it) and written atomically by the runner when the job returns. A job whose
+  result file exists is not run again: its stored result is returned (run-if-missing).
+- ``runs/<name>/progress.json``: the last count the job gave :meth:`RunFolder.Progress`, from
+  which the parent draws the run's bar (a battery bar counts the runs, a bar per running job
+  counts its units; the parent reads the records every :data:`POLL_SECONDS`).
+- anything else in ``runs/<name>/``: the job's own checkpoints. A job that saves its whole state
+  there (atomically, see :mod:`mobee_drake.atomic_files`) and starts from it when it finds one
+  resumes exactly after a kill, on either backend.
+
+The results are returned, keyed by job name in job order, as parsed from their files, so a
+result computed now and one loaded later are equal. Jobs are deterministic functions of their
+kwargs and the runner adds nothing to their results, so a job gives the same bytes on every
+backend, and a battery interrupted on one backend finishes on another. (The environment is the
+job's business: a job whose numbers depend on the count of BLAS threads should be run with
+``OMP_NUM_THREADS`` set by the command.) A job that fails does not stop the others; when all are
+done, :class:`BatteryError` names those that failed.
+
+Backends (``Session()`` gives a ``submit(job, output)`` that returns a
+:class:`concurrent.futures.Future` of the result's JSON text; ``capacity`` is how many jobs the
+parent keeps submitted):
+
+- :class:`LocalProcesses`, the default: a pool of ``workers`` spawned processes. Each worker
+  asks Linux for SIGKILL when its parent dies (``prctl(PR_SET_PDEATHSIG)``; it checks right after
+  that the parent is still the one that started it) and ignores SIGINT, so a Ctrl-C in a terminal
+  reaches only the parent, which kills its workers and re-raises. During a battery, SIGTERM
+  raises :class:`SystemExit` in the parent (as SIGINT raises :class:`KeyboardInterrupt`), so the
+  same clean-up runs; after a SIGKILL of the parent the kernel kills the workers (processes
+  that a job starts itself are the job's to tie to its own life). A worker that dies (say, at the
+  hands of the OOM killer) breaks the pool: the battery stops with :class:`BatteryError`, and
+  running it again resumes.
+- :class:`Ray`: tasks on a Ray cluster (``ray.init(address)``; no address, a local instance, or
+  the cluster ``RAY_ADDRESS`` names). When Ray is already initialised, the battery uses that
+  connection (so a caller can pass ``runtime_env`` and other options to :func:`ray.init` itself)
+  and leaves it open; otherwise it initialises Ray and shuts it down at the end. Ray retries a
+  task whose worker died (its ``max_retries``), and the job resumes from its checkpoint. On a
+  cluster of several nodes, ``output`` must be on storage that every node sees at the same path
+  (a shared file system), and the package must be installed on every node. On Ctrl-C or SIGTERM
+  the tasks are cancelled (their workers killed) before Ray is shut down.
+
+  What a SIGKILL of the driver leaves of a local instance (Ray 2.60, Linux): Ray starts the GCS,
+  raylet, dashboard and monitors with kernel fate-sharing (``PR_SET_PDEATHSIG`` = SIGKILL), and
+  the workers exit when their raylet goes. But the raylet's two agents (``ray::DashboardAgent``,
+  ``ray::RuntimeEnvAgent``) notice that the raylet died, then wait up to 60 s to report it to
+  the dead GCS before exiting. So a local instance that the battery starts has a watchdog: a
+  small process of its own session, started before :func:`ray.init`, that notes every second
+  the instance's processes (the driver's children run from Ray's package folder and all their
+  descendants, with their start times) and SIGKILLs those still alive when its stdin, a pipe
+  from the driver, closes: at the end of the battery, or when the kernel closes it because the
+  driver died.
+- :class:`InProcess`: one job after the other in the calling process, for tests and debugging
+  (a breakpoint in a job works); the display only advances between jobs.
+"""
+
+import collections
+from collections.abc import Callable, Iterable
+import concurrent.futures
+import contextlib
+import ctypes
+import dataclasses
+import functools
+import json
+import math
+import multiprocessing
+import os
+import pathlib
+import pickle
+import re
+import select
+import signal
+import subprocess
+import sys
+import threading
+from typing import ClassVar
+
+from tqdm import tqdm
+
+from mobee_drake.atomic_files import WriteJsonAtomically, WriteTextAtomically
+
+RESULT = "result.json"
+PROGRESS = "progress.json"
+# How often the parent reads the running jobs' progress records (s).
+POLL_SECONDS = 1.0
+RAY_MISSING = '--ray needs the optional extra: pip install "mobee-drake[ray]"'
+_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._+=-]*")
+
+
+@dataclasses.dataclass(frozen=True)
+class Job:
+    """One run of a battery: ``function(run, **kwargs)``, with ``run`` its :class:`RunFolder`.
+
+    Attributes:
+        name: Unique in the battery; names the run's folder (letters, digits and ``._+=-``).
+        function: A module-level function (workers import it by name) returning a JSON-able
+            dict.
+        kwargs: Its keyword arguments; picklable.
+        total: The units of :meth:`RunFolder.Progress` in a whole run (0: unknown).
+    """
+
+    name: str
+    function: Callable[..., dict]
+    kwargs: dict = dataclasses.field(default_factory=dict)
+    total: int = 0
+
+    def __post_init__(self):
+        if not _NAME.fullmatch(self.name):
+            raise ValueError(
+                f"job name {self.name!r}: it names a folder; use letters, digits and ._+=-"
+            )
+        try:
+            pickle.dumps(self)
+        except (pickle.PicklingError, AttributeError, TypeError) as error:
+            raise TypeError(
+                f"job {self.name!r} cannot be sent to a worker (the function must "
+                f"be module-level, the kwargs picklable): {error}"
+            ) from error
+
+
+@dataclasses.dataclass(frozen=True)
+class RunFolder:
+    """A job's own folder, ``output/runs/<name>/``, for its checkpoints: any files but
+    ``result.json`` and ``progress.json``, which are the runner's."""
+
+    path: pathlib.Path
+
+    def Progress(self, done: int) -> None:
+        """Records that ``done`` of the job's :attr:`Job.total` units are done, for the display.
+        One small atomic write: call it every few seconds of work or so, not in a tight loop."""
+        WriteJsonAtomically(self.path / PROGRESS, {"done": int(done)})
+
+
+class BatteryError(RuntimeError):
+    """Jobs of a battery failed (the message names them); the others' results are on disk."""
+
+
+def _RunJob(job: Job, output: pathlib.Path) -> str:
+    """Runs ``job`` wherever the backend put it; writes its result and returns it as JSON."""
+    run = RunFolder(output / "runs" / job.name)
+    run.path.mkdir(parents=True, exist_ok=True)
+    run.Progress(0)
+    result = job.function(run, **job.kwargs)
+    if not isinstance(result, dict):
+        raise TypeError(f"job {job.name!r} returned a {type(result).__name__}, not a dict")
+    try:
+        text = json.dumps(result, allow_nan=False)
+    except (TypeError, ValueError) as error:
+        raise ValueError(
+            f"job {job.name!r} returned a result that is not strict JSON: {error}"
+        ) from error
+    WriteTextAtomically(run.path / RESULT, text)
+    return text
+
+
+def _RunHere(job: Job, output: pathlib.Path) -> concurrent.futures.Future:
+    future = concurrent.futures.Future()
+    try:
+        future.set_result(_RunJob(job, output))
+    except Exception as error:
+        future.set_exception(error)
+    return future
+
+
+@dataclasses.dataclass(frozen=True)
+class InProcess:
+    """Runs the jobs one after the other in the calling process (for tests and debugging)."""
+
+    capacity: ClassVar[float] = 1
+
+    @contextlib.contextmanager
+    def Session(self):
+        yield _RunHere
+
+
+def _DieWithParent(parent: int) -> None:
+    """The local workers' initializer: SIGKILL when the parent dies (Linux); no SIGINT."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        PR_SET_PDEATHSIG = 1
+        if ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0):
+            raise OSError(ctypes.get_errno(), "prctl(PR_SET_PDEATHSIG) failed")
+        if os.getppid() != parent:  # The parent died before the prctl.
+            os._exit(1)
+
+
+@dataclasses.dataclass(frozen=True)
+class LocalProcesses:
+    """Runs the jobs in ``workers`` spawned processes of this machine."""
+
+    workers: int = 1
+
+    @property
+    def capacity(self) -> float:
+        return self.workers
+
+    @contextlib.contextmanager
+    def Session(self):
+        pool = concurrent.futures.ProcessPoolExecutor(
+            self.workers,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_DieWithParent,
+            initargs=(os.getpid(),),
+        )
+        try:
+            yield functools.partial(pool.submit, _RunJob)
+        except BaseException:
+            # Interrupted: no worker outlives the battery (Python 3.11 has no public way).
+            for process in list(pool._processes.values()):
+                process.kill()
+            raise
+        finally:
+            pool.shutdown(cancel_futures=True)
+
+
+def _ProcessTable() -> dict[int, tuple[int, int]]:
+    """Every live process (zombies excepted): pid -> (parent pid, start time), from /proc."""
+    table = {}
+    for entry in os.scandir("/proc"):
+        if entry.name.isdigit():
+            try:
+                fields = pathlib.Path(entry.path, "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if fields[0] != "Z":
+                table[int(entry.name)] = (int(fields[1]), int(fields[19]))
+    return table
+
+
+def _CommandLine(pid: int) -> str:
+    try:
+        return pathlib.Path(f"/proc/{pid}/cmdline").read_bytes().decode(errors="replace")
+    except OSError:
+        return ""
+
+
+def _WatchRay(driver: int, ray_folder: str) -> None:
+    """The watchdog of a local Ray instance (see the module's docstring), in its own process:
+    until its stdin closes, notes the processes of the instance that ``driver`` started; then
+    kills those still alive (the same pid and start time)."""
+    tracked = {}
+    while not select.select([sys.stdin], [], [], POLL_SECONDS)[0]:
+        table = _ProcessTable()
+        children = collections.defaultdict(list)
+        for pid, (parent, _) in table.items():
+            children[parent].append(pid)
+        stack = [
+            pid
+            for pid in children[driver]
+            if pid != os.getpid() and ray_folder in _CommandLine(pid)
+        ]
+        while stack:
+            pid = stack.pop()
+            tracked[pid] = table[pid][1]
+            stack.extend(children[pid])
+    table = _ProcessTable()
+    for pid, start in tracked.items():
+        if pid in table and table[pid][1] == start:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+
+
+@contextlib.contextmanager
+def _RayWatchdog(ray_folder: str):
+    """Runs :func:`_WatchRay` for this driver while the context lasts."""
+    code = f"from {__name__} import _WatchRay; _WatchRay({os.getpid()}, {ray_folder!r})"
+    watchdog = subprocess.Popen(
+        [sys.executable, "-c", code], stdin=subprocess.PIPE, start_new_session=True
+    )
+    try:
+        yield
+    finally:
+        watchdog.stdin.close()
+        watchdog.wait()
+
+
+@dataclasses.dataclass(frozen=True)
+class Ray:
+    """Runs the jobs as tasks on a Ray cluster at ``address`` (None: a local instance)."""
+
+    address: str | None = None
+    capacity: ClassVar[float] = math.inf
+
+    @contextlib.contextmanager
+    def Session(self):
+        try:
+            import ray
+        except ImportError:
+            raise ImportError(RAY_MISSING) from None
+        with contextlib.ExitStack() as stack:
+            if not ray.is_initialized():
+                if sys.platform.startswith("linux"):
+                    stack.enter_context(_RayWatchdog(os.path.dirname(ray.__file__)))
+                ray.init(address=self.address)
+                stack.callback(ray.shutdown)
+            remote, refs = ray.remote(_RunJob), []
+
+            def Submit(job: Job, output: pathlib.Path) -> concurrent.futures.Future:
+                refs.append(remote.remote(job, output))
+                return refs[-1].future()
+
+            try:
+                yield Submit
+            except BaseException:
+                for ref in refs:
+                    ray.cancel(ref, force=True)
+                raise
+
+
+Backend = InProcess | LocalProcesses | Ray
+
+
+def _Terminate(signum, frame):
+    raise SystemExit(128 + signum)
+
+
+@contextlib.contextmanager
+def _TerminationRaises():
+    """SIGTERM raises SystemExit in the main thread while the context lasts."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _Terminate)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL if previous is None else previous)
+
+
+class _Display:
+    """The battery's bar and a bar per running job that has a progress record."""
+
+    def __init__(self, output: pathlib.Path, jobs: int, done: int, description: str, enabled: bool):
+        self.output, self.enabled, self.runs = output, enabled, {}
+        self.battery = tqdm(
+            total=jobs,
+            initial=done,
+            desc=description or "battery",
+            unit="run",
+            disable=not enabled,
+            dynamic_ncols=True,
+        )
+
+    def Update(self, running: Iterable[Job], finished: int) -> None:
+        self.battery.update(finished)
+        if not self.enabled:
+            return
+        running = {job.name: job for job in running}
+        for name in self.runs.keys() - running.keys():
+            self.runs.pop(name).close()
+        for name, job in running.items():
+            try:
+                done = json.loads((self.output / "runs" / name / PROGRESS).read_text())["done"]
+            except (OSError, ValueError):  # Not started.
+                continue
+            if name not in self.runs:
+                self.runs[name] = tqdm(
+                    total=job.total or None,
+                    initial=done,
+                    desc=name,
+                    leave=False,
+                    dynamic_ncols=True,
+                )
+            self.runs[name].update(done - self.runs[name].n)
+
+    def Close(self) -> None:
+        for bar in self.runs.values():
+            bar.close()
+        self.battery.close()
+
+
+def _StoredResult(output: pathlib.Path, name: str) -> dict | None:
+    try:
+        return json.loads((output / "runs" / name / RESULT).read_text())
+    except FileNotFoundError:
+        return None
+
+
+def RunBattery(
+    jobs: Iterable[Job],
+    output: str | pathlib.Path,
+    *,
+    backend: Backend | None = None,
+    workers: int = 1,
+    progress: bool = True,
+    description: str = "",
+) -> dict[str, dict]:
+    """Runs the ``jobs`` that have no result in ``output`` yet and returns every job's result,
+    keyed by name in job order (see the module's docstring).
+
+    Args:
+        jobs: The battery's runs.
+        output: The battery's folder (``runs/<name>/`` for each job).
+        backend: Where the jobs run; None: ``LocalProcesses(workers)``.
+        workers: The local processes of the default backend.
+        progress: Whether to show the bars.
+        description: The battery bar's label.
+
+    Raises:
+        BatteryError: When jobs failed, after the others finished.
+    """
+    jobs, output = list(jobs), pathlib.Path(output).absolute()  # Workers have their own cwd.
+    names = [job.name for job in jobs]
+    if len(set(names)) != len(names):
+        raise ValueError(f"job names repeat: {sorted({n for n in names if names.count(n) > 1})}")
+    results = {job.name: _StoredResult(output, job.name) for job in jobs}
+    queue = collections.deque(job for job in jobs if results[job.name] is None)
+    if not queue:
+        return results
+    # Records of an interrupted battery would show bars for jobs not yet started.
+    for job in queue:
+        (output / "runs" / job.name / PROGRESS).unlink(missing_ok=True)
+    backend = backend or LocalProcesses(workers)
+    errors = {}
+    display = _Display(output, len(jobs), len(jobs) - len(queue), description, progress)
+    try:
+        with _TerminationRaises(), backend.Session() as submit:
+            running = {}
+            while queue or running:
+                while queue and len(running) < backend.capacity:
+                    job = queue.popleft()
+                    try:
+                        running[submit(job, output)] = job
+                    except Exception as error:  # A broken pool, say.
+                        errors[job.name] = error
+                finished, _ = concurrent.futures.wait(
+                    running, POLL_SECONDS, concurrent.futures.FIRST_COMPLETED
+                )
+                for future in finished:
+                    job = running.pop(future)
+                    try:
+                        results[job.name] = json.loads(future.result())
+                    except Exception as error:
+                        errors[job.name] = error
+                display.Update(running.values(), len(finished))
+    finally:
+        display.Close()
+    if errors:
+        failures = [
+            f"{name}: {type(errors[name]).__name__}: {errors[name]}"
+            for name in names
+            if name in errors
+        ]
+        raise BatteryError(
+            f"{len(errors)} of {len(jobs)} jobs failed:\n" + "\n".join(failures)
+        ) from next(iter(errors.values()))
+    return results
+
+
+def AddBackendArguments(parser, workers: int = 1) -> None:
+    """Adds ``--workers`` and ``--ray [ADDRESS]`` to an experiment's command line."""
+    parser.add_argument(
+        "--workers", type=int, default=workers, help="local worker processes (default %(default)s)"
+    )
+    parser.add_argument(
+        "--ray",
+        nargs="?",
+        const="",
+        default=None,
+        metavar="ADDRESS",
+        help="run on Ray instead: a cluster's address, or none for a local Ray instance "
+        '(needs pip install "mobee-drake[ray]")',
+    )
+
+
+def BackendOf(args) -> Backend:
+    """The backend an experiment's command line asks for (see :func:`AddBackendArguments`)."""
+    if args.ray is not None:
+        return Ray(address=args.ray or None)
+    return LocalProcesses(args.workers)

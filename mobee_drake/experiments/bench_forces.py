@@ -1,0 +1,204 @@
+"""Benchmark: MoBeE total-force evaluations per second for a robot among boxes (Fig. 2.4).
+
+Like the scalability experiment of dissertation ch. 2.4: every controlled joint is driven through
+its range by its own oscillator, and for each new pose the whole MoBeE evaluation runs (forward
+kinematics, SceneGraph's signed-distance query, every force term and their total), against 0 to
+several hundred boxes in the robot's workspace: the iCub upper body (20 joints, 14 primitives) or
+the Katana of App. B (5 joints, 10 primitives). With ``--churn``, as in Alg. 1, objects are removed
+and inserted while the robot moves: before every evaluation one box is removed and a new one
+inserted (our single-threaded stand-in for the source's sensory thread flooding the model).
+One process, one core.
+
+Run: ``mobee-drake bench forces [--robot katana] [--churn] [--plot FILE.png]`` (or
+``python -m mobee_drake.experiments.bench_forces``).
+"""
+
+import argparse
+import dataclasses as dc
+import time
+
+import numpy as np
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+from pydrake.systems.framework import DiagramBuilder
+
+from mobee_drake.experiments.plots import plt
+from mobee_drake.mobee.system import Mobee
+from mobee_drake.robots.icub import IcubConfig
+from mobee_drake.robots.scenario_robot import AddScenarioRobot
+from mobee_drake.robots.zero_position import ZeroPositionConfig
+from mobee_drake.world.live_world import LiveWorld
+from mobee_drake.world.objects import Box, SceneObject
+
+# Where boxes are placed, per robot (root frame, metres). In front of the iCub (x backwards, y
+# right, z up): 60 cm in front of the chest, 1.2 m across and 1 m high; the arms reach about half
+# of it. Around the Katana: its reach (about 0.5 m around the shoulder at (0, 0, -0.01)).
+BOX_REGIONS = {
+    "icub": (np.array([-0.80, -0.60, -0.40]), np.array([-0.20, 0.60, 0.60])),
+    "katana": (np.array([-0.50, -0.50, -0.20]), np.array([0.50, 0.50, 0.55])),
+}
+ROBOTS = {"icub": IcubConfig, "katana": ZeroPositionConfig}
+
+
+@dc.dataclass
+class ForceBenchmarkResult:
+    num_obstacles: int
+    # The best and the median rate over the repeats (this machine's speed varies between runs).
+    best_per_second: float
+    median_per_second: float
+    mean_pairs_in_fields: float
+
+
+def _RandomBox(name: str, robot: str, rng: np.random.Generator) -> SceneObject:
+    low, high = BOX_REGIONS[robot]
+    return SceneObject(
+        name=name,
+        shape=Box(size=rng.uniform(0.02, 0.05, size=3).tolist()),
+        position=rng.uniform(low, high).tolist(),
+    )
+
+
+def _BuildRobotAmongBoxes(robot: str, num_boxes: int, rng: np.random.Generator):
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
+    overlay, joints = AddScenarioRobot(plant, scene_graph, ROBOTS[robot]())
+    world = LiveWorld(plant, scene_graph)
+    for i in range(num_boxes):
+        world.Register(_RandomBox(f"box{i}", robot, rng))
+    plant.Finalize()
+    mobee = Mobee.AddToBuilder(
+        builder, plant=plant, scene_graph=scene_graph, robot=overlay, joints=joints
+    )
+    diagram = builder.Build()
+    return diagram, plant, mobee, world
+
+
+def _OscillatorPoses(
+    mobee: Mobee, num_poses: int, rng: np.random.Generator, amplitude: float = 1.0
+) -> np.ndarray:
+    """Poses 10 ms apart, each joint on its own sinusoid.
+
+    With ``amplitude`` 1 every joint sweeps its whole range (Fig. 2.4); with a smaller amplitude it
+    sweeps that fraction of its range around the home posture (clipped to the limits).
+    """
+    q_min, q_max = mobee.position_limits
+    period = rng.uniform(4.0, 12.0, size=q_min.size)  # seconds per sweep
+    phase = rng.uniform(0, 2 * np.pi, size=q_min.size)
+    t = 0.01 * np.arange(num_poses)[:, None]
+    center = (q_min + q_max) / 2 if amplitude >= 1 else mobee.home
+    q = center + amplitude * (q_max - q_min) / 2 * np.sin(2 * np.pi * t / period + phase)
+    return np.clip(q, q_min, q_max)
+
+
+def MeasureForceEvaluations(
+    num_obstacles: int,
+    *,
+    robot: str = "icub",
+    num_poses: int = 2000,
+    repeats: int = 5,
+    amplitude: float = 1.0,
+    churn: bool = False,
+    seed: int = 0,
+) -> ForceBenchmarkResult:
+    """Times ``repeats`` sweeps of ``num_poses`` total-force evaluations among boxes; with
+    ``churn``, each evaluation follows the removal of one box and the insertion of another."""
+    rng = np.random.default_rng(seed)
+    diagram, plant, mobee, world = _BuildRobotAmongBoxes(robot, num_obstacles, rng)
+    context = diagram.CreateDefaultContext()
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    mobee_context = mobee.GetMyContextFromRoot(context)
+    boxes = [f"box{i}" for i in range(num_obstacles)]
+    replacements = [
+        _RandomBox(f"new{k}", robot, rng)
+        for k in range(num_poses * repeats if churn and boxes else 0)
+    ]
+    total, contacts = mobee.GetOutputPort("total"), mobee.GetOutputPort("field_contacts")
+    # The plant's positions are the controlled joints, possibly in another order.
+    order = [plant.GetJointByName(j).position_start() for j in mobee.joints]
+    poses = _OscillatorPoses(mobee, num_poses, rng, amplitude)
+    x = plant.GetPositions(plant_context)
+    rates = []
+    for repeat in range(repeats):
+        start = time.perf_counter()
+        for k, q in enumerate(poses):
+            if replacements:
+                new = replacements[repeat * num_poses + k]
+                world.Remove(context, boxes[k % len(boxes)])
+                world.Add(context, new)
+                boxes[k % len(boxes)] = new.name
+            x[order] = q
+            plant.SetPositions(plant_context, x)
+            total.Eval(mobee_context)
+        rates.append(num_poses / (time.perf_counter() - start))
+    pairs = 0
+    for q in poses[::10]:  # Untimed: how busy the field term was.
+        x[order] = q
+        plant.SetPositions(plant_context, x)
+        pairs += len(contacts.Eval(mobee_context))
+    return ForceBenchmarkResult(
+        num_obstacles, max(rates), float(np.median(rates)), pairs / len(poses[::10])
+    )
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--robot", choices=sorted(ROBOTS), nargs="+", default=["icub"])
+    parser.add_argument("--obstacles", type=int, nargs="+", default=[0, 10, 30, 100, 300])
+    parser.add_argument("--poses", type=int, default=2000, help="evaluations per sweep")
+    parser.add_argument("--repeats", type=int, default=5, help="sweeps per row")
+    parser.add_argument(
+        "--amplitude",
+        type=float,
+        default=1.0,
+        help="fraction of each joint's range swept (1: the whole range, Fig. 2.4)",
+    )
+    parser.add_argument(
+        "--churn",
+        action="store_true",
+        help="remove one box and insert another before every evaluation (Alg. 1)",
+    )
+    parser.add_argument("--plot", default="", help="save the curves (like Fig. 2.4) to this PNG")
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args(argv)
+    print(
+        "| robot | boxes | evaluations/s (best) | evaluations/s (median) | us/evaluation (best) "
+        "| pairs inside fields (mean) |"
+    )
+    print("|---|---:|---:|---:|---:|---:|")
+    curves = {}
+    for robot in args.robot:
+        for n in args.obstacles:
+            r = MeasureForceEvaluations(
+                n,
+                robot=robot,
+                num_poses=args.poses,
+                repeats=args.repeats,
+                amplitude=args.amplitude,
+                churn=args.churn,
+                seed=args.seed,
+            )
+            curves.setdefault(robot, []).append((n, r.best_per_second, r.median_per_second))
+            print(
+                f"| {robot} | {n} | {r.best_per_second:,.0f} | {r.median_per_second:,.0f} | "
+                f"{1e6 / r.best_per_second:.0f} | {r.mean_pairs_in_fields:.2f} |",
+                flush=True,
+            )
+    if args.plot:
+        figure, axis = plt.subplots(figsize=(6, 4))
+        for robot, points in curves.items():
+            n, best, median = np.array(points).T
+            axis.plot(n, best, "o-", label=f"{robot} (best)")
+            axis.plot(n, median, "x--", label=f"{robot} (median)")
+        axis.set_yscale("log")
+        axis.set_xlabel("boxes in the workspace" + (" (churning)" if args.churn else ""))
+        axis.set_ylabel("MoBeE evaluations per second")
+        axis.grid(True, which="both", alpha=0.3)
+        axis.legend()
+        figure.tight_layout()
+        figure.savefig(args.plot, dpi=90)
+        print(f"plot: {args.plot}")
+
+
+if __name__ == "__main__":
+    main()

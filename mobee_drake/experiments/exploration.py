@@ -1,0 +1,99 @@
+"""Exploring agents on the kinematic iCub, run until a stop condition: the shared step of the
+ch. 7 experiments and of the MDP the ch. 8 reach learner starts from."""
+
+import pathlib
+import time
+
+import numpy as np
+
+from mobee_drake.planning.explorers import INITIALIZATIONS
+from mobee_drake.planning.supervisor import ExploreAttractor, ExploringAgent
+from mobee_drake.scenario import BuildScenario, Scenario
+from mobee_drake.station.checkpoint import SaveCheckpoint
+from mobee_drake.station.runner import Advance
+from mobee_drake.station.world_events import MakeSimulator
+
+
+def ExplorationScenario(
+    agents: list[ExploringAgent], objects=(), robot=None, random_seed: int = 0
+) -> Scenario:
+    """A headless kinematic scenario in which ``agents`` explore (``robot``: the iCub's
+    configuration, by default the upper body's joints; agent i's generator is seeded with
+    ``random_seed + i``)."""
+    scenario = Scenario()
+    scenario.robot = robot or scenario.robot
+    scenario.objects = list(objects)
+    scenario.attractor = ExploreAttractor(agents=agents)
+    scenario.time_step = 0.02
+    scenario.random_seed = random_seed
+    return scenario
+
+
+def StartExploration(scenario: Scenario):
+    """The scenario built and initialised: the station, its simulator, the exploration
+    supervisor and the supervisor's context."""
+    station = BuildScenario(scenario)
+    simulator = MakeSimulator(station)
+    simulator.Initialize()
+    supervisor = station.client
+    return station, simulator, supervisor, supervisor.GetMyContextFromRoot(simulator.get_context())
+
+
+def Misses(explorer) -> np.ndarray:
+    """Per state-action, the share of its tries that did not end in its goal state (0 untried)."""
+    space, counts = explorer.space, explorer.transitions.counts
+    initial = 1 + INITIALIZATIONS[explorer.config.initialization]  # goal counts before tries
+    hits = counts[np.arange(space.num_state_actions), space.action_goal] - initial
+    return np.where(explorer.tries > 0, 1 - hits / np.maximum(explorer.tries, 1), 0.0)
+
+
+def Explore(
+    scenario: Scenario,
+    stop,
+    snapshots=(),
+    chunk: float = 2.0,
+    keep: pathlib.Path | None = None,
+    observer=None,
+    progress=None,
+) -> dict:
+    """Runs until ``stop(records)``; returns per-agent tries (and values at ``snapshots``); with
+    ``keep``, saves the final checkpoint there (the learned models, for a planner to reuse);
+    ``observer(station)``, if given, returns a callable run on the root context after every
+    chunk of the simulation and a function giving its data for the result; ``progress(n)``, if
+    given, is told the number of actions done after every chunk."""
+    station, simulator, supervisor, supervisor_context = StartExploration(scenario)
+    context = simulator.get_context()
+    observe, observed = observer(station) if observer else (None, dict)
+    taken, coverage, start = {}, [], time.perf_counter()
+    while True:
+        Advance(station, simulator, context.get_time() + chunk, after_chunk=observe)
+        records = supervisor.Records(supervisor_context)
+        done = sum(r.actions_done for r in records)
+        if progress is not None:
+            progress(done)
+        coverage.append([done] + [int((r.explorer.tries > 0).sum()) for r in records])
+        for count in snapshots:
+            if count not in taken and records[0].actions_done >= count:
+                taken[count] = dict(
+                    tries=records[0].explorer.tries.tolist(),
+                    values=records[0].explorer.Values()[0].tolist(),
+                )
+        if stop(records):
+            break
+    if keep is not None:
+        SaveCheckpoint(station, context, keep)
+    report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
+    return dict(
+        agents=supervisor.agent_names,
+        tries=[r.explorer.tries.tolist() for r in records],
+        values=[r.explorer.Values()[0].tolist() for r in records],
+        misses=[Misses(r.explorer).tolist() for r in records],
+        goals=[r.explorer.space.centres[r.explorer.space.action_goal].tolist() for r in records],
+        actions=[r.actions_done for r in records],
+        snapshots=taken,
+        coverage=coverage,
+        simulated_seconds=context.get_time(),
+        wall_seconds=time.perf_counter() - start,
+        penetrating_steps=report.penetrating_steps,
+        **observed(),
+    )

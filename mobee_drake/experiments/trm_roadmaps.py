@@ -1,0 +1,132 @@
+"""Build the example roadmaps (ch. 3.4), measure them and show them.
+
+For each example: the roadmap (``<example>/roadmap.npz|json``), a figure of the palm's positions
+over the vertices with the edges (as Fig. 3.1-3.3, 3.8), a Meshcat recording (``<example>.html``:
+the marker cloud, the edges and the robot moving along the path between the two vertices
+farthest apart in task space) and a report of what was measured: size, build speed, and how
+many edges are free of collisions when interpolated (TRM edges are not checked when built).
+
+Run: ``mobee-drake experiment trm --output DIR [--examples reach_into raise_a_glass]
+[--max-vertices N] [--seed S]``.
+"""
+
+import argparse
+import pathlib
+
+import numpy as np
+from pydrake.geometry import Meshcat
+
+from mobee_drake.experiments.plots import plt
+from mobee_drake.trm.display import MarkerCloud, PathMotion, RecordMotion, ShowRoadmap
+from mobee_drake.trm.examples import EXAMPLES, OpenBox, TrmExample
+from mobee_drake.trm.roadmap import BuildTrm, TaskRelevantRoadmap, TrmConfig
+
+EDGE_SAMPLES = 10  # interpolated poses per edge for the collision check
+
+
+def EdgeCollisions(example: TrmExample, roadmap: TaskRelevantRoadmap) -> int:
+    """How many edges collide somewhere along their joint-space interpolation."""
+    colliding = 0
+    for a, b in roadmap.edges:
+        for s in np.linspace(0.0, 1.0, EDGE_SAMPLES + 1)[1:-1]:
+            q = (1 - s) * roadmap.q[a] + s * roadmap.q[b]
+            if example.model.Evaluate(q).collision_pairs:
+                colliding += 1
+                break
+    return colliding
+
+
+def FarthestPair(roadmap: TaskRelevantRoadmap) -> tuple[int, int]:
+    y = roadmap.y
+    distances = np.linalg.norm(y[:, None, :] - y[None, :, :], axis=2)
+    a, b = np.unravel_index(np.argmax(distances), distances.shape)
+    return int(a), int(b)
+
+
+def Plot(
+    points: np.ndarray, roadmap: TaskRelevantRoadmap, title: str, path: pathlib.Path, boxes: bool
+) -> None:
+
+    figure = plt.figure(figsize=(6, 5))
+    axes = figure.add_subplot(projection="3d")
+    for a, b in roadmap.edges:
+        axes.plot(*points[[a, b]].T, color="0.75", linewidth=0.4)
+    axes.scatter(*points.T, s=6, color="tab:blue")
+    if boxes:  # the open box's walls and floor as wireframes
+        signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).T.reshape(-1, 3)
+        for obj in OpenBox():
+            corners = np.array(obj.position) + signs * np.array(obj.shape.size) / 2
+            for i, j in zip(*np.triu_indices(8, 1)):
+                if np.sum(signs[i] != signs[j]) == 1:
+                    axes.plot(*corners[[i, j]].T, color="tab:brown", linewidth=0.6)
+    axes.set_xlabel("x (m, back)")
+    axes.set_ylabel("y (m, right)")
+    axes.set_zlabel("z (m, up)")
+    axes.set_title(title)
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+
+
+def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) -> str:
+    meshcat = Meshcat()
+    example = EXAMPLES[name](meshcat)
+    roadmap = BuildTrm(
+        example.problem, example.task_space, example.q_init, config, np.random.default_rng(seed)
+    )
+    roadmap.Save(output / name)
+    points = MarkerCloud(example.model, roadmap, example.marker)
+    Plot(
+        points,
+        roadmap,
+        f"{name}: {roadmap.num_vertices} vertices",
+        output / f"{name}.png",
+        boxes=name == "reach_into",
+    )
+    start, goal = FarthestPair(roadmap)
+    path = roadmap.Path(start, goal)
+    ShowRoadmap(meshcat, points, roadmap)
+    RecordMotion(example.model, PathMotion(roadmap, path))
+    (output / f"{name}.html").write_text(meshcat.StaticHtml())
+    colliding = EdgeCollisions(example, roadmap)
+    seconds = roadmap.build_seconds
+    extent = roadmap.y.max(axis=0) - roadmap.y.min(axis=0)
+    return "\n".join(
+        [
+            f"## {name}",
+            "",
+            f"- {roadmap.num_vertices} vertices, {len(roadmap.edges)} edges, "
+            f"{len(roadmap.simplices)} simplices in R; {roadmap.searches} NGIK searches "
+            f"({roadmap.searches - roadmap.num_vertices} rejected)",
+            f"- built in {seconds:.1f} s: {roadmap.num_vertices / seconds:.2f} vertices/s, "
+            f"{roadmap.searches / seconds:.2f} searches/s",
+            f"- task-space extent {np.round(extent, 3).tolist()} m; spacing d = {config.spacing} m",
+            f"- edges colliding along their interpolation ({EDGE_SAMPLES} samples): {colliding} of "
+            f"{len(roadmap.edges)}",
+            f"- path shown: {len(path)} vertices from {start} to {goal}",
+            f"- figure `{name}.png`, Meshcat recording `{name}.html`, roadmap `{name}/`",
+            "",
+        ]
+    )
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(
+        prog="mobee-drake experiment trm", description=__doc__.split("\n")[0]
+    )
+    parser.add_argument("--output", required=True)
+    parser.add_argument("--examples", nargs="+", choices=sorted(EXAMPLES), default=list(EXAMPLES))
+    parser.add_argument("--max-vertices", type=int, default=TrmConfig.max_vertices)
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args(argv)
+    output = pathlib.Path(args.output)
+    output.mkdir(parents=True, exist_ok=True)
+    config = TrmConfig(max_vertices=args.max_vertices)
+    sections = [RunExample(name, output, config, args.seed) for name in args.examples]
+    report = "# Task-relevant roadmaps\n\n" + "\n".join(sections)
+    (output / "report.md").write_text(report)
+    print(report)
+
+
+if __name__ == "__main__":
+    main()

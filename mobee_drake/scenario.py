@@ -1,0 +1,122 @@
+"""Scenarios: what to simulate, read from YAML, built into a station with its client, and run.
+
+This is the composition root: the only module that knows the station and every client. A
+scenario (``diagrams/*.yaml``) is a :class:`~mobee_drake.station.config.StationConfig` (the robot,
+its world, MoBeE, what moves the robot, what to show, the random seed) plus the client that sets
+MoBeE's attractor (one tag of ``CLIENTS``) and the duration. :func:`LoadScenario` reads one (a
+file, or the name of a shipped scenario); errors name the file, the key and, where YAML gives it,
+the line. :func:`BuildScenario` builds it; :func:`RunScenario` runs it.
+
+A client of your own is a dataclass with ``Validate()`` and ``AddToBuilder(parts)`` (see
+:mod:`mobee_drake.station.parts`): build it with
+``MakeMobeeStation(config, prebuild_callback=client.AddToBuilder)``, no scenario file needed.
+"""
+
+import dataclasses as dc
+import pathlib
+
+from pydrake.common.yaml import yaml_load_typed
+from pydrake.geometry import Meshcat
+
+from mobee_drake.planning.supervisor import ExploreAttractor
+from mobee_drake.resources import ResolveScenarioFile
+from mobee_drake.station.attractors import FixedAttractor, RandomAttractors, SliderAttractor
+from mobee_drake.station.builder import MakeMobeeStation, Station
+from mobee_drake.station.config import StationConfig, StationConfigErrors
+from mobee_drake.station.executor import StateActionAttractor
+from mobee_drake.station.runner import RunStation, RunSummary
+from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
+
+# The clients a scenario file can name, by their YAML tags.
+CLIENTS = (
+    FixedAttractor,
+    RandomAttractors,
+    SliderAttractor,
+    ExploreAttractor,
+    StateActionAttractor,
+)
+
+
+@dc.dataclass
+class Scenario(StationConfig):
+    """Everything a run needs (see ``diagrams/`` for examples)."""
+
+    # What sets MoBeE's attractor: one of CLIENTS.
+    attractor: (
+        FixedAttractor
+        | RandomAttractors
+        | SliderAttractor
+        | ExploreAttractor
+        | StateActionAttractor
+    ) = dc.field(default_factory=FixedAttractor)
+    # Seconds to simulate.
+    duration: float = 10.0
+
+
+def ScenarioErrors(scenario: Scenario) -> list[str]:
+    """What is wrong with ``scenario`` that its types cannot say (empty: nothing)."""
+    errors = StationConfigErrors(scenario)
+    if not scenario.duration > 0:
+        errors.append(f"duration must be > 0, got {scenario.duration}")
+    try:
+        scenario.attractor.Validate()
+    except ValueError as e:
+        errors.append(str(e))
+    return errors
+
+
+def ValidateScenario(scenario: Scenario, source: str = "scenario") -> None:
+    """Raises YamlFileError naming ``source`` and the first thing wrong with ``scenario``."""
+    errors = ScenarioErrors(scenario)
+    if errors:
+        raise YamlFileError(f"{source}: {errors[0]}")
+
+
+def LoadScenario(
+    filename: str | pathlib.Path,
+    overrides: str | list[str] | None = None,
+    *,
+    scenario_name: str | None = None,
+) -> Scenario:
+    """Loads a scenario (a file, or a shipped scenario's name; with ``scenario_name``, that
+    top-level key of the file), then applies ``overrides``: YAML texts with the same keys, in
+    order (e.g. ``{mover: !Dynamic {control: force}}``)."""
+    filename = ResolveScenarioFile(filename)
+    scenario = LoadYamlFile(schema=Scenario, filename=filename, child_name=scenario_name)
+    for text in [overrides] if isinstance(overrides, str) else overrides or []:
+        try:
+            scenario = yaml_load_typed(schema=Scenario, data=text, defaults=scenario)
+        except (RuntimeError, ValueError) as e:
+            raise YamlFileError(f"overrides '{text}': {e}") from e
+    ValidateScenario(scenario, str(filename))
+    return scenario
+
+
+def BuildScenario(scenario: Scenario, meshcat: Meshcat | None = None) -> Station:
+    """The station of ``scenario`` with its client (``station.client``); with ``meshcat``, also
+    the viewer."""
+    return MakeMobeeStation(scenario, meshcat, prebuild_callback=scenario.attractor.AddToBuilder)
+
+
+def RunScenario(
+    scenario: Scenario,
+    *,
+    meshcat: Meshcat | None = None,
+    record: str | None = None,
+    realtime_rate: float = 0.0,
+    progress: bool = False,
+    checkpoint: str | None = None,
+) -> RunSummary:
+    """Builds and runs ``scenario`` for its duration (see
+    :func:`~mobee_drake.station.runner.RunStation`); ``record`` (an HTML file) records the run in
+    ``meshcat``, or in a Meshcat of its own."""
+    if record and meshcat is None:
+        meshcat = Meshcat()
+    return RunStation(
+        BuildScenario(scenario, meshcat),
+        scenario.duration,
+        record=record,
+        realtime_rate=realtime_rate,
+        progress=progress,
+        checkpoint=checkpoint,
+    )

@@ -1,1 +1,0 @@
-"""Simulating the iCub under MoBeE: scenarios, robots, world, viewer and runner."""

@@ -1,0 +1,356 @@
+"""The station: the robot, its world, MoBeE, what moves the robot, companions and the viewer, in
+one Diagram that knows no client (clients connect through :mod:`mobee_drake.station.parts`).
+
+What moves the robot (``StationConfig.mover``):
+
+- **kinematic**: MoBeE's virtual dynamics (eq. 5.7) are the robot. :class:`VirtualDynamics`
+  integrates them every ``time_step`` and its positions pose the robot's geometry through
+  ``MultibodyPositionToGeometryPose``; the plant only supplies kinematics and geometry and is not
+  simulated.
+- **reflex**: the same kinematic robot, moved by MoBeE 1.0's position moves and reflex; the
+  attractor is the move command.
+- **dynamic**: the MultibodyPlant is simulated with contact (its ``plant_config``), and follows
+  MoBeE, which sees the plant's measured state, through one of the modalities of ch. 5.2:
+
+  - ``position``: MoBeE's virtual trajectory (q, v integrated by :class:`VirtualDynamics` from the
+    forces at the measured state, as the real iCub's MoBeE sent commands every period) is the
+    desired state of a joint-space inverse-dynamics PD controller (gravity and inertia
+    compensated, as the iCub's position control);
+  - ``velocity``: the same controller tracking the virtual velocity only (no position gain);
+  - ``force``: the robot is torque-controlled so that it accelerates as eq. 5.7 asks: the joint
+    torques are the inverse dynamics of ``q'' = total / M`` (so gravity, inertia and Coriolis
+    forces are compensated and MoBeE's virtual mass is honoured). MoBeE's total is sampled every
+    ``time_step`` and held in between.
+
+The diagram exports ``robot_state`` ((q, v) of MoBeE's joints, whichever robot moves),
+``attractor`` (MoBeE's q*), MoBeE's ``marker_positions`` and ``field_pairs``, and takes
+``config_force`` and, unless the client sets them, ``attractor`` and ``marker_forces`` as inputs.
+"""
+
+import dataclasses as dc
+
+import numpy as np
+from pydrake.geometry import Meshcat, MeshcatVisualizer, SceneGraph
+from pydrake.multibody.plant import AddMultibodyPlant, MultibodyPlant
+from pydrake.systems.controllers import InverseDynamics, InverseDynamicsController
+from pydrake.systems.framework import Diagram, DiagramBuilder, LeafSystem, OutputPort
+from pydrake.systems.primitives import (
+    Adder,
+    MatrixGain,
+    PassThrough,
+    SharedPointerSystem,
+    ZeroOrderHold,
+)
+from pydrake.systems.rendering import MultibodyPositionToGeometryPose
+
+from mobee_drake.mobee.params import MobeeParams
+from mobee_drake.mobee.reflex import ReflexController
+from mobee_drake.mobee.system import Mobee
+from mobee_drake.robots.assembly import JointStateSelector
+from mobee_drake.robots.overlay import RobotOverlay
+from mobee_drake.robots.scenario_robot import AddScenarioRobot
+from mobee_drake.station.config import Dynamic, Kinematic, Reflex, StationConfig
+from mobee_drake.station.parts import ClientPorts, StationParts
+from mobee_drake.station.safety import SafetyMonitor
+from mobee_drake.station.viewer import AddViewer
+from mobee_drake.station.virtual_dynamics import VirtualDynamics
+from mobee_drake.station.world_events import RequestPorts, WorldEventLedger
+from mobee_drake.world.live_world import LiveWorld, ObjectPose
+from mobee_drake.world.objects import WorldEvent
+
+# Gains of the dynamic robot's joint controller, per unit of (mass-normalised) acceleration:
+# critically damped at 20 rad/s, which tracks MoBeE's virtual trajectory (time constants around
+# one second) closely.
+POSITION_GAIN, VELOCITY_GAIN = 400.0, 40.0
+
+
+@dc.dataclass
+class Station:
+    """A built station and typed handles to its parts."""
+
+    config: StationConfig
+    diagram: Diagram
+    plant: MultibodyPlant
+    scene_graph: SceneGraph
+    robot: RobotOverlay
+    mobee: Mobee
+    world: LiveWorld
+    monitor: SafetyMonitor
+    # The diagram's outputs: the robot's (q, v) in MoBeE's joint order, whichever robot moves,
+    # and MoBeE's attractor.
+    robot_state: OutputPort
+    attractor: OutputPort
+    # The world events: the scripted ones by time, the clients' request ports, and the ledger
+    # of those applied (see :mod:`mobee_drake.station.world_events`).
+    scripted_events: list[WorldEvent]
+    request_ports: list[OutputPort]
+    event_ledger: WorldEventLedger
+    # The client's system (None: the attractor is an input of the diagram).
+    client: LeafSystem | None = None
+    meshcat: Meshcat | None = None
+    visualizer: MeshcatVisualizer | None = None
+
+
+def _AddMobee(
+    builder: DiagramBuilder,
+    plant: MultibodyPlant,
+    scene_graph: SceneGraph,
+    robot: RobotOverlay,
+    joints: list[str],
+    params: MobeeParams,
+    time_step: float,
+    mover_config: Kinematic | Dynamic | Reflex,
+    prefix: str = "",
+):
+    """One robot's MoBeE, what moves it (its virtual dynamics, eq. 5.7, or MoBeE 1.0's reflex
+    controller, whose command input the caller connects) and the map of its state into the
+    plant's; returns MoBeE, the mover, the selector matrix and its gain system."""
+    mobee = builder.AddNamedSystem(
+        f"{prefix}mobee", Mobee(plant, robot, joints=joints, params=params)
+    )
+    builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
+    if isinstance(mover_config, Reflex):
+        mover = builder.AddNamedSystem(
+            f"{prefix}reflex",
+            ReflexController(
+                initial_positions=mobee.home,
+                period=time_step,
+                params=mover_config,
+                clauses=mobee.clauses,
+            ),
+        )
+        builder.Connect(mobee.GetOutputPort("field_pairs"), mover.GetInputPort("field_pairs"))
+    else:
+        _, damping, _ = params.PerJoint(joints)
+        mover = builder.AddNamedSystem(
+            f"{prefix}virtual_dynamics",
+            VirtualDynamics(
+                mass=mobee.mass,
+                damping=np.array(damping),
+                period=time_step,
+                initial_positions=mobee.home,
+            ),
+        )
+        builder.Connect(mobee.GetOutputPort("total"), mover.GetInputPort("total"))
+        builder.Connect(mobee.GetOutputPort("damping"), mover.GetInputPort("damping"))
+    selector = JointStateSelector(plant, mobee.joints, robot.instance)
+    to_plant = builder.AddNamedSystem(f"{prefix}to_plant_state", MatrixGain(selector))
+    builder.Connect(mover.GetOutputPort("state"), to_plant.get_input_port())
+    return mobee, mover, selector, to_plant
+
+
+def _AddJointController(
+    builder: DiagramBuilder,
+    plant: MultibodyPlant,
+    mobee: Mobee,
+    selector: np.ndarray,
+    to_plant: LeafSystem,
+    dynamic: Dynamic,
+    time_step: float,
+) -> None:
+    """The dynamic robot's joint torques, by its control modality (see the module)."""
+    n = plant.num_velocities()
+    if dynamic.control == "force":
+        held = builder.AddNamedSystem("total_hold", ZeroOrderHold(time_step, len(mobee.joints)))
+        builder.Connect(mobee.GetOutputPort("total"), held.get_input_port())
+        # q'' = total / M in MoBeE's order, then to the plant's velocity order.
+        to_acceleration = selector[plant.num_positions() :, len(mobee.joints) :]
+        acceleration = builder.AddNamedSystem(
+            "acceleration", MatrixGain(to_acceleration @ np.diag(1.0 / mobee.mass))
+        )
+        builder.Connect(held.get_output_port(), acceleration.get_input_port())
+        controller = builder.AddNamedSystem("inverse_dynamics", InverseDynamics(plant))
+        builder.Connect(
+            acceleration.get_output_port(), controller.get_input_port_desired_acceleration()
+        )
+    else:
+        kp = np.full(n, POSITION_GAIN if dynamic.control == "position" else 0.0)
+        controller = builder.AddNamedSystem(
+            "joint_controller",
+            InverseDynamicsController(plant, kp, np.zeros(n), np.full(n, VELOCITY_GAIN), False),
+        )
+        builder.Connect(to_plant.get_output_port(), controller.get_input_port_desired_state())
+    builder.Connect(plant.get_state_output_port(), controller.get_input_port_estimated_state())
+    builder.Connect(
+        controller.get_output_port_generalized_force(),
+        plant.get_applied_generalized_force_input_port(),
+    )
+
+
+def MakeMobeeStation(
+    config: StationConfig, meshcat: Meshcat | None = None, *, prebuild_callback=None
+) -> Station:
+    """Builds the station of ``config``; with ``meshcat``, also the viewer.
+
+    ``prebuild_callback(parts: StationParts) -> ClientPorts | None``, if given, adds the client
+    (see :mod:`mobee_drake.station.parts`) and any other systems of the user's (a logger, a
+    supervisor). A system with an abstract output port named ``world_events`` edits the live
+    world (see :mod:`mobee_drake.station.world_events`); simulate the station with
+    :func:`~mobee_drake.station.world_events.MakeSimulator`, which applies them.
+    """
+    builder = DiagramBuilder()
+    mover_config = config.mover
+    if isinstance(mover_config, Dynamic):
+        plant, scene_graph = AddMultibodyPlant(mover_config.plant_config, builder)
+    else:
+        scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
+        plant = MultibodyPlant(0.0)
+        plant.RegisterAsSourceForSceneGraph(scene_graph)
+    robot, joints = AddScenarioRobot(plant, scene_graph, config.robot)
+    companions = [
+        AddScenarioRobot(
+            plant,
+            scene_graph,
+            c.robot,
+            model_name=c.name,
+            X_WRoot=ObjectPose(c.position, c.rpy_deg),
+        )
+        for c in config.companions
+    ]
+    world = LiveWorld(plant, scene_graph)
+    for obj in config.objects:
+        world.Register(obj)
+    plant.Finalize()
+
+    mobee, mover, selector, to_plant = _AddMobee(
+        builder, plant, scene_graph, robot, joints, config.mobee, config.time_step, mover_config
+    )
+    # The client's forces (eq. 5.9-5.10) are inputs of the diagram, for scripts and supervisors
+    # (unfixed, they are zero), unless the client sets the marker forces.
+    builder.ExportInput(mobee.GetInputPort("config_force"), "config_force")
+    companion_positions = []
+    for i, (companion, (overlay, companion_joints)) in enumerate(
+        zip(config.companions, companions)
+    ):
+        prefix = f"{companion.name}_"
+        other, other_mover, _, other_to_plant = _AddMobee(
+            builder,
+            plant,
+            scene_graph,
+            overlay,
+            companion_joints,
+            companion.mobee,
+            config.time_step,
+            Kinematic(),
+            prefix=prefix,
+        )
+        builder.Connect(other_mover.GetOutputPort("state"), other.GetInputPort("state"))
+        ports = companion.attractor.AddToBuilder(
+            StationParts(
+                builder=builder,
+                plant=plant,
+                scene_graph=scene_graph,
+                mobee=other,
+                world=world,
+                robot_state=other_mover.GetOutputPort("state"),
+                meshcat=None,
+                random_seed=config.random_seed + 1 + i,  # its own draws
+                prefix=prefix,
+            )
+        )
+        builder.Connect(ports.attractor, other.GetInputPort("attractor"))
+        companion_positions.append(other_to_plant.get_output_port())
+
+    if isinstance(mover_config, Dynamic):
+        from_plant = builder.AddNamedSystem("from_plant_state", MatrixGain(selector.T))
+        builder.Connect(plant.get_state_output_port(), from_plant.get_input_port())
+        robot_state = from_plant.get_output_port()
+        _AddJointController(
+            builder, plant, mobee, selector, to_plant, mover_config, config.time_step
+        )
+    else:
+        # The plant lives as long as the diagram; it is not a system of it.
+        builder.AddNamedSystem("plant_owner", SharedPointerSystem(plant))
+        to_pose = builder.AddNamedSystem(
+            "to_geometry_pose", MultibodyPositionToGeometryPose(plant, input_multibody_state=True)
+        )
+        plant_state = to_plant.get_output_port()
+        if companion_positions:  # Each robot's joints fill their own entries of the state.
+            adder = builder.AddNamedSystem(
+                "all_robots_state",
+                Adder(1 + len(companion_positions), plant.num_multibody_states()),
+            )
+            for i, port in enumerate([plant_state] + companion_positions):
+                builder.Connect(port, adder.get_input_port(i))
+            plant_state = adder.get_output_port()
+        builder.Connect(plant_state, to_pose.get_input_port())
+        builder.Connect(
+            to_pose.get_output_port(), scene_graph.get_source_pose_port(plant.get_source_id())
+        )
+        robot_state = mover.GetOutputPort("state")
+    builder.Connect(robot_state, mobee.GetInputPort("state"))
+
+    monitor = builder.AddNamedSystem(
+        "safety_monitor", SafetyMonitor(names=world.names, period=config.time_step)
+    )
+    builder.Connect(mobee.GetOutputPort("field_pairs"), monitor.GetInputPort("field_pairs"))
+    builder.Connect(scene_graph.get_query_output_port(), monitor.GetInputPort("geometry_query"))
+
+    parts = StationParts(
+        builder=builder,
+        plant=plant,
+        scene_graph=scene_graph,
+        mobee=mobee,
+        world=world,
+        robot_state=robot_state,
+        meshcat=meshcat,
+        random_seed=config.random_seed,
+    )
+    client: ClientPorts | None = prebuild_callback(parts) if prebuild_callback else None
+    if client is None:  # The attractor is the diagram's input.
+        attractor_input = builder.AddNamedSystem("attractor_input", PassThrough(len(joints)))
+        builder.ExportInput(attractor_input.get_input_port(), "attractor")
+        attractor = attractor_input.get_output_port()
+    else:
+        attractor = client.attractor
+    builder.Connect(attractor, mobee.GetInputPort("attractor"))
+    if isinstance(mover_config, Reflex):  # MoBeE 1.0: the attractor is the position move command
+        builder.Connect(attractor, mover.GetInputPort("command"))
+    marker_forces = client.marker_forces if client is not None else None
+    if marker_forces is None:
+        builder.ExportInput(mobee.GetInputPort("marker_forces"), "marker_forces")
+    else:
+        builder.Connect(marker_forces, mobee.GetInputPort("marker_forces"))
+
+    visualizer = None
+    if meshcat is not None:
+        visualizer = AddViewer(
+            builder,
+            config=config,
+            meshcat=meshcat,
+            plant=plant,
+            scene_graph=scene_graph,
+            mobee=mobee,
+            attractor=attractor,
+            marker_forces=marker_forces or "marker_forces",
+        )
+
+    request_ports = RequestPorts(builder.GetSystems())
+    event_ledger = builder.AddNamedSystem(
+        "world_event_ledger", WorldEventLedger(num_request_ports=len(request_ports))
+    )
+
+    builder.ExportOutput(robot_state, "robot_state")
+    builder.ExportOutput(attractor, "attractor")
+    builder.ExportOutput(mobee.GetOutputPort("marker_positions"), "marker_positions")
+    builder.ExportOutput(mobee.GetOutputPort("field_pairs"), "field_pairs")
+    diagram = builder.Build()
+    diagram.set_name("mobee_station")
+    return Station(
+        config=config,
+        diagram=diagram,
+        plant=plant,
+        scene_graph=scene_graph,
+        robot=robot,
+        mobee=mobee,
+        world=world,
+        monitor=monitor,
+        robot_state=diagram.GetOutputPort("robot_state"),
+        attractor=diagram.GetOutputPort("attractor"),
+        scripted_events=sorted(config.world_events, key=lambda e: e.time),
+        request_ports=request_ports,
+        event_ledger=event_ledger,
+        client=client.system if client is not None else None,
+        meshcat=meshcat,
+        visualizer=visualizer,
+    )

@@ -1,0 +1,160 @@
+"""What the station is made of, as typed dataclasses for Drake's YAML loader.
+
+The station is the robot (the iCub or a MoBeE XML robot), its world, MoBeE, what moves the
+robot, companions with their own MoBeE and the viewer. What moves the robot is one of three
+tagged choices, so that no illegal combination can be written:
+
+- ``!Kinematic {}`` (the default, for learning runs): MoBeE's virtual dynamics (eq. 5.7) are the
+  robot; the plant gives kinematics and geometry and is not simulated.
+- ``!Dynamic {control: position | velocity | force, plant_config: {...}}``: the MultibodyPlant
+  (Drake's :class:`MultibodyPlantConfig`: time step, contact model) is simulated and follows MoBeE
+  through one modality of ch. 5.2.
+- ``!Reflex {speed_deg: ..., history: ..., tolerance_deg: ...}``: MoBeE 1.0's position moves with
+  the rewinding reflex (ch. 4.1) move the kinematic robot.
+"""
+
+import dataclasses as dc
+
+from pydrake.multibody.plant import MultibodyPlantConfig
+
+from mobee_drake.mobee.params import MobeeParams
+from mobee_drake.mobee.reflex import ReflexParams
+from mobee_drake.robots.icub import IcubConfig
+from mobee_drake.robots.zero_position import ZeroPositionConfig
+from mobee_drake.station.attractors import FixedAttractor, RandomAttractors
+from mobee_drake.world.objects import OBJECT_ROLES, SceneObject, WorldEvent
+
+CONTROL_MODALITIES = ("position", "velocity", "force")
+
+
+def _Zeros3() -> list[float]:
+    return [0.0, 0.0, 0.0]
+
+
+@dc.dataclass
+class Kinematic:
+    """MoBeE's virtual dynamics (eq. 5.7) move the robot, every ``time_step``."""
+
+
+@dc.dataclass
+class Dynamic:
+    """The MultibodyPlant is simulated, with contact, and follows MoBeE (ch. 5.2)."""
+
+    # "position" (tracks MoBeE's virtual trajectory), "velocity" (its velocity only) or "force"
+    # (the joint torques that accelerate the robot as eq. 5.7 asks).
+    control: str = "position"
+    plant_config: MultibodyPlantConfig = dc.field(
+        default_factory=lambda: MultibodyPlantConfig(time_step=0.001)
+    )
+
+
+@dc.dataclass
+class Reflex(ReflexParams):
+    """MoBeE 1.0: position moves with the reflex that rewinds to the last waypoint (ch. 4.1)."""
+
+
+Mover = Kinematic | Dynamic | Reflex
+
+
+@dc.dataclass
+class Companion:
+    """Another robot in the same world with its own MoBeE (dissertation ch. 4.1.2, Fig. 4.5).
+
+    Kinematic runs only. Each robot's MoBeE keeps its own body out of the other's way: to it, the
+    other robot is an obstacle.
+    """
+
+    name: str = "katana"
+    robot: ZeroPositionConfig | IcubConfig = dc.field(default_factory=ZeroPositionConfig)
+    # Pose of the companion's root in world: metres, degrees.
+    position: list[float] = dc.field(default_factory=_Zeros3)
+    rpy_deg: list[float] = dc.field(default_factory=_Zeros3)
+    mobee: MobeeParams = dc.field(default_factory=MobeeParams)
+    attractor: RandomAttractors | FixedAttractor = dc.field(default_factory=RandomAttractors)
+
+
+@dc.dataclass
+class Visualization:
+    """What the viewer draws when the station has Meshcat."""
+
+    # The marker whose path is drawn as a trail ("" for none).
+    trail_marker: str = "r_palm"
+    # Draw the attractor as a translucent second robot.
+    show_attractor: bool = True
+
+
+@dc.dataclass
+class StationConfig:
+    """The robot, its world and what moves it (see ``diagrams/`` for examples)."""
+
+    # The iCub, or ``!ZeroPositionConfig {file: katana.xml}`` for a robot from a MoBeE XML file.
+    robot: IcubConfig | ZeroPositionConfig = dc.field(default_factory=IcubConfig)
+    objects: list[SceneObject] = dc.field(default_factory=list)
+    # Other robots in the same world, each with its own MoBeE (not with the !Dynamic mover).
+    companions: list[Companion] = dc.field(default_factory=list)
+    mobee: MobeeParams = dc.field(default_factory=MobeeParams)
+    # What moves the robot (see the module).
+    mover: Kinematic | Dynamic | Reflex = dc.field(default_factory=Kinematic)
+    # MoBeE's period (s): the kinematic robot's integration step, the dynamic robot's control rate.
+    time_step: float = 0.01
+    # Scripted changes of the world.
+    world_events: list[WorldEvent] = dc.field(default_factory=list)
+    visualization: Visualization = dc.field(default_factory=Visualization)
+    # Seeds every generator of a run: random attractors, exploring agents, companions.
+    random_seed: int = 0
+
+
+def StationConfigErrors(config: StationConfig) -> list[str]:
+    """What is wrong with ``config`` that its types cannot say (empty: nothing)."""
+    errors = []
+    mover = config.mover
+    if isinstance(mover, Dynamic):
+        if mover.control not in CONTROL_MODALITIES:
+            errors.append(
+                f"mover control must be one of {CONTROL_MODALITIES}, got '{mover.control}'"
+            )
+        if not mover.plant_config.time_step > 0:
+            errors.append(f"plant_config time_step must be > 0, got {mover.plant_config.time_step}")
+    if isinstance(mover, Reflex) and not (
+        mover.speed_deg > 0 and mover.history >= 2 and mover.tolerance_deg > 0
+    ):
+        errors.append("reflex: speed_deg and tolerance_deg must be > 0 and history >= 2")
+    if not config.time_step > 0:
+        errors.append(f"time_step must be > 0, got {config.time_step}")
+    names = set()
+    for obj in config.objects:
+        if not obj.name or obj.name in names:
+            errors.append(f"every object needs a unique name, got '{obj.name}'")
+        names.add(obj.name)
+        if obj.role not in OBJECT_ROLES:
+            errors.append(
+                f"object '{obj.name}': role must be one of {OBJECT_ROLES}, got '{obj.role}'"
+            )
+        if not (len(obj.position) == 3 and len(obj.rpy_deg) == 3):
+            errors.append(f"object '{obj.name}': position and rpy_deg need three numbers")
+    for event in config.world_events:
+        where = f"world event at {event.time} s"
+        if event.object not in names:
+            errors.append(f"{where} names unknown object '{event.object}'")
+        if event.role not in OBJECT_ROLES + ("",):
+            errors.append(f"{where}: role must be one of {OBJECT_ROLES}, got '{event.role}'")
+        if len(event.position) not in (0, 3):
+            errors.append(f"{where}: position needs three numbers")
+    for companion in config.companions:
+        if isinstance(mover, Dynamic):
+            errors.append(
+                f"companion '{companion.name}': other robots run with the kinematic robot only "
+                "(!Kinematic or !Reflex)"
+            )
+        if not companion.name or companion.name in names:
+            errors.append(
+                f"every companion needs a unique name, not an object's, got '{companion.name}'"
+            )
+        names.add(companion.name)
+        if not (len(companion.position) == 3 and len(companion.rpy_deg) == 3):
+            errors.append(f"companion '{companion.name}': position and rpy_deg need three numbers")
+        try:
+            companion.attractor.Validate()
+        except ValueError as e:
+            errors.append(f"companion '{companion.name}': {e}")
+    return errors

@@ -1,0 +1,261 @@
+"""State-actions on the robot: state transitions and dynamic reaches (dissertation ch. 8.2).
+
+A *transition* sets MoBeE's attractor q* to a state's centre and ends when the robot has settled (as
+the actions of ch. 6-7, :mod:`mobee_drake.station.settling`, watching all of MoBeE's joints). A
+*reach* keeps q* at the centre of the state it starts from and forces a marker (the palm) toward a
+workspace target x* through MoBeE's workspace force f_work (eq. 5.10, the J^T direction), in real
+time; when the robot stops (or the timeout passes) the marker's position is taken for the reward of
+eq. 8.4, the forcing stops, the attractor pulls the robot back, and the reach ends when the robot
+has settled a second time.
+
+The force on the marker points at the target with a magnitude that fades within
+``softening`` of it: ``F (x* - x) / (|x* - x| + softening)`` (the source interprets Alg. 5's
+``dq`` as a direction; the fading keeps the force from chattering once the marker is there).
+How far the marker gets is decided by MoBeE: the squashed force against the attractor spring,
+the joint limits, the constraints and the obstacles.
+
+The executor also notes whether MoBeE's fields felt a workspace object (a field pair whose other
+geometry is not the robot's) at any poll of the action in flight: the learner of ch. 9.4.1 tells
+a problem's obstacle from its own model's error by it. Sampled at the poll period, like the
+settling; a touch shorter than a poll can be missed, a transition blocked by an object is not.
+
+Everything the executor knows is in its discrete state, so a checkpoint of the diagram's
+discrete states (:mod:`mobee_drake.station.checkpoint`) holds the action in flight too.
+"""
+
+import dataclasses as dc
+import enum
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.systems.framework import BasicVector, LeafSystem
+
+from mobee_drake.mobee.fields import NO_FIELD_PAIRS, FieldPairs
+from mobee_drake.station.parts import ClientPorts, StationParts
+from mobee_drake.station.settling import ActionTiming
+
+
+class Phase(enum.IntEnum):
+    IDLE = 0  # no action in flight: q* stays where the last one put it
+    MOVING = 1  # a transition: q* at the goal state's centre
+    FORCING = 2  # a reach, the marker forced toward the target
+    RETURNING = 3  # a reach, the forcing stopped, back to the state's centre
+
+
+@dc.dataclass
+class ReachForcing:
+    """The workspace force of a reach (ch. 8.2)."""
+
+    # The marker forced toward the target.
+    marker: str = "r_palm"
+    # Force magnitude far from the target (N on the marker, before MoBeE's squashing).
+    force: float = 300.0
+    # Within about this distance of the target the force fades linearly (m).
+    softening: float = 0.05
+
+
+class StateActionExecutor(LeafSystem):
+    """Executes one state-action at a time on MoBeE: transitions and reaches.
+
+    .. pydrake_system::
+
+        name: StateActionExecutor
+        input_ports:
+        - robot_state
+        - marker_positions
+        - field_pairs
+        output_ports:
+        - attractor
+        - marker_forces
+
+    ``robot_state`` is (q, v) of MoBeE's n joints, ``marker_positions`` MoBeE's output of the same
+    name (3m), ``field_pairs`` MoBeE's :class:`FieldPairs`; ``attractor`` is q* (n),
+    ``marker_forces`` the force on every marker (3m, zero but on the reaching marker while it is
+    forced).
+
+    A client starts an action with :meth:`StartTransition` or :meth:`StartReach` and polls
+    :meth:`Done`; :meth:`ReachedPosition` is the marker's position at the end of the forcing,
+    :meth:`FeltObject` whether the fields felt a workspace object during the action.
+    """
+
+    # The discrete state: phase, the number of actions finished, the phase's start time, since
+    # when the robot has been slow (inf: not slow), the target x*, the marker's position when the
+    # forcing stopped, whether the fields felt an object, q*.
+    _PHASE, _FINISHED, _STARTED, _SLOW_SINCE = range(4)
+    _TARGET = slice(4, 7)
+    _REACHED = slice(7, 10)
+    _FELT_OBJECT = 10
+    _Q_STAR = 11
+
+    def __init__(
+        self,
+        *,
+        num_joints: int,
+        marker_index: int,
+        num_markers: int,
+        initial_attractor: np.ndarray,
+        forcing: ReachForcing | None = None,
+        timing: ActionTiming | None = None,
+        period: float = 0.1,
+    ):
+        super().__init__()
+        self._n, self._marker, self._num_markers = num_joints, marker_index, num_markers
+        self._forcing = forcing or ReachForcing()
+        self._timing = timing or ActionTiming()
+        if not (self._forcing.force > 0 and self._forcing.softening > 0):
+            raise ValueError(
+                f"reach forcing: force and softening must be > 0, got "
+                f"{self._forcing.force} and {self._forcing.softening}"
+            )
+        initial = np.zeros(self._Q_STAR + num_joints)
+        initial[self._SLOW_SINCE] = np.inf
+        initial[self._Q_STAR :] = initial_attractor
+        self._state_port = self.DeclareVectorInputPort("robot_state", 2 * num_joints)
+        self._markers_port = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
+        self._pairs_port = self.DeclareAbstractInputPort(
+            "field_pairs", AbstractValue.Make(NO_FIELD_PAIRS)
+        )
+        self._state = self.DeclareDiscreteState(BasicVector(initial))
+        self.DeclarePeriodicDiscreteUpdateEvent(
+            period_sec=period, offset_sec=period, update=self._Poll
+        )
+        self.DeclareVectorOutputPort(
+            "attractor",
+            num_joints,
+            lambda context, output: output.SetFromVector(self._Vector(context)[self._Q_STAR :]),
+            prerequisites_of_calc={self.discrete_state_ticket(self._state)},
+        )
+        self.DeclareVectorOutputPort(
+            "marker_forces",
+            3 * num_markers,
+            self._CalcMarkerForces,
+            prerequisites_of_calc={
+                self.discrete_state_ticket(self._state),
+                self._markers_port.ticket(),
+            },
+        )
+
+    def _Vector(self, context) -> np.ndarray:
+        return context.get_discrete_state(self._state).value()
+
+    def _Marker(self, context) -> np.ndarray:
+        return self._markers_port.Eval(context)[3 * self._marker : 3 * self._marker + 3]
+
+    def _CalcMarkerForces(self, context, output) -> None:
+        x = self._Vector(context)
+        forces = np.zeros(3 * self._num_markers)
+        if x[self._PHASE] == Phase.FORCING:
+            error = x[self._TARGET] - self._Marker(context)
+            forces[3 * self._marker : 3 * self._marker + 3] = (
+                self._forcing.force * error / (np.linalg.norm(error) + self._forcing.softening)
+            )
+        output.SetFromVector(forces)
+
+    def _Poll(self, context, discrete_state) -> None:
+        x = self._Vector(context).copy()
+        phase = Phase(int(x[self._PHASE]))
+        if phase == Phase.IDLE:
+            return
+        now, timing = context.get_time(), self._timing
+        v = self._state_port.Eval(context)[self._n :]
+        pairs: FieldPairs = self._pairs_port.Eval(context)
+        if not np.all(pairs.b_is_robot):
+            x[self._FELT_OBJECT] = 1.0
+        x[self._SLOW_SINCE] = timing.SlowSince(x[self._SLOW_SINCE], now, v)
+        if timing.Ended(now, x[self._STARTED], x[self._SLOW_SINCE]):
+            if phase == Phase.FORCING:
+                x[self._REACHED] = self._Marker(context)
+                x[self._PHASE] = Phase.RETURNING
+            else:
+                x[self._PHASE] = Phase.IDLE
+                x[self._FINISHED] += 1
+            x[self._STARTED], x[self._SLOW_SINCE] = now, np.inf
+        discrete_state.set_value(self._state, x)
+
+    def _Start(self, context, phase: Phase, q_star: np.ndarray, target=None) -> None:
+        q_star = np.asarray(q_star, dtype=float)
+        if q_star.shape != (self._n,):
+            raise ValueError(f"q* must have {self._n} entries, got shape {q_star.shape}")
+        x = self._Vector(context).copy()
+        if x[self._PHASE] != Phase.IDLE:
+            raise ValueError(f"an action is in flight (phase {Phase(int(x[self._PHASE])).name})")
+        x[self._PHASE], x[self._STARTED], x[self._SLOW_SINCE] = phase, context.get_time(), np.inf
+        x[self._FELT_OBJECT] = 0.0
+        x[self._Q_STAR :] = q_star
+        if target is not None:
+            x[self._TARGET] = target
+        context.SetDiscreteState(self._state, x)
+
+    def StartTransition(self, context, q_star: np.ndarray) -> None:
+        """Starts a state transition to the attractor ``q_star`` (this system's context)."""
+        self._Start(context, Phase.MOVING, q_star)
+
+    def StartReach(self, context, q_star: np.ndarray, target: np.ndarray) -> None:
+        """Starts a reach for ``target`` (world, m) from the state whose centre is ``q_star``."""
+        target = np.asarray(target, dtype=float)
+        if target.shape != (3,) or not np.all(np.isfinite(target)):
+            raise ValueError(f"a reach target must be three finite numbers, got {target}")
+        self._Start(context, Phase.FORCING, q_star, target)
+
+    @property
+    def marker_name(self) -> str:
+        """The marker a reach forces toward its target."""
+        return self._forcing.marker
+
+    def CurrentPhase(self, context) -> Phase:
+        return Phase(int(self._Vector(context)[self._PHASE]))
+
+    def Done(self, context) -> bool:
+        """Whether no action is in flight."""
+        return self.CurrentPhase(context) == Phase.IDLE
+
+    def FinishedActions(self, context) -> int:
+        return int(self._Vector(context)[self._FINISHED])
+
+    def ReachedPosition(self, context) -> np.ndarray:
+        """Where the marker was when the last reach's forcing stopped (world, m)."""
+        return self._Vector(context)[self._REACHED].copy()
+
+    def FeltObject(self, context) -> bool:
+        """Whether MoBeE's fields felt a workspace object during the last (or current) action."""
+        return bool(self._Vector(context)[self._FELT_OBJECT])
+
+
+@dc.dataclass
+class StateActionAttractor:
+    """The attractor and a marker's force are set by a client's state-actions, one at a time:
+    transitions and dynamic reaches (ch. 8)."""
+
+    forcing: ReachForcing = dc.field(default_factory=ReachForcing)
+    timing: ActionTiming = dc.field(default_factory=ActionTiming)
+
+    def Validate(self) -> None:
+        if not (self.forcing.force > 0 and self.forcing.softening > 0):
+            raise ValueError(
+                f"reach forcing: force and softening must be > 0, got "
+                f"{self.forcing.force} and {self.forcing.softening}"
+            )
+
+    def AddToBuilder(self, parts: StationParts) -> ClientPorts:
+        mobee, builder = parts.mobee, parts.builder
+        executor = builder.AddNamedSystem(
+            f"{parts.prefix}state_action_executor",
+            StateActionExecutor(
+                num_joints=len(mobee.joints),
+                marker_index=mobee.marker_index(self.forcing.marker),
+                num_markers=len(mobee.marker_names),
+                initial_attractor=mobee.home,
+                forcing=self.forcing,
+                timing=self.timing,
+            ),
+        )
+        builder.Connect(parts.robot_state, executor.GetInputPort("robot_state"))
+        builder.Connect(
+            mobee.GetOutputPort("marker_positions"), executor.GetInputPort("marker_positions")
+        )
+        builder.Connect(mobee.GetOutputPort("field_pairs"), executor.GetInputPort("field_pairs"))
+        return ClientPorts(
+            system=executor,
+            attractor=executor.GetOutputPort("attractor"),
+            marker_forces=executor.GetOutputPort("marker_forces"),
+        )

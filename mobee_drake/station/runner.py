@@ -1,0 +1,143 @@
+"""Runs a built station: advances it with a progress bar, checkpoints it, reports."""
+
+import dataclasses as dc
+import pathlib
+import time
+
+from pydrake.systems.analysis import InitializeParams, Simulator
+from tqdm import tqdm
+
+from mobee_drake.atomic_files import WriteTextAtomically
+from mobee_drake.station.builder import Station
+from mobee_drake.station.checkpoint import LoadCheckpoint, SaveCheckpoint
+from mobee_drake.station.safety import SafetyReport
+from mobee_drake.station.world_events import MakeSimulator
+
+
+@dc.dataclass
+class RunSummary:
+    simulated_time: float
+    wall_time: float
+    safety: SafetyReport
+    recording: str | None = None
+
+    @property
+    def realtime_factor(self) -> float:
+        return self.simulated_time / self.wall_time if self.wall_time > 0 else float("inf")
+
+    def Format(self) -> str:
+        lines = [
+            f"simulated {self.simulated_time:.2f} s in {self.wall_time:.2f} s "
+            f"({self.realtime_factor:.1f}x real time)"
+        ]
+        lines.append("closest approach of the robot's solids (m; '-' = never inside a field):")
+        for name, distance in self.safety.closest_approach.items():
+            lines.append(f"  {name:20s} {'-' if distance is None else f'{distance:+.4f}'}")
+        lines.append(
+            f"penetrations of solid geometry: {self.safety.penetrating_steps} control "
+            f"periods, deepest {1000 * self.safety.deepest_penetration:.2f} mm"
+        )
+        if self.recording:
+            lines.append(f"recording: {self.recording}")
+        return "\n".join(lines)
+
+
+def Advance(
+    station: Station,
+    simulator: Simulator,
+    until: float,
+    *,
+    progress: bool = False,
+    after_chunk=None,
+) -> None:
+    """Advances to ``until`` in at most 500 chunks.
+
+    ``after_chunk(context)``, if given, is called after each: the progress bar's and the
+    checkpoints' occasions. World events are applied by the simulator's monitor (see
+    :func:`~mobee_drake.station.world_events.MakeSimulator`).
+    """
+    context = simulator.get_mutable_context()
+    start = context.get_time()
+    chunks = max(1, min(500, int(round((until - start) / station.config.time_step))))
+    bar = None
+    if progress:
+        bar = tqdm(
+            total=round(until - start, 3),
+            leave=False,
+            bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} s simulated [{elapsed}<{remaining}]",
+        )
+    for k in range(1, chunks + 1):
+        before = context.get_time()
+        simulator.AdvanceTo(start + (until - start) * k / chunks)
+        if bar is not None:
+            bar.update(round(context.get_time() - before, 3))
+        if after_chunk is not None:
+            after_chunk(context)
+    if bar is not None:
+        bar.close()
+
+
+def CompletedActions(station: Station, context) -> int:
+    """How many actions the station's clients have completed: the sum of
+    ``CompletedActions(context)`` over the systems that count them (0 without such systems)."""
+    return sum(
+        system.CompletedActions(system.GetMyContextFromRoot(context))
+        for system in station.diagram.GetSystems()
+        if hasattr(system, "CompletedActions")
+    )
+
+
+def RunStation(
+    station: Station,
+    duration: float,
+    *,
+    record: str | None = None,
+    realtime_rate: float = 0.0,
+    progress: bool = False,
+    checkpoint: str | None = None,
+) -> RunSummary:
+    """Runs ``station`` until ``duration``; with ``record`` saves its Meshcat recording (HTML;
+    the station must have been built with Meshcat).
+
+    With ``checkpoint`` (a folder), a run resumes from the checkpoint there if there is one, and
+    saves one whenever a client has completed an action (and at the end), so that an interrupted
+    run loses at most the actions in flight.
+    """
+    simulator = MakeSimulator(station)
+    simulator.set_target_realtime_rate(realtime_rate)
+    context = simulator.get_mutable_context()
+    if checkpoint and (pathlib.Path(checkpoint) / "simulation.npz").is_file():
+        LoadCheckpoint(station, context, checkpoint)
+        simulator.Initialize(InitializeParams(suppress_initialization_events=True))
+    else:
+        simulator.Initialize()
+    if record:
+        station.visualizer.StartRecording()
+    saved = [CompletedActions(station, context)]
+
+    def AfterChunk(context):
+        done = CompletedActions(station, context)
+        if checkpoint and done > saved[0]:
+            SaveCheckpoint(station, context, checkpoint)
+            saved[0] = done
+
+    start = time.perf_counter()
+    simulated_before = context.get_time()
+    Advance(station, simulator, duration, progress=progress, after_chunk=AfterChunk)
+    if checkpoint:
+        SaveCheckpoint(station, context, checkpoint)
+    wall = time.perf_counter() - start
+    recording = None
+    if record:
+        station.visualizer.StopRecording()
+        station.visualizer.PublishRecording()
+        path = pathlib.Path(record)
+        WriteTextAtomically(path, station.meshcat.StaticHtml())
+        recording = str(path.resolve())
+    report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
+    return RunSummary(
+        simulated_time=context.get_time() - simulated_before,
+        wall_time=wall,
+        safety=report,
+        recording=recording,
+    )

@@ -1,0 +1,228 @@
+"""Meshcat: the robot and its world, the attractor as a translucent robot, the trail of a marker,
+and MoBeE's workspace forces: field forces at witness points, client forces at markers."""
+
+import numpy as np
+from pydrake.common.value import AbstractValue
+from pydrake.geometry import (
+    Meshcat,
+    MeshcatVisualizer,
+    MeshcatVisualizerParams,
+    Rgba,
+    Role,
+    SceneGraph,
+)
+from pydrake.math import RigidTransform
+from pydrake.multibody.parsing import Parser
+from pydrake.multibody.plant import MultibodyPlant
+from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem, OutputPort
+from pydrake.systems.primitives import MatrixGain, SharedPointerSystem
+from pydrake.systems.rendering import MultibodyPositionToGeometryPose
+
+from mobee_drake.mobee.system import Mobee
+from mobee_drake.robots.assembly import FreezeJoints, JointStateSelector
+from mobee_drake.robots.scenario_robot import RobotModelText
+from mobee_drake.station.config import StationConfig
+
+ATTRACTOR_ALPHA = 0.25
+TRAIL_COLOR = Rgba(0.9, 0.2, 0.2, 1.0)
+CONTACT_FORCE_COLOR = Rgba(1.0, 0.55, 0.0, 1.0)
+MARKER_FORCE_COLOR = Rgba(0.85, 0.0, 0.85, 1.0)
+MARKER_ARROW_LENGTH_PER_FORCE = 0.01
+# Length of a drawn contact force per metre of field penetration (a full 3 cm field: 15 cm).
+ARROW_LENGTH_PER_PENETRATION = 5.0
+
+
+class ForceDrawer(LeafSystem):
+    """Draws MoBeE's workspace forces as segments (publish only: it keeps no state).
+
+    - Field forces: from each witness point on the robot along the force (the separating
+      direction), the length proportional to the field penetration (orange, ``/field_forces``).
+    - Client forces on markers (``marker_forces``, when given): from each loaded marker along its
+      force, 1 cm per unit of force (magenta, ``/marker_forces``).
+    """
+
+    def __init__(self, *, meshcat: Meshcat, num_markers: int, period: float):
+        super().__init__()
+        self._meshcat = meshcat
+        self._contacts_port = self.DeclareAbstractInputPort(
+            "field_contacts", AbstractValue.Make([])
+        )
+        self._positions_port = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
+        self._forces_port = self.DeclareVectorInputPort("marker_forces", 3 * num_markers)
+        self.DeclarePeriodicPublishEvent(period_sec=period, offset_sec=0.0, publish=self._Draw)
+        self.DeclareForcedPublishEvent(self._Draw)
+
+    def _Segments(self, path: str, starts: list, ends: list, color: Rgba) -> None:
+        if starts:
+            self._meshcat.SetLineSegments(path, np.array(starts).T, np.array(ends).T, 4.0, color)
+        else:
+            self._meshcat.Delete(path)
+
+    def _Draw(self, context) -> None:
+        contacts = self._contacts_port.Eval(context)
+        self._Segments(
+            "/field_forces",
+            [c.p_WCa for c in contacts],
+            [
+                c.p_WCa + ARROW_LENGTH_PER_PENETRATION * c.penetration * c.nhat_BA_W
+                for c in contacts
+            ],
+            CONTACT_FORCE_COLOR,
+        )
+        starts, ends = [], []
+        if self._forces_port.HasValue(context):
+            points = self._positions_port.Eval(context).reshape(-1, 3)
+            forces = self._forces_port.Eval(context).reshape(-1, 3)
+            for p, f in zip(points, forces):
+                if np.any(f != 0):
+                    starts.append(p)
+                    ends.append(p + MARKER_ARROW_LENGTH_PER_FORCE * f)
+        self._Segments("/marker_forces", starts, ends, MARKER_FORCE_COLOR)
+
+
+class TrailDrawer(LeafSystem):
+    """Draws the recent path of one marker as a line in Meshcat.
+
+    The last ``capacity`` positions, sampled every ``period``, are kept in the discrete state (a
+    ring buffer and its count); a periodic publish sends them to Meshcat.
+    """
+
+    def __init__(
+        self,
+        *,
+        meshcat: Meshcat,
+        marker_index: int,
+        num_markers: int,
+        period: float,
+        capacity: int = 600,
+        path: str = "/trail",
+    ):
+        super().__init__()
+        self._meshcat, self._path, self._capacity = meshcat, path, capacity
+        self._marker_index = marker_index
+        self._positions_port = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
+        self._state = self.DeclareDiscreteState(BasicVector(np.zeros(3 * capacity + 1)))
+        self.DeclarePeriodicDiscreteUpdateEvent(
+            period_sec=period, offset_sec=0.0, update=self._Append
+        )
+        self.DeclarePeriodicPublishEvent(period_sec=period, offset_sec=0.0, publish=self._Draw)
+
+    def _Append(self, context, discrete_state) -> None:
+        x = context.get_discrete_state(self._state).value().copy()
+        count = int(x[-1])
+        i = 3 * self._marker_index
+        p = self._positions_port.Eval(context)[i : i + 3]
+        slot = count % self._capacity
+        x[3 * slot : 3 * slot + 3] = p
+        x[-1] = count + 1
+        discrete_state.get_mutable_vector(self._state).SetFromVector(x)
+
+    def _Draw(self, context) -> None:
+        x = context.get_discrete_state(self._state).value()
+        count = int(x[-1])
+        if count < 2:
+            return
+        points = x[:-1].reshape(self._capacity, 3)
+        if count > self._capacity:  # Oldest first.
+            start = count % self._capacity
+            points = np.vstack([points[start:], points[:start]])
+        else:
+            points = points[:count]
+        self._meshcat.SetLine(self._path, points.T, 3.0, TRAIL_COLOR)
+
+
+def _AddAttractorRobot(
+    builder: DiagramBuilder,
+    config: StationConfig,
+    scene_graph: SceneGraph,
+    mobee: Mobee,
+    attractor: OutputPort,
+) -> None:
+    """A second, translucent robot (illustration only) posed at the attractor."""
+    text, extension, root, home = RobotModelText(config.robot, ATTRACTOR_ALPHA)
+    ghost = MultibodyPlant(0.0)
+    ghost.RegisterAsSourceForSceneGraph(scene_graph)
+    parser = Parser(ghost, "attractor")
+    (instance,) = parser.AddModelsFromString(text, extension)
+    ghost.RenameModelInstance(instance, "attractor")
+    ghost.WeldFrames(ghost.world_frame(), ghost.GetFrameByName(root, instance), RigidTransform())
+    FreezeJoints(ghost, instance, keep=mobee.joints, home=home, source="attractor robot")
+    ghost.Finalize()
+    builder.AddNamedSystem("attractor_robot_owner", SharedPointerSystem(ghost))
+    positions = JointStateSelector(ghost, mobee.joints, instance)[
+        : ghost.num_positions(), : len(mobee.joints)
+    ]
+    to_ghost = builder.AddNamedSystem("attractor_to_robot", MatrixGain(positions))
+    to_pose = builder.AddNamedSystem("attractor_pose", MultibodyPositionToGeometryPose(ghost))
+    builder.Connect(attractor, to_ghost.get_input_port())
+    builder.Connect(to_ghost.get_output_port(), to_pose.get_input_port())
+    builder.Connect(
+        to_pose.get_output_port(), scene_graph.get_source_pose_port(ghost.get_source_id())
+    )
+
+
+def AddViewer(
+    builder: DiagramBuilder,
+    *,
+    config: StationConfig,
+    meshcat: Meshcat,
+    plant: MultibodyPlant,
+    scene_graph: SceneGraph,
+    mobee: Mobee,
+    attractor: OutputPort,
+    marker_forces: OutputPort | str | None = None,
+) -> MeshcatVisualizer:
+    """Adds the Meshcat viewer of a scenario; returns the illustration visualizer.
+
+    ``marker_forces`` is the port, or names the diagram input, that carries the client's marker
+    forces, if any.
+    """
+    settings = config.visualization
+    if settings.show_attractor:
+        _AddAttractorRobot(builder, config, scene_graph, mobee, attractor)
+    visualizer = MeshcatVisualizer.AddToBuilder(
+        builder,
+        scene_graph,
+        meshcat,
+        MeshcatVisualizerParams(role=Role.kIllustration, prefix="illustration"),
+    )
+    # MoBeE's primitives, hidden by default (toggle "collision" in Meshcat's controls).
+    MeshcatVisualizer.AddToBuilder(
+        builder,
+        scene_graph,
+        meshcat,
+        MeshcatVisualizerParams(
+            role=Role.kProximity,
+            prefix="collision",
+            default_color=Rgba(0.2, 0.5, 0.9, 0.4),
+            visible_by_default=False,
+        ),
+    )
+    forces = builder.AddNamedSystem(
+        "force_drawer",
+        ForceDrawer(
+            meshcat=meshcat,
+            num_markers=len(mobee.marker_names),
+            period=max(config.time_step, 1 / 30),
+        ),
+    )
+    builder.Connect(mobee.GetOutputPort("field_contacts"), forces.GetInputPort("field_contacts"))
+    builder.Connect(
+        mobee.GetOutputPort("marker_positions"), forces.GetInputPort("marker_positions")
+    )
+    if isinstance(marker_forces, str):
+        builder.ConnectInput(marker_forces, forces.GetInputPort("marker_forces"))
+    elif marker_forces is not None:
+        builder.Connect(marker_forces, forces.GetInputPort("marker_forces"))
+    if settings.trail_marker:
+        trail = builder.AddNamedSystem(
+            "trail",
+            TrailDrawer(
+                meshcat=meshcat,
+                marker_index=mobee.marker_index(settings.trail_marker),
+                num_markers=len(mobee.marker_names),
+                period=max(config.time_step, 0.02),
+            ),
+        )
+        builder.Connect(mobee.GetOutputPort("marker_positions"), trail.get_input_port())
+    return visualizer

@@ -1,0 +1,82 @@
+"""World events in a running station: the scenario's scripted ones and those a client requests.
+
+A client changes the world by listing every :class:`~mobee_drake.world.objects.WorldEvent` it
+has issued, in order, on an abstract output port named ``world_events`` (the list is a function
+of its state). SceneGraph's world lives in its Context's parameters, which no system's event may
+change, so the events are applied between simulation steps by a Simulator *monitor*
+(:func:`MakeSimulator`): after every step it applies the scripted events that are due and the
+requests not yet applied. How many of each have been applied is the discrete state of a
+:class:`WorldEventLedger` in the diagram, so a plain ``Simulator.AdvanceTo`` in one call, the
+runner's chunks, two contexts and a restored checkpoint all agree on the world.
+
+An event at time t is applied when the step that reaches t ends, before the discrete updates at
+t (the robot's next period sees the new world); a request issued by an update at t is applied
+at the end of the next step.
+"""
+
+import numpy as np
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem, OutputPort
+
+WORLD_EVENTS_PORT = "world_events"
+
+
+class WorldEventLedger(LeafSystem):
+    """How many world events have been applied: the scripted ones, then each client's requests.
+
+    .. pydrake_system::
+
+        name: WorldEventLedger
+
+    It has no ports and no events: :func:`ApplyWorldEvents` keeps its state.
+    """
+
+    def __init__(self, *, num_request_ports: int):
+        super().__init__()
+        self._counts = self.DeclareDiscreteState(BasicVector(np.zeros(1 + num_request_ports)))
+
+    def Counts(self, context) -> np.ndarray:
+        """(scripted events applied, requests applied per port), in this system's ``context``."""
+        return context.get_discrete_state(self._counts).value()
+
+    def SetCounts(self, context, counts: np.ndarray) -> None:
+        context.SetDiscreteState(self._counts, counts)
+
+
+def RequestPorts(systems) -> list[OutputPort]:
+    """The ``world_events`` output ports of ``systems``."""
+    return [
+        s.GetOutputPort(WORLD_EVENTS_PORT) for s in systems if s.HasOutputPort(WORLD_EVENTS_PORT)
+    ]
+
+
+def ApplyWorldEvents(station, root_context) -> None:
+    """Applies the station's due scripted events and new requests to ``root_context``."""
+    ledger = station.event_ledger
+    ledger_context = ledger.GetMyMutableContextFromRoot(root_context)
+    before = ledger.Counts(ledger_context)
+    counts = before.copy()
+    scripted, now = station.scripted_events, root_context.get_time()
+    while counts[0] < len(scripted) and scripted[int(counts[0])].time <= now:
+        station.world.Apply(root_context, scripted[int(counts[0])])
+        counts[0] += 1
+    for i, port in enumerate(station.request_ports, start=1):
+        issued = port.Eval(port.get_system().GetMyContextFromRoot(root_context))
+        for event in issued[int(counts[i]) :]:
+            station.world.Apply(root_context, event)
+        counts[i] = len(issued)
+    if np.any(counts != before):
+        ledger.SetCounts(ledger_context, counts)
+
+
+def MakeSimulator(station) -> Simulator:
+    """A Simulator of ``station``'s diagram that applies its world events after every step."""
+    simulator = Simulator(station.diagram)
+    if station.scripted_events or station.request_ports:
+
+        def Monitor(root_context) -> EventStatus:
+            ApplyWorldEvents(station, root_context)
+            return EventStatus.Succeeded()
+
+        simulator.set_monitor(Monitor)
+    return simulator

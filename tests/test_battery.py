@@ -1,0 +1,296 @@
+"""The battery runner: run-if-missing, exact resume after a kill, the same results on local
+processes and on Ray (and across them), strict JSON, the display, and no worker outliving its
+battery when the parent is interrupted or killed."""
+
+import contextlib
+import importlib.util
+import io
+import os
+import pathlib
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+from unittest import mock
+
+from battery_jobs import Count, Nan, Walk
+
+from mobee_drake.experiments.battery import (
+    RAY_MISSING,
+    BatteryError,
+    InProcess,
+    Job,
+    LocalProcesses,
+    Ray,
+    RunBattery,
+)
+
+TESTS = str(pathlib.Path(__file__).parent)
+HAVE_RAY = importlib.util.find_spec("ray") is not None
+
+
+def Walks(die_at: int | None = None, pause: float = 0.0) -> list[Job]:
+    """Three random walks; the first dies at step ``die_at`` on its first attempt."""
+    return [
+        Job(
+            f"walk{i}",
+            Walk,
+            dict(steps=8, seed=i, die_at=die_at if i == 0 else None, pause=pause),
+            total=8,
+        )
+        for i in range(3)
+    ]
+
+
+def Counts(calls: pathlib.Path, n: int = 3) -> list[Job]:
+    return [Job(f"count{x}", Count, dict(x=x, calls=str(calls))) for x in range(n)]
+
+
+def ResultFiles(output: pathlib.Path) -> dict[str, bytes]:
+    return {path.parent.name: path.read_bytes() for path in output.glob("runs/*/result.json")}
+
+
+def Calls(calls: pathlib.Path) -> list[str]:
+    return calls.read_text().split() if calls.exists() else []
+
+
+class TemporaryFolder(unittest.TestCase):
+    def setUp(self):
+        self.folder = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, self.folder, ignore_errors=True)
+
+
+class LocalBatteryTest(TemporaryFolder):
+    def test_results_are_stored_and_not_recomputed(self):
+        output, calls = self.folder / "out", self.folder / "calls"
+        results = RunBattery(Counts(calls), output, workers=2, progress=False)
+        self.assertEqual(list(results), ["count0", "count1", "count2"])
+        self.assertEqual(results["count2"], dict(square=4, third=2 / 3))
+        self.assertEqual(sorted(Calls(calls)), ["count0", "count1", "count2"])
+        self.assertEqual(RunBattery(Counts(calls), output, progress=False), results)
+        self.assertEqual(len(Calls(calls)), 3)
+        RunBattery(Counts(calls, 4), output, backend=InProcess(), progress=False)
+        self.assertEqual(sorted(Calls(calls)), ["count0", "count1", "count2", "count3"])
+
+    def test_killed_job_resumes_exactly(self):
+        reference = RunBattery(Walks(), self.folder / "ref", backend=InProcess(), progress=False)
+        output = self.folder / "out"
+        with self.assertRaisesRegex(BatteryError, "walk0"):
+            RunBattery(Walks(die_at=4), output, workers=2, progress=False)
+        self.assertTrue((output / "runs/walk0/checkpoint.json").is_file())
+        self.assertFalse((output / "runs/walk0/result.json").exists())
+        self.assertEqual(RunBattery(Walks(die_at=4), output, workers=2, progress=False), reference)
+        self.assertEqual(ResultFiles(output), ResultFiles(self.folder / "ref"))
+
+    def test_nan_is_refused_naming_the_job(self):
+        jobs = [Job("fine", Count, dict(x=1, calls=str(self.folder / "calls"))), Job("bad", Nan)]
+        output = self.folder / "out"
+        with self.assertRaisesRegex(
+            BatteryError, "job 'bad' returned a result that is not strict JSON"
+        ):
+            RunBattery(jobs, output, workers=2, progress=False)
+        self.assertTrue((output / "runs/fine/result.json").is_file())
+        self.assertFalse((output / "runs/bad/result.json").exists())
+
+    def test_bad_jobs_are_refused(self):
+        with self.assertRaisesRegex(TypeError, "job 'local'"):
+            Job("local", lambda run: {})
+        with self.assertRaisesRegex(ValueError, "names a folder"):
+            Job("a/b", Nan)
+        with self.assertRaisesRegex(ValueError, "repeat: \\['a'\\]"):
+            RunBattery([Job("a", Nan), Job("a", Nan)], self.folder, progress=False)
+
+    def test_display_shows_the_battery_and_the_running_jobs(self):
+        stream = io.StringIO()
+        with contextlib.redirect_stderr(stream):
+            RunBattery(Walks(pause=0.2)[:2], self.folder, workers=2, description="walks")
+        self.assertIn("walks: 100%", stream.getvalue())
+        self.assertRegex(stream.getvalue(), r"walk0: +\d+%")
+
+    def test_without_ray_the_error_says_how_to_install_it(self):
+        with mock.patch.dict(sys.modules, {"ray": None}):
+            with self.assertRaisesRegex(ImportError, re.escape(RAY_MISSING)):
+                RunBattery([Job("a", Nan)], self.folder, backend=Ray(), progress=False)
+
+
+@unittest.skipUnless(HAVE_RAY, "needs ray")
+class RayBatteryTest(TemporaryFolder):
+    @classmethod
+    def setUpClass(cls):
+        import ray
+
+        ray.init(
+            num_cpus=2,
+            include_dashboard=False,
+            log_to_driver=False,
+            runtime_env={"env_vars": {"PYTHONPATH": TESTS}},
+        )
+
+    @classmethod
+    def tearDownClass(cls):
+        import ray
+
+        ray.shutdown()
+
+    def test_same_results_as_local_processes(self):
+        on_ray = RunBattery(Walks(), self.folder / "ray", backend=Ray(), progress=False)
+        local = RunBattery(Walks(), self.folder / "local", workers=2, progress=False)
+        self.assertEqual(on_ray, local)
+        self.assertEqual(ResultFiles(self.folder / "ray"), ResultFiles(self.folder / "local"))
+
+    def test_half_done_battery_finishes_on_the_other_backend(self):
+        reference = RunBattery(
+            Counts(self.folder / "calls"), self.folder / "ref", backend=InProcess(), progress=False
+        )
+        for first, second in ((LocalProcesses(2), Ray()), (Ray(), LocalProcesses(2))):
+            with self.subTest(first=type(first).__name__):
+                output, calls = self.folder / type(first).__name__, self.folder / "calls"
+                calls.unlink(missing_ok=True)
+                RunBattery(Counts(calls)[:2], output, backend=first, progress=False)
+                results = RunBattery(Counts(calls), output, backend=second, progress=False)
+                self.assertEqual(results, reference)
+                self.assertEqual(ResultFiles(output), ResultFiles(self.folder / "ref"))
+                self.assertEqual(sorted(Calls(calls)), ["count0", "count1", "count2"])
+
+    def test_job_killed_on_local_processes_resumes_on_ray(self):
+        reference = RunBattery(Walks(), self.folder / "ref", backend=InProcess(), progress=False)
+        output = self.folder / "out"
+        with self.assertRaises(BatteryError):
+            RunBattery(Walks(die_at=4), output, workers=2, progress=False)
+        self.assertEqual(
+            RunBattery(Walks(die_at=4), output, backend=Ray(), progress=False), reference
+        )
+        self.assertEqual(ResultFiles(output), ResultFiles(self.folder / "ref"))
+
+    def test_ray_retries_a_killed_job_from_its_checkpoint(self):
+        reference = RunBattery(Walks(), self.folder / "ref", backend=InProcess(), progress=False)
+        output = self.folder / "out"
+        self.assertEqual(
+            RunBattery(Walks(die_at=4), output, backend=Ray(), progress=False), reference
+        )
+        self.assertTrue((output / "runs/walk0/died").exists())
+
+    def test_nan_is_refused_naming_the_job(self):
+        with self.assertRaisesRegex(
+            BatteryError, "job 'bad' returned a result that is not strict JSON"
+        ):
+            RunBattery([Job("bad", Nan)], self.folder, backend=Ray(), progress=False)
+
+
+def Processes() -> dict[int, tuple[int, str]]:
+    """Pid -> (parent pid, state) of every process, from /proc."""
+    table = {}
+    for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
+        with contextlib.suppress(OSError):
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+            table[int(stat.parent.name)] = (int(fields[1]), fields[0])
+    return table
+
+
+def Descendants(pid: int) -> set[int]:
+    table, found, stack = Processes(), set(), [pid]
+    while stack:
+        parent = stack.pop()
+        children = [p for p, (pp, _) in table.items() if pp == parent]
+        found.update(children)
+        stack.extend(children)
+    return found
+
+
+def Alive(pids: set[int]) -> set[int]:
+    """Those of ``pids`` that run (zombies are dead: nobody may reap orphans here)."""
+    table = Processes()
+    return {pid for pid in pids if pid in table and table[pid][1] not in "ZX"}
+
+
+def Kill(pids: set[int]) -> None:
+    for pid in Alive(pids):
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(pid, signal.SIGKILL)
+
+
+def WaitFor(condition, seconds: float) -> bool:
+    deadline = time.monotonic() + seconds
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.1)
+    return True
+
+
+@unittest.skipUnless(sys.platform.startswith("linux"), "PR_SET_PDEATHSIG and /proc are Linux's")
+class NoOrphansTest(TemporaryFolder):
+    """A battery of a quick job and two sleepers (:func:`battery_jobs.Main`) in a process of its
+    own, interrupted or killed once the sleepers run."""
+
+    def Start(self, backend: str) -> tuple[subprocess.Popen, set[int]]:
+        """The battery's process and its descendants once the sleepers run."""
+        self.output, pids = self.folder / "out", self.folder / "pids"
+        pids.mkdir()
+        environment = dict(os.environ, PYTHONPATH=TESTS)
+        log = (self.folder / "parent.log").open("w")
+        self.addCleanup(log.close)
+        code = "import sys, battery_jobs; battery_jobs.Main(*sys.argv[1:])"
+        parent = subprocess.Popen(
+            [sys.executable, "-c", code, backend, self.output, pids],
+            env=environment,
+            stdout=log,
+            stderr=log,
+        )
+        self.addCleanup(parent.kill)
+        ready = WaitFor(
+            lambda: (
+                {"sleeper0", "sleeper1"} <= {p.name for p in pids.iterdir()}
+                and (self.output / "runs/quick/result.json").exists()
+            ),
+            60,
+        )
+        self.assertTrue(ready, (self.folder / "parent.log").read_text())
+        processes = Descendants(parent.pid)
+        sleepers = {int((pids / name).read_text()) for name in ("sleeper0", "sleeper1")}
+        self.assertLessEqual(sleepers, processes)
+        self.addCleanup(Kill, processes)  # Should a test fail.
+        return parent, processes
+
+    def AssertAllGone(self, processes: set[int], seconds: float):
+        WaitFor(lambda: not Alive(processes), seconds)
+        self.assertEqual(Alive(processes), set(), (self.folder / "parent.log").read_text())
+
+    def AssertInterruptsCleanly(self, backend: str, signum: int, seconds: float):
+        parent, processes = self.Start(backend)
+        parent.send_signal(signum)
+        self.assertNotEqual(parent.wait(seconds), 0)
+        self.AssertAllGone(processes, 5)
+        self.assertTrue((self.output / "runs/quick/result.json").is_file())
+        self.assertFalse((self.output / "runs/sleeper0/result.json").exists())
+
+    def test_sigkill_of_the_parent_leaves_no_local_worker(self):
+        parent, processes = self.Start("local")
+        parent.kill()
+        parent.wait()
+        self.AssertAllGone(processes, 5)
+
+    def test_sigint_stops_the_local_workers(self):
+        self.AssertInterruptsCleanly("local", signal.SIGINT, 10)
+
+    def test_sigterm_stops_the_local_workers(self):
+        self.AssertInterruptsCleanly("local", signal.SIGTERM, 10)
+
+    @unittest.skipUnless(HAVE_RAY, "needs ray")
+    def test_sigkill_of_the_driver_leaves_no_ray_process(self):
+        parent, processes = self.Start("ray")
+        parent.kill()
+        parent.wait()
+        self.AssertAllGone(processes, 5)
+
+    @unittest.skipUnless(HAVE_RAY, "needs ray")
+    def test_sigint_stops_ray(self):
+        self.AssertInterruptsCleanly("ray", signal.SIGINT, 30)
+
+
+if __name__ == "__main__":
+    unittest.main()

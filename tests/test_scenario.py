@@ -1,0 +1,158 @@
+"""Scenarios from Drake's config types: the test file's Defaults and OneOfEverything, every shipped
+scenario, tagged unions that make an illegal combination unwritable, one seed for every generator,
+and a client of one's own through the station's seam."""
+
+import dataclasses as dc
+import pathlib
+import unittest
+
+import numpy as np
+from pydrake.geometry import Meshcat
+from pydrake.systems.primitives import ConstantVectorSource
+
+from mobee_drake.resources import ScenarioNames
+from mobee_drake.scenario import BuildScenario, LoadScenario, Scenario
+from mobee_drake.station.builder import MakeMobeeStation
+from mobee_drake.station.config import Dynamic, Reflex
+from mobee_drake.station.parts import ClientPorts, StationParts
+from mobee_drake.station.runner import RunStation
+from mobee_drake.station.world_events import MakeSimulator
+from mobee_drake.yaml_io import YamlFileError
+
+TEST_SCENARIOS = pathlib.Path(__file__).with_name("test_scenarios.yaml")
+
+
+class TestScenarioFile(unittest.TestCase):
+    def test_defaults_are_the_schemas(self):
+        self.assertEqual(LoadScenario(TEST_SCENARIOS, scenario_name="Defaults"), Scenario())
+
+    def test_one_of_everything_sets_every_field(self):
+        scenario = LoadScenario(TEST_SCENARIOS, scenario_name="OneOfEverything")
+        defaults = Scenario()
+        unchanged = [
+            field.name
+            for field in dc.fields(Scenario)
+            if getattr(scenario, field.name) == getattr(defaults, field.name)
+        ]
+        self.assertEqual(unchanged, [])
+        self.assertIsInstance(scenario.mover, Reflex)
+        self.assertEqual(scenario.mover.speed_deg, 30.0)
+
+    def test_every_test_scenario_builds_and_runs(self):
+        for name in ("Defaults", "OneOfEverything", "DynamicForce"):
+            with self.subTest(name):
+                scenario = LoadScenario(TEST_SCENARIOS, scenario_name=name)
+                scenario.duration = min(scenario.duration, 0.3)
+                summary = RunStation(BuildScenario(scenario), scenario.duration)
+                self.assertAlmostEqual(summary.simulated_time, scenario.duration)
+
+    def test_one_of_everything_applies_its_world_events(self):
+        scenario = LoadScenario(TEST_SCENARIOS, scenario_name="OneOfEverything")
+        station = BuildScenario(scenario)
+        simulator = MakeSimulator(station)
+        simulator.Initialize()
+        context = simulator.get_context()
+        self.assertEqual(station.world.Role(context, "ball"), "ghost")
+        simulator.AdvanceTo(0.2)
+        self.assertEqual(station.world.Role(context, "ball"), "obstacle")
+        can = station.world.Objects(context)["can"][3]
+        np.testing.assert_allclose(can.translation(), [-0.3, -0.25, 0.0])
+
+    def test_dynamic_plant_config_reaches_the_plant(self):
+        scenario = LoadScenario(TEST_SCENARIOS, scenario_name="DynamicForce")
+        self.assertIsInstance(scenario.mover, Dynamic)
+        station = BuildScenario(scenario)
+        self.assertEqual(station.plant.time_step(), 0.002)
+        self.assertEqual(station.plant.get_discrete_contact_approximation().name, "kSap")
+
+
+class TestShippedScenarios(unittest.TestCase):
+    def test_every_shipped_scenario_builds_and_runs(self):
+        names = ScenarioNames()
+        self.assertGreaterEqual(len(names), 7)
+        for name in names:
+            with self.subTest(name):
+                scenario = LoadScenario(name, "{duration: 0.1}")
+                # The sliders need Meshcat; every other scenario runs headless.
+                meshcat = Meshcat() if name == "interactive" else None
+                summary = RunStation(BuildScenario(scenario, meshcat), scenario.duration)
+                self.assertAlmostEqual(summary.simulated_time, 0.1)
+
+
+class TestIllegalCombinations(unittest.TestCase):
+    def _Load(self, text: str):
+        return LoadScenario(TEST_SCENARIOS, text, scenario_name="Defaults")
+
+    def test_mover_fields_belong_to_their_tag(self):
+        with self.assertRaisesRegex(YamlFileError, "control"):
+            self._Load("{mover: !Kinematic {control: force}}")
+        with self.assertRaisesRegex(YamlFileError, "speed_deg"):
+            self._Load("{mover: !Dynamic {speed_deg: 20}}")
+        with self.assertRaisesRegex(YamlFileError, "mover control must be one of"):
+            self._Load("{mover: !Dynamic {control: torque}}")
+
+    def test_companions_need_the_kinematic_robot(self):
+        with self.assertRaisesRegex(YamlFileError, "kinematic robot only"):
+            LoadScenario("icub_and_katana", "{mover: !Dynamic {}}")
+
+
+class TestOneSeed(unittest.TestCase):
+    def _Attractors(self, overrides: str) -> np.ndarray:
+        station = BuildScenario(LoadScenario("explore_hypercube", overrides))
+        simulator = MakeSimulator(station)
+        simulator.Initialize()
+        attractors = []
+        for t in (0.1, 5.0, 10.0):
+            simulator.AdvanceTo(t)
+            attractors.append(station.attractor.Eval(simulator.get_context()).copy())
+        return np.array(attractors)
+
+    def test_random_seed_reaches_the_exploring_agents(self):
+        same = self._Attractors("{random_seed: 3, duration: 10}")
+        np.testing.assert_array_equal(same, self._Attractors("{random_seed: 3, duration: 10}"))
+        other = self._Attractors("{random_seed: 4, duration: 10}")
+        self.assertFalse(np.array_equal(same, other))
+
+
+class HoldPose:
+    """A client of one's own: holds the attractor at the home pose with the elbow bent."""
+
+    def Validate(self) -> None:
+        pass
+
+    def AddToBuilder(self, parts: StationParts) -> ClientPorts:
+        q_star = parts.mobee.home
+        q_star[parts.mobee.joint_index("r_elbow")] = np.radians(80.0)
+        source = parts.builder.AddNamedSystem("hold_pose", ConstantVectorSource(q_star))
+        return ClientPorts(system=source, attractor=source.get_output_port())
+
+
+class TestOwnClient(unittest.TestCase):
+    def test_a_client_of_ones_own_through_the_seam(self):
+        scenario = LoadScenario("reach_around_ball")
+        station = MakeMobeeStation(scenario, prebuild_callback=HoldPose().AddToBuilder)
+        self.assertIsInstance(station.client, ConstantVectorSource)
+        simulator = MakeSimulator(station)
+        context = simulator.get_context()
+        elbow = station.mobee.joint_index("r_elbow")
+        self.assertEqual(np.degrees(station.attractor.Eval(context)[elbow]), 80.0)
+        n = len(station.mobee.joints)
+        start = np.degrees(station.robot_state.Eval(context)[elbow])
+        simulator.AdvanceTo(3.0)
+        q = station.robot_state.Eval(context)[:n]
+        # The spring pulls the elbow from its home angle toward the client's 80 degrees.
+        self.assertGreater(np.degrees(q[elbow]), start + 20.0)
+
+    def test_without_a_client_the_attractor_is_an_input(self):
+        station = MakeMobeeStation(LoadScenario("reach_around_ball"))
+        self.assertIsNone(station.client)
+        simulator = MakeSimulator(station)
+        context = simulator.get_mutable_context()
+        q_star = station.mobee.home
+        station.diagram.GetInputPort("attractor").FixValue(context, q_star)
+        simulator.AdvanceTo(0.5)
+        np.testing.assert_array_equal(station.attractor.Eval(context), q_star)
+
+
+if __name__ == "__main__":
+    unittest.main()
