@@ -242,7 +242,7 @@ class TestKinematicRobot(unittest.TestCase):
         # free motion in the world with the ball and look at the hand's distance to it.
         scenario.objects = [o for o in scenario.objects if o.name != "ball"]
         _, _, _, free = _Trajectory(scenario, np.arange(0.1, scenario.duration, 0.1))
-        virtual = simulation.diagram.GetSubsystemByName("virtual_dynamics")
+        virtual = simulation.mover
         context = simulator.get_mutable_context()
         mobee_context = simulation.mobee.GetMyContextFromRoot(context)
         distances = []

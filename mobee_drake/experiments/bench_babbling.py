@@ -87,7 +87,7 @@ def RunOne(run: RunFolder, controller: str, seed: int, minutes: float, scenario_
         "deepest": safety.deepest_penetration,
     }
     if controller == "reflex":
-        reflex = simulation.diagram.GetSubsystemByName("reflex")
+        reflex = simulation.mover
         status = reflex.GetOutputPort("status").Eval(reflex.GetMyContextFromRoot(context))
         row.update(reflexes=int(status[Status.REFLEXES]), stuck=int(status[Status.STUCK_COUNT] > 0))
     else:

@@ -98,8 +98,9 @@ class ReflexRobot:
     with ``attractor: !StateActionAttractor``)."""
 
     def __init__(self, station: Station):
-        reflex = [s for s in station.diagram.GetSystems() if isinstance(s, ReflexController)]
-        if not reflex or not isinstance(station.client, StateActionExecutor):
+        if not isinstance(station.mover, ReflexController) or not isinstance(
+            station.client, StateActionExecutor
+        ):
             raise ValueError(
                 "ReflexRobot needs a station with the !Reflex mover and a "
                 "!StateActionAttractor client"
@@ -108,7 +109,7 @@ class ReflexRobot:
         self.simulator = MakeSimulator(station)
         self.context = self.simulator.get_mutable_context()
         self.simulator.Initialize()
-        self._reflex, self._executor = reflex[0], station.client
+        self._reflex, self._executor = station.mover, station.client
         self._executor_context = self._executor.GetMyMutableContextFromRoot(self.context)
         self._period = station.config.time_step
 

@@ -74,6 +74,8 @@ class Station:
     scene_graph: SceneGraph
     robot: RobotOverlay
     mobee: Mobee
+    # What moves the robot: its virtual dynamics, or MoBeE 1.0's reflex controller.
+    mover: VirtualDynamics | ReflexController
     world: LiveWorld
     monitor: SafetyMonitor
     # The diagram's outputs: the robot's (q, v) in MoBeE's joint order, whichever robot moves,
@@ -177,6 +179,97 @@ def _AddJointController(
     )
 
 
+def _AddCompanions(
+    builder: DiagramBuilder,
+    plant: MultibodyPlant,
+    scene_graph: SceneGraph,
+    world: LiveWorld,
+    config: StationConfig,
+    robots: list[tuple[RobotOverlay, list[str]]],
+) -> list[OutputPort]:
+    """Each companion's MoBeE, virtual dynamics and attractor program; returns the ports of
+    their states in the plant's state vector."""
+    positions = []
+    for i, (companion, (overlay, joints)) in enumerate(zip(config.companions, robots)):
+        prefix = f"{companion.name}_"
+        mobee, mover, _, to_plant = _AddMobee(
+            builder,
+            plant,
+            scene_graph,
+            overlay,
+            joints,
+            companion.mobee,
+            config.time_step,
+            Kinematic(),
+            prefix=prefix,
+        )
+        builder.Connect(mover.GetOutputPort("state"), mobee.GetInputPort("state"))
+        parts = StationParts(
+            builder=builder,
+            plant=plant,
+            scene_graph=scene_graph,
+            mobee=mobee,
+            world=world,
+            robot_state=mover.GetOutputPort("state"),
+            meshcat=None,
+            random_seed=config.random_seed + 1 + i,  # its own draws
+            prefix=prefix,
+        )
+        builder.Connect(
+            companion.attractor.AddToBuilder(parts).attractor, mobee.GetInputPort("attractor")
+        )
+        positions.append(to_plant.get_output_port())
+    return positions
+
+
+def _PoseKinematicRobots(
+    builder: DiagramBuilder,
+    plant: MultibodyPlant,
+    scene_graph: SceneGraph,
+    state_ports: list[OutputPort],
+) -> None:
+    """Poses the geometry of the kinematic robots (each port fills its own robot's entries of
+    the plant's state); the plant is not simulated, only kept alive by the diagram."""
+    builder.AddNamedSystem("plant_owner", SharedPointerSystem(plant))
+    to_pose = builder.AddNamedSystem(
+        "to_geometry_pose", MultibodyPositionToGeometryPose(plant, input_multibody_state=True)
+    )
+    plant_state = state_ports[0]
+    if len(state_ports) > 1:
+        adder = builder.AddNamedSystem(
+            "all_robots_state", Adder(len(state_ports), plant.num_multibody_states())
+        )
+        for i, port in enumerate(state_ports):
+            builder.Connect(port, adder.get_input_port(i))
+        plant_state = adder.get_output_port()
+    builder.Connect(plant_state, to_pose.get_input_port())
+    builder.Connect(
+        to_pose.get_output_port(), scene_graph.get_source_pose_port(plant.get_source_id())
+    )
+
+
+def _ConnectClient(
+    builder: DiagramBuilder, client: ClientPorts | None, mobee: Mobee, mover, reflex: bool
+) -> tuple[OutputPort, OutputPort | str]:
+    """Wires the client's ports into MoBeE (and MoBeE 1.0's mover); without a client, the
+    attractor and the marker forces are inputs of the diagram. Returns the attractor's port and
+    the marker forces' port or diagram input name."""
+    if client is None:
+        attractor_input = builder.AddNamedSystem("attractor_input", PassThrough(len(mobee.joints)))
+        builder.ExportInput(attractor_input.get_input_port(), "attractor")
+        attractor = attractor_input.get_output_port()
+    else:
+        attractor = client.attractor
+    builder.Connect(attractor, mobee.GetInputPort("attractor"))
+    if reflex:  # MoBeE 1.0: the attractor is the position move command.
+        builder.Connect(attractor, mover.GetInputPort("command"))
+    if client is None or client.marker_forces is None:
+        builder.ExportInput(mobee.GetInputPort("marker_forces"), "marker_forces")
+        return attractor, "marker_forces"
+    builder.Connect(client.marker_forces, mobee.GetInputPort("marker_forces"))
+    return attractor, client.marker_forces
+
+
 def MakeMobeeStation(
     config: StationConfig, meshcat: Meshcat | None = None, *, prebuild_callback=None
 ) -> Station:
@@ -218,39 +311,7 @@ def MakeMobeeStation(
     # The client's forces (eq. 5.9-5.10) are inputs of the diagram, for scripts and supervisors
     # (unfixed, they are zero), unless the client sets the marker forces.
     builder.ExportInput(mobee.GetInputPort("config_force"), "config_force")
-    companion_positions = []
-    for i, (companion, (overlay, companion_joints)) in enumerate(
-        zip(config.companions, companions)
-    ):
-        prefix = f"{companion.name}_"
-        other, other_mover, _, other_to_plant = _AddMobee(
-            builder,
-            plant,
-            scene_graph,
-            overlay,
-            companion_joints,
-            companion.mobee,
-            config.time_step,
-            Kinematic(),
-            prefix=prefix,
-        )
-        builder.Connect(other_mover.GetOutputPort("state"), other.GetInputPort("state"))
-        ports = companion.attractor.AddToBuilder(
-            StationParts(
-                builder=builder,
-                plant=plant,
-                scene_graph=scene_graph,
-                mobee=other,
-                world=world,
-                robot_state=other_mover.GetOutputPort("state"),
-                meshcat=None,
-                random_seed=config.random_seed + 1 + i,  # its own draws
-                prefix=prefix,
-            )
-        )
-        builder.Connect(ports.attractor, other.GetInputPort("attractor"))
-        companion_positions.append(other_to_plant.get_output_port())
-
+    companion_positions = _AddCompanions(builder, plant, scene_graph, world, config, companions)
     if isinstance(mover_config, Dynamic):
         from_plant = builder.AddNamedSystem("from_plant_state", MatrixGain(selector.T))
         builder.Connect(plant.get_state_output_port(), from_plant.get_input_port())
@@ -259,23 +320,8 @@ def MakeMobeeStation(
             builder, plant, mobee, selector, to_plant, mover_config, config.time_step
         )
     else:
-        # The plant lives as long as the diagram; it is not a system of it.
-        builder.AddNamedSystem("plant_owner", SharedPointerSystem(plant))
-        to_pose = builder.AddNamedSystem(
-            "to_geometry_pose", MultibodyPositionToGeometryPose(plant, input_multibody_state=True)
-        )
-        plant_state = to_plant.get_output_port()
-        if companion_positions:  # Each robot's joints fill their own entries of the state.
-            adder = builder.AddNamedSystem(
-                "all_robots_state",
-                Adder(1 + len(companion_positions), plant.num_multibody_states()),
-            )
-            for i, port in enumerate([plant_state] + companion_positions):
-                builder.Connect(port, adder.get_input_port(i))
-            plant_state = adder.get_output_port()
-        builder.Connect(plant_state, to_pose.get_input_port())
-        builder.Connect(
-            to_pose.get_output_port(), scene_graph.get_source_pose_port(plant.get_source_id())
+        _PoseKinematicRobots(
+            builder, plant, scene_graph, [to_plant.get_output_port()] + companion_positions
         )
         robot_state = mover.GetOutputPort("state")
     builder.Connect(robot_state, mobee.GetInputPort("state"))
@@ -296,22 +342,10 @@ def MakeMobeeStation(
         meshcat=meshcat,
         random_seed=config.random_seed,
     )
-    client: ClientPorts | None = prebuild_callback(parts) if prebuild_callback else None
-    if client is None:  # The attractor is the diagram's input.
-        attractor_input = builder.AddNamedSystem("attractor_input", PassThrough(len(joints)))
-        builder.ExportInput(attractor_input.get_input_port(), "attractor")
-        attractor = attractor_input.get_output_port()
-    else:
-        attractor = client.attractor
-    builder.Connect(attractor, mobee.GetInputPort("attractor"))
-    if isinstance(mover_config, Reflex):  # MoBeE 1.0: the attractor is the position move command
-        builder.Connect(attractor, mover.GetInputPort("command"))
-    marker_forces = client.marker_forces if client is not None else None
-    if marker_forces is None:
-        builder.ExportInput(mobee.GetInputPort("marker_forces"), "marker_forces")
-    else:
-        builder.Connect(marker_forces, mobee.GetInputPort("marker_forces"))
-
+    client = prebuild_callback(parts) if prebuild_callback else None
+    attractor, marker_forces = _ConnectClient(
+        builder, client, mobee, mover, isinstance(mover_config, Reflex)
+    )
     visualizer = None
     if meshcat is not None:
         visualizer = AddViewer(
@@ -322,9 +356,8 @@ def MakeMobeeStation(
             scene_graph=scene_graph,
             mobee=mobee,
             attractor=attractor,
-            marker_forces=marker_forces or "marker_forces",
+            marker_forces=marker_forces,
         )
-
     request_ports = RequestPorts(builder.GetSystems())
     event_ledger = builder.AddNamedSystem(
         "world_event_ledger", WorldEventLedger(num_request_ports=len(request_ports))
@@ -343,6 +376,7 @@ def MakeMobeeStation(
         scene_graph=scene_graph,
         robot=robot,
         mobee=mobee,
+        mover=mover,
         world=world,
         monitor=monitor,
         robot_state=diagram.GetOutputPort("robot_state"),

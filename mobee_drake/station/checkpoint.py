@@ -17,6 +17,7 @@ it was saved.
 
 import json
 import pathlib
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
@@ -25,6 +26,17 @@ from mobee_drake.station.builder import Station
 
 # Systems whose state only serves the viewer: a checkpoint may have them or not.
 _VIEWER_SYSTEMS = ("trail",)
+
+
+@runtime_checkable
+class CheckpointedSystem(Protocol):
+    """A system whose state is more than numbers: it writes and reads files of its own."""
+
+    def WriteCheckpoint(self, context, folder: pathlib.Path) -> None:
+        """Writes its state in ``context`` (its own) into ``folder``."""
+
+    def ReadCheckpoint(self, context, folder: pathlib.Path) -> None:
+        """Restores its state from ``folder`` into ``context`` (its own)."""
 
 
 def _DiscreteStates(station: Station, context):
@@ -37,7 +49,7 @@ def _DiscreteStates(station: Station, context):
 
 def _CheckpointedSystems(station: Station) -> list:
     """The systems that write and read checkpoint files of their own (see the module)."""
-    return [s for s in station.diagram.GetSystems() if hasattr(s, "WriteCheckpoint")]
+    return [s for s in station.diagram.GetSystems() if isinstance(s, CheckpointedSystem)]
 
 
 def SaveCheckpoint(station: Station, context, folder: str | pathlib.Path) -> None:

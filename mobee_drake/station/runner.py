@@ -3,6 +3,7 @@
 import dataclasses as dc
 import pathlib
 import time
+from typing import Protocol, runtime_checkable
 
 from pydrake.systems.analysis import InitializeParams, Simulator
 from tqdm import tqdm
@@ -77,13 +78,20 @@ def Advance(
         bar.close()
 
 
+@runtime_checkable
+class ActionCounter(Protocol):
+    """A client that counts the actions it has completed (the runner checkpoints after each)."""
+
+    def CompletedActions(self, context) -> int:
+        """How many actions it has completed, in ``context`` (its own)."""
+
+
 def CompletedActions(station: Station, context) -> int:
-    """How many actions the station's clients have completed: the sum of
-    ``CompletedActions(context)`` over the systems that count them (0 without such systems)."""
+    """How many actions the station's clients have completed (0 without an ActionCounter)."""
     return sum(
         system.CompletedActions(system.GetMyContextFromRoot(context))
         for system in station.diagram.GetSystems()
-        if hasattr(system, "CompletedActions")
+        if isinstance(system, ActionCounter)
     )
 
 
