@@ -86,13 +86,14 @@ class ActionCounter(Protocol):
         """How many actions it has completed, in ``context`` (its own)."""
 
 
-def CompletedActions(station: Station, context) -> int:
-    """How many actions the station's clients have completed (0 without an ActionCounter)."""
-    return sum(
-        system.CompletedActions(system.GetMyContextFromRoot(context))
-        for system in station.diagram.GetSystems()
-        if isinstance(system, ActionCounter)
-    )
+def ActionCounters(station: Station) -> list:
+    """The station's systems that count their completed actions."""
+    return [s for s in station.diagram.GetSystems() if isinstance(s, ActionCounter)]
+
+
+def CompletedActions(counters: list, context) -> int:
+    """How many actions ``counters`` have completed in the root ``context`` (0 without any)."""
+    return sum(c.CompletedActions(c.GetMyContextFromRoot(context)) for c in counters)
 
 
 def RunStation(
@@ -121,10 +122,11 @@ def RunStation(
         simulator.Initialize()
     if record:
         station.visualizer.StartRecording()
-    saved = [CompletedActions(station, context)]
+    counters = ActionCounters(station)
+    saved = [CompletedActions(counters, context)]
 
     def AfterChunk(context):
-        done = CompletedActions(station, context)
+        done = CompletedActions(counters, context)
         if checkpoint and done > saved[0]:
             SaveCheckpoint(station, context, checkpoint)
             saved[0] = done
