@@ -87,7 +87,8 @@ def _Run(args: list[str]) -> None:
         station,
         scenario.duration,
         record=record,
-        realtime_rate=1.0 if known.meshcat and not known.no_meshcat else 0.0,
+        simulator_config=scenario.simulator_config,
+        realtime_rate=1.0 if meshcat is not None and known.meshcat else None,
         progress=True,
         checkpoint=known.checkpoint,
     )

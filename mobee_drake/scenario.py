@@ -17,6 +17,7 @@ import pathlib
 
 from pydrake.common.yaml import yaml_load_typed
 from pydrake.geometry import Meshcat
+from pydrake.systems.analysis import SimulatorConfig
 
 from mobee_drake.planning.supervisor import ExploreAttractor
 from mobee_drake.resources import ResolveScenarioFile
@@ -51,6 +52,9 @@ class Scenario(StationConfig):
     ) = dc.field(default_factory=FixedAttractor)
     # Seconds to simulate.
     duration: float = 10.0
+    # Drake's simulator settings (the target real-time rate; the station's systems are discrete,
+    # so the integrator's settings do not matter).
+    simulator_config: SimulatorConfig = dc.field(default_factory=SimulatorConfig)
 
 
 def ScenarioErrors(scenario: Scenario) -> list[str]:
@@ -103,7 +107,7 @@ def RunScenario(
     *,
     meshcat: Meshcat | None = None,
     record: str | None = None,
-    realtime_rate: float = 0.0,
+    realtime_rate: float | None = None,
     progress: bool = False,
     checkpoint: str | None = None,
 ) -> RunSummary:
@@ -116,6 +120,7 @@ def RunScenario(
         BuildScenario(scenario, meshcat),
         scenario.duration,
         record=record,
+        simulator_config=scenario.simulator_config,
         realtime_rate=realtime_rate,
         progress=progress,
         checkpoint=checkpoint,

@@ -5,7 +5,7 @@ import pathlib
 import time
 from typing import Protocol, runtime_checkable
 
-from pydrake.systems.analysis import InitializeParams, Simulator
+from pydrake.systems.analysis import InitializeParams, Simulator, SimulatorConfig
 from tqdm import tqdm
 
 from mobee_drake.atomic_files import WriteTextAtomically
@@ -101,19 +101,22 @@ def RunStation(
     duration: float,
     *,
     record: str | None = None,
-    realtime_rate: float = 0.0,
+    simulator_config: SimulatorConfig | None = None,
+    realtime_rate: float | None = None,
     progress: bool = False,
     checkpoint: str | None = None,
 ) -> RunSummary:
-    """Runs ``station`` until ``duration``; with ``record`` saves its Meshcat recording (HTML;
-    the station must have been built with Meshcat).
+    """Runs ``station`` until ``duration`` with Drake's ``simulator_config`` (``realtime_rate``,
+    if given, overrides its target real-time rate); with ``record`` saves its Meshcat recording
+    (HTML; the station must have been built with Meshcat).
 
     With ``checkpoint`` (a folder), a run resumes from the checkpoint there if there is one, and
     saves one whenever a client has completed an action (and at the end), so that an interrupted
     run loses at most the actions in flight.
     """
-    simulator = MakeSimulator(station)
-    simulator.set_target_realtime_rate(realtime_rate)
+    simulator = MakeSimulator(station, simulator_config)
+    if realtime_rate is not None:
+        simulator.set_target_realtime_rate(realtime_rate)
     context = simulator.get_mutable_context()
     if checkpoint and (pathlib.Path(checkpoint) / "simulation.npz").is_file():
         LoadCheckpoint(station, context, checkpoint)

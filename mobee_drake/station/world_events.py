@@ -15,7 +15,7 @@ at the end of the next step.
 """
 
 import numpy as np
-from pydrake.systems.analysis import Simulator
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem, OutputPort
 
 WORLD_EVENTS_PORT = "world_events"
@@ -69,9 +69,12 @@ def ApplyWorldEvents(station, root_context) -> None:
         ledger.SetCounts(ledger_context, counts)
 
 
-def MakeSimulator(station) -> Simulator:
-    """A Simulator of ``station``'s diagram that applies its world events after every step."""
+def MakeSimulator(station, config: SimulatorConfig | None = None) -> Simulator:
+    """A Simulator of ``station``'s diagram (set up by Drake's ``config``, if given) that applies
+    the station's world events after every step."""
     simulator = Simulator(station.diagram)
+    if config is not None:
+        ApplySimulatorConfig(config, simulator)
     if station.scripted_events or station.request_ports:
 
         def Monitor(root_context) -> EventStatus:
