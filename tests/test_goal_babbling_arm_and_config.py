@@ -1,5 +1,6 @@
 """The planar arm's forward kinematics against closed forms, and the configuration's round trip."""
 
+import json
 import math
 import unittest
 
@@ -8,8 +9,7 @@ import numpy as np
 from mobee_drake.goal_babbling.config import (
     ArmConfig,
     ConfigFromDict,
-    ConfigFromJson,
-    ConfigToJson,
+    ConfigToDict,
     Experiment1Config,
     Experiment2Config,
     GoalBabblingConfig,
@@ -92,30 +92,29 @@ class TestConfig(unittest.TestCase):
         self.assertEqual((config.arm.num_joints, config.arm.total_length), (15, 50.0))
         self.assertEqual((config.num_subgoals, config.reset_every_attempts), (5, 2))
         self.assertEqual(config.interest.max_region_goals, 50)
-        self.assertEqual(config.interest.mode_probabilities, (0.7, 0.2, 0.1))
+        self.assertEqual(config.interest.mode_probabilities, [0.7, 0.2, 0.1])
         self.assertEqual(config.low_level.velocity, 0.5)
         first, second = Experiment1Config(), Experiment2Config()
         self.assertEqual(
             (first.goal_space_high, first.low_level.exploration_actions, first.budget),
-            ((50.0, 50.0), 20, 50_000),
+            ([50.0, 50.0], 20, 50_000),
         )
         self.assertEqual(
             (second.goal_space_low, second.low_level.exploration_actions, second.budget),
-            ((0.0, -150.0), 100, 200_000),
+            ([0.0, -150.0], 100, 200_000),
         )
 
     def test_round_trip(self):
         config = Experiment2Config(seed=7, budget=1234)
-        config.interest.mode_probabilities = (0.5, 0.3, 0.2)
+        config.interest.mode_probabilities = [0.5, 0.3, 0.2]
         config.arm.sensor_noise_std = 0.1
-        restored = ConfigFromJson(ConfigToJson(config))
+        restored = ConfigFromDict(json.loads(json.dumps(ConfigToDict(config))))
         self.assertEqual(restored, config)
-        self.assertIsInstance(restored.goal_space_low, tuple)
         self.assertIsInstance(restored.low_level.exploration_actions, int)
 
     def test_partial_and_unknown_fields(self):
         self.assertEqual(ConfigFromDict({"arm": {"num_joints": 3}}).arm, ArmConfig(num_joints=3))
-        with self.assertRaises(ValueError):
+        with self.assertRaisesRegex(RuntimeError, "joints"):
             ConfigFromDict({"arm": {"joints": 3}})
 
     def test_actuator_reset_period(self):

@@ -8,7 +8,8 @@ comment and is listed in docs/saggriac.md.
 import dataclasses
 import json
 import math
-import typing
+
+from pydrake.common.yaml import yaml_load_typed
 
 
 @dataclasses.dataclass
@@ -90,7 +91,7 @@ class InterestConfig:
     max_region_goals: int = 50
     window: int = 20
     min_child_goals: int = 10
-    mode_probabilities: tuple[float, float, float] = (0.7, 0.2, 0.1)
+    mode_probabilities: list[float] = dataclasses.field(default_factory=lambda: [0.7, 0.2, 0.1])
     competence_tolerance: float = -0.05
     min_competence: float = -1.0
 
@@ -137,8 +138,8 @@ class GoalBabblingConfig:
         evaluation: Evaluation parameters.
     """
 
-    goal_space_low: tuple[float, float] = (0.0, -50.0)
-    goal_space_high: tuple[float, float] = (50.0, 50.0)
+    goal_space_low: list[float] = dataclasses.field(default_factory=lambda: [0.0, -50.0])
+    goal_space_high: list[float] = dataclasses.field(default_factory=lambda: [50.0, 50.0])
     num_subgoals: int = 5
     reset_every_attempts: int = 2
     budget: int = 50_000
@@ -173,8 +174,8 @@ def Experiment1Config(seed: int = 0, budget: int = 50_000) -> GoalBabblingConfig
         The configuration.
     """
     return GoalBabblingConfig(
-        goal_space_low=(0.0, -50.0),
-        goal_space_high=(50.0, 50.0),
+        goal_space_low=[0.0, -50.0],
+        goal_space_high=[50.0, 50.0],
         budget=budget,
         seed=seed,
         low_level=LowLevelConfig(exploration_actions=20),
@@ -192,8 +193,8 @@ def Experiment2Config(seed: int = 0, budget: int = 200_000) -> GoalBabblingConfi
         The configuration.
     """
     return GoalBabblingConfig(
-        goal_space_low=(0.0, -150.0),
-        goal_space_high=(150.0, 150.0),
+        goal_space_low=[0.0, -150.0],
+        goal_space_high=[150.0, 150.0],
         budget=budget,
         seed=seed,
         low_level=LowLevelConfig(exploration_actions=100),
@@ -201,56 +202,15 @@ def Experiment2Config(seed: int = 0, budget: int = 200_000) -> GoalBabblingConfi
 
 
 def ConfigToDict(config: GoalBabblingConfig) -> dict:
-    """Plain JSON-compatible dict of a configuration.
-
-    Args:
-        config: The configuration.
-
-    Returns:
-        Nested dict (tuples become lists).
-    """
+    """Plain JSON-compatible dict of a configuration."""
     return dataclasses.asdict(config)
 
 
-def _Build(cls: type, data: dict):
-    hints = typing.get_type_hints(cls)
-    kwargs = {}
-    for field in dataclasses.fields(cls):
-        if field.name not in data:
-            continue
-        value = data[field.name]
-        hint = hints[field.name]
-        if dataclasses.is_dataclass(hint):
-            value = _Build(hint, value)
-        elif typing.get_origin(hint) is tuple:
-            value = tuple(value)
-        kwargs[field.name] = value
-    unknown = set(data) - {field.name for field in dataclasses.fields(cls)}
-    if unknown:
-        raise ValueError(f"unknown {cls.__name__} fields: {sorted(unknown)}")
-    return cls(**kwargs)
-
-
 def ConfigFromDict(data: dict) -> GoalBabblingConfig:
-    """Inverse of ConfigToDict; missing fields take their defaults.
-
-    Args:
-        data: Nested dict as written by ConfigToDict (or a subset of it).
-
-    Returns:
-        The configuration.
+    """Inverse of :func:`ConfigToDict` by Drake's YAML loader (JSON is YAML); missing fields take
+    their defaults.
 
     Raises:
-        ValueError: On a field name the configuration does not have.
+        RuntimeError: naming a field the configuration does not have.
     """
-    return _Build(GoalBabblingConfig, data)
-
-
-def ConfigToJson(config: GoalBabblingConfig) -> str:
-    """JSON text of a configuration."""
-    return json.dumps(ConfigToDict(config), indent=2, sort_keys=True)
-
-
-def ConfigFromJson(text: str) -> GoalBabblingConfig:
-    """Configuration from JSON text written by ConfigToJson."""
-    return ConfigFromDict(json.loads(text))
+    return yaml_load_typed(schema=GoalBabblingConfig, data=json.dumps(data))
