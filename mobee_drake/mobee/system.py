@@ -19,6 +19,7 @@ from mobee_drake.mobee.joint_limits import JointLimits
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.mobee.projection import PointForceProjector
 from mobee_drake.mobee.squash import Squash
+from mobee_drake.robots.controlled_robot import ControlledRobot
 from mobee_drake.robots.overlay import MarkerStates, RobotOverlay
 
 # The force terms of eq. 5.7, in the order of the rows of the force cache; "total" is their sum.
@@ -93,35 +94,17 @@ class Mobee(LeafSystem):
         self._joints = list(joints)
         n = len(self._joints)
         params.Validate(self._joints)
-        source = "MoBeE"
-        self._q_index, self._v_index, q_min, q_max = [], [], [], []
-        for name in self._joints:
-            if not plant.HasJointNamed(name, robot.instance):
-                movable = [
-                    plant.get_joint(j).name()
-                    for j in plant.GetJointIndices(robot.instance)
-                    if plant.get_joint(j).num_positions() == 1
-                ]
-                raise ValueError(
-                    f"{source}: unknown joint '{name}'; the robot's joints are: "
-                    + ", ".join(movable)
-                )
-            joint = plant.GetJointByName(name, robot.instance)
-            self._q_index.append(joint.position_start())
-            self._v_index.append(joint.velocity_start())
-            q_min.append(joint.position_lower_limits()[0])
-            q_max.append(joint.position_upper_limits()[0])
-        self._q_index = np.array(self._q_index)
-        self._v_index = np.array(self._v_index)
-        self._q_min, self._q_max = np.array(q_min), np.array(q_max)
+        self._robot = controlled = ControlledRobot.Of(plant, robot, self._joints, "MoBeE")
+        self._q_index, self._v_index = controlled.q_index, controlled.v_index
+        self._q_min, self._q_max = controlled.lower, controlled.upper
         mass, damping, stiffness = (np.array(x) for x in params.PerJoint(self._joints))
         self._mass, self._damping, self._stiffness = mass, damping, stiffness
         self._limits = JointLimits(self._q_min, self._q_max, params.limit_delta, params.limit_force)
         self._clauses = ClauseSet(
-            robot.overlay.clauses, self._joints, robot.frozen_joints, source=source
+            robot.overlay.clauses, self._joints, robot.frozen_joints, source="MoBeE"
         )
         self._default_positions = plant.GetPositions(plant.CreateDefaultContext())
-        self._home = self._default_positions[self._q_index]
+        self._home = controlled.home
         self._state_names = [f"{j} position" for j in self._joints] + [
             f"{j} velocity" for j in self._joints
         ]
@@ -131,11 +114,7 @@ class Mobee(LeafSystem):
         self._geometry_names = dict(robot.geometry_names)
         self._geometry_frames = {g: plant.get_frame(f) for g, f in robot.geometry_frames.items()}
         self._project = PointForceProjector(plant)
-        self._markers = robot.markers
-        self._marker_bodies = [
-            plant.GetBodyByName(m.body_name, robot.instance) for m in self._markers
-        ]
-        self._marker_index = {m.name: i for i, m in enumerate(self._markers)}
+        self._markers, self._marker_bodies = controlled.markers, controlled.marker_bodies
         num_markers = len(self._markers)
 
         self._state_port = self.DeclareVectorInputPort("state", 2 * n)
@@ -276,23 +255,15 @@ class Mobee(LeafSystem):
 
     @property
     def marker_names(self) -> list[str]:
-        return [m.name for m in self._markers]
+        return self._robot.marker_names
 
     def marker_index(self, name: str) -> int:
         """The index of marker ``name`` in the marker ports (its force is ``3i:3i+3``)."""
-        if name not in self._marker_index:
-            raise ValueError(
-                f"MoBeE: unknown marker '{name}'; markers are: " + ", ".join(self.marker_names)
-            )
-        return self._marker_index[name]
+        return self._robot.MarkerIndex(name)
 
     def joint_index(self, name: str) -> int:
         """The index of joint ``name`` in the n-vectors of this system."""
-        if name not in self._joints:
-            raise ValueError(
-                f"MoBeE: unknown joint '{name}'; controlled joints are: " + ", ".join(self._joints)
-            )
-        return self._joints.index(name)
+        return self._robot.JointIndex(name)
 
     @property
     def home(self) -> np.ndarray:

@@ -19,6 +19,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake.mobee.constraints import ClauseSet
 from mobee_drake.mobee.fields import FindFieldPairs
+from mobee_drake.robots.controlled_robot import ControlledRobot
 from mobee_drake.robots.overlay import MarkerStates
 from mobee_drake.robots.scenario_robot import AddScenarioRobot, RobotConfig
 from mobee_drake.world.live_world import LiveWorld
@@ -73,19 +74,15 @@ class KinematicModel:
         self.context = self.diagram.CreateDefaultContext()
         self._plant_context = plant.GetMyMutableContextFromRoot(self.context)
         self._scene_graph_context = scene_graph.GetMyContextFromRoot(self.context)
-        instance = self._overlay.instance
-        joints = [plant.GetJointByName(name, instance) for name in self.joints]
+        self.robot = ControlledRobot.Of(plant, self._overlay, self.joints, "kinematic model")
         # Where each controlled joint's position is in the plant's positions.
-        self.position_index = np.array([j.position_start() for j in joints])
-        self.lower = np.array([j.position_lower_limits()[0] for j in joints])
-        self.upper = np.array([j.position_upper_limits()[0] for j in joints])
-        self.home = plant.GetPositions(self._plant_context)[self.position_index]
+        self.position_index = self.robot.q_index
+        self.lower, self.upper, self.home = self.robot.lower, self.robot.upper, self.robot.home
         self.clauses = ClauseSet(
             self._overlay.overlay.clauses, self.joints, self._overlay.frozen_joints
         )
-        self.markers = self._overlay.markers
-        self.marker_names = [m.name for m in self.markers]
-        self._marker_bodies = [plant.GetBodyByName(m.body_name, instance) for m in self.markers]
+        self.markers, self._marker_bodies = self.robot.markers, self.robot.marker_bodies
+        self.marker_names = self.robot.marker_names
         self.clearance = clearance
         self._field_margins = self._overlay.field_margins if inside_fields else None
         self._max_margin = max(self._overlay.field_margins.values(), default=0.0)
@@ -94,18 +91,10 @@ class KinematicModel:
         self._names.update(self._overlay.geometry_names)
 
     def JointIndex(self, name: str) -> int:
-        if name not in self.joints:
-            raise ValueError(
-                f"unknown joint '{name}'; the model's joints are: " + ", ".join(self.joints)
-            )
-        return self.joints.index(name)
+        return self.robot.JointIndex(name)
 
     def MarkerIndex(self, name: str) -> int:
-        if name not in self.marker_names:
-            raise ValueError(
-                f"unknown marker '{name}'; the model's markers are: " + ", ".join(self.marker_names)
-            )
-        return self.marker_names.index(name)
+        return self.robot.MarkerIndex(name)
 
     def SetPose(self, q: np.ndarray) -> None:
         """Puts the model in pose ``q`` (the controlled joints, rad)."""
