@@ -4,6 +4,7 @@ Each writer stages its output beside the destination (same file system) and rena
 place with :func:`os.replace`, so a reader sees the old whole or the new whole, never a part.
 """
 
+import contextlib
 import json
 import os
 import pathlib
@@ -30,17 +31,24 @@ def WriteJsonAtomically(path: str | pathlib.Path, data) -> None:
     WriteTextAtomically(path, json.dumps(data))
 
 
+@contextlib.contextmanager
+def _StagedFolder(folder: pathlib.Path):
+    """A new folder beside ``folder`` (same file system), removed if the block fails."""
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    staging = pathlib.Path(tempfile.mkdtemp(dir=folder.parent, prefix=f".{folder.name}-"))
+    try:
+        yield staging
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+
+
 def WriteFolderAtomically(folder: str | pathlib.Path, write) -> None:
     """Calls ``write(staging)`` on a new folder beside ``folder``, then renames it into place, so
     that ``folder`` is always either the old or the new whole."""
     folder = pathlib.Path(folder)
-    folder.parent.mkdir(parents=True, exist_ok=True)
-    staging = pathlib.Path(tempfile.mkdtemp(dir=folder.parent, prefix=f".{folder.name}-"))
-    try:
+    with _StagedFolder(folder) as staging:
         write(staging)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
     if folder.exists():
         old = folder.with_name(f".{folder.name}-old")
         shutil.rmtree(old, ignore_errors=True)
@@ -51,15 +59,15 @@ def WriteFolderAtomically(folder: str | pathlib.Path, write) -> None:
         os.replace(staging, folder)
 
 
-def PublishFolder(staging: pathlib.Path, folder: pathlib.Path) -> bool:
-    """Renames a complete ``staging`` folder to ``folder`` unless another writer got there
-    first (then ``staging`` is removed); returns whether this writer's copy is the one in place.
-    For caches whose entries, once written, never change."""
+def WriteFolderOnce(folder: str | pathlib.Path, write) -> None:
+    """As :func:`WriteFolderAtomically`, for a cache entry that never changes once written: when
+    another writer put its whole copy in place first, that copy stays and this one is dropped."""
+    folder = pathlib.Path(folder)
+    with _StagedFolder(folder) as staging:
+        write(staging)
     try:
         os.replace(staging, folder)
-        return True
     except OSError:
         shutil.rmtree(staging, ignore_errors=True)
-        if not folder.exists():
+        if not folder.is_dir():
             raise
-        return False

@@ -20,11 +20,11 @@ an interrupted conversion never leaves a half-written model behind.
 import hashlib
 import os
 import pathlib
-import shutil
-import tempfile
 import xml.etree.ElementTree as ET
 
 import icub_models
+
+from mobee_drake.atomic_files import WriteFolderOnce, WriteTextAtomically
 
 _MESH_PACKAGE_PREFIX = "package://iCub/meshes/"
 # Changes whenever the conversion below changes, so that old cached models are not reused.
@@ -55,10 +55,7 @@ def IcubModelSourceFile(model_name: str) -> pathlib.Path:
 def _ConvertMesh(source: pathlib.Path, destination: pathlib.Path) -> None:
     import trimesh  # Imported lazily: only the first use of a model needs it.
 
-    mesh = trimesh.load(source, force="mesh")
-    temporary = destination.with_suffix(f".{os.getpid()}.tmp.obj")
-    mesh.export(temporary)
-    os.replace(temporary, destination)
+    WriteTextAtomically(destination, trimesh.load(source, force="mesh").export(file_type="obj"))
 
 
 def _LeafLinksToFrames(robot: ET.Element) -> None:
@@ -121,14 +118,6 @@ def PreparedIcubModel(model_name: str) -> pathlib.Path:
 
     _LeafLinksToFrames(robot)
 
-    folder.parent.mkdir(parents=True, exist_ok=True)
-    staging = pathlib.Path(tempfile.mkdtemp(dir=folder.parent, prefix=f".{model_name}-"))
-    try:
-        tree.write(staging / "model.urdf")
-        os.replace(staging, folder)
-    except OSError:
-        # Another process won the race and renamed its copy first; use that one.
-        shutil.rmtree(staging, ignore_errors=True)
-        if not urdf.is_file():
-            raise
+    # A process that loses the race to a concurrent one uses the winner's copy.
+    WriteFolderOnce(folder, lambda staging: tree.write(staging / "model.urdf"))
     return urdf
