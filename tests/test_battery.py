@@ -19,6 +19,7 @@ from unittest import mock
 
 from battery_jobs import Count, Nan, Walk
 
+from mobee_drake.experiments import saggriac
 from mobee_drake.experiments.battery import (
     RAY_MISSING,
     BatteryError,
@@ -141,6 +142,20 @@ class RayBatteryTest(TemporaryFolder):
         local = RunBattery(Walks(), self.folder / "local", workers=2, progress=False)
         self.assertEqual(on_ray, local)
         self.assertEqual(ResultFiles(self.folder / "ray"), ResultFiles(self.folder / "local"))
+
+    def test_an_experiment_battery_gives_the_same_runs_on_both_backends(self):
+        # SAGG-RIAC's runs, tiny: everything but the wall time is the same on both backends.
+        specs = [
+            saggriac.RunSpec(1, method, 0, 300, 1) for method in ("SAGG-RIAC", "ACTUATOR-RIAC")
+        ]
+        results = {
+            name: saggriac.RunAll(specs, self.folder / name, backend)
+            for name, backend in (("ray", Ray()), ("local", LocalProcesses(2)))
+        }
+        for run in (*results["ray"], *results["local"]):
+            self.assertGreater(run.pop("wall_time_s"), 0.0)
+        self.assertEqual(results["ray"], results["local"])
+        self.assertEqual(len(results["ray"][0]["curve"]), 2)
 
     def test_half_done_battery_finishes_on_the_other_backend(self):
         reference = RunBattery(
