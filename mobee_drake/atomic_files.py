@@ -2,12 +2,21 @@
 
 Each writer stages its output beside the destination (same file system) and renames it into
 place with :func:`os.replace`, so a reader sees the old whole or the new whole, never a part.
+
+Checkpoints, which a run rewrites again and again, are *generations*
+(:func:`WriteGeneration`, :func:`CurrentGeneration`): a folder holds complete generations
+``g000001``, ``g000002``, ... A write stages the new generation in a hidden folder, renames it
+to its final name (one atomic step: from then on it is complete and the newest), and only then
+removes the older generations. A kill at any moment leaves at least one complete generation, and
+the reader takes the highest-numbered one; half-written staging and half-removed old generations
+are ignored, and cleared by the next write.
 """
 
 import contextlib
 import json
 import os
 import pathlib
+import re
 import shutil
 import tempfile
 
@@ -71,3 +80,49 @@ def WriteFolderOnce(folder: str | pathlib.Path, write) -> None:
         shutil.rmtree(staging, ignore_errors=True)
         if not folder.is_dir():
             raise
+
+
+_GENERATION = re.compile(r"g(\d{6})")
+
+
+def _Generations(folder: pathlib.Path) -> list[pathlib.Path]:
+    """The generations in ``folder``, oldest first."""
+    if not folder.is_dir():
+        return []
+    found = [p for p in folder.iterdir() if p.is_dir() and _GENERATION.fullmatch(p.name)]
+    return sorted(found, key=lambda p: p.name)
+
+
+def _Step(name: str) -> None:
+    """A point between two steps of :func:`WriteGeneration`, where the tests inject kills."""
+
+
+def CurrentGeneration(folder: str | pathlib.Path) -> pathlib.Path | None:
+    """The newest complete generation of ``folder`` (None when it holds none)."""
+    generations = _Generations(pathlib.Path(folder))
+    return generations[-1] if generations else None
+
+
+def WriteGeneration(folder: str | pathlib.Path, write) -> pathlib.Path:
+    """Calls ``write(staging)`` on a new folder inside ``folder``, makes it the newest complete
+    generation and removes the older ones and any staging a kill left; returns the generation."""
+    folder = pathlib.Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    generations = _Generations(folder)
+    number = int(_GENERATION.fullmatch(generations[-1].name).group(1)) + 1 if generations else 1
+    generation = folder / f"g{number:06d}"
+    staging = pathlib.Path(tempfile.mkdtemp(dir=folder, prefix=".staging-"))
+    try:
+        write(staging)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    _Step("staged")
+    os.rename(staging, generation)
+    _Step("renamed")
+    for old in generations:
+        shutil.rmtree(old, ignore_errors=True)
+        _Step("pruned one")
+    for leftover in folder.glob(".staging-*"):
+        shutil.rmtree(leftover, ignore_errors=True)
+    return generation

@@ -12,10 +12,12 @@ from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake import __version__
 from mobee_drake.mobee.system import Mobee
+from mobee_drake.owned_folders import FolderError
 from mobee_drake.resources import ScenarioNames
 from mobee_drake.robots.icub import AddIcub, IcubConfig
 from mobee_drake.robots.model_cache import IcubModelNames
-from mobee_drake.scenario import BuildScenario, LoadScenario
+from mobee_drake.scenario import BuildScenario, LoadScenario, ResumableConfiguration
+from mobee_drake.station.checkpoint import CheckpointError
 from mobee_drake.station.runner import RunStation
 
 
@@ -83,15 +85,19 @@ def _Run(args: list[str]) -> None:
         _Fail(str(e))
     if known.graphviz:
         pathlib.Path(known.graphviz).write_text(station.diagram.GetGraphvizString())
-    summary = RunStation(
-        station,
-        scenario.duration,
-        record=record,
-        simulator_config=scenario.simulator_config,
-        realtime_rate=1.0 if meshcat is not None and known.meshcat else None,
-        progress=True,
-        checkpoint=known.checkpoint,
-    )
+    try:
+        summary = RunStation(
+            station,
+            scenario.duration,
+            record=record,
+            simulator_config=scenario.simulator_config,
+            realtime_rate=1.0 if meshcat is not None and known.meshcat else None,
+            progress=True,
+            checkpoint=known.checkpoint,
+            configuration=ResumableConfiguration(scenario),
+        )
+    except (FolderError, CheckpointError) as e:  # Raised before anything is simulated.
+        _Fail(str(e))
     print(summary.Format())
 
 

@@ -15,15 +15,16 @@ A client of your own is a dataclass with ``Validate()`` and ``AddToBuilder(parts
 import dataclasses as dc
 import pathlib
 
-from pydrake.common.yaml import yaml_load_typed
+from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 from pydrake.geometry import Meshcat
 from pydrake.systems.analysis import SimulatorConfig
 
+from mobee_drake import __version__
 from mobee_drake.planning.supervisor import ExploreAttractor
 from mobee_drake.resources import ResolveScenarioFile
 from mobee_drake.station.attractors import FixedAttractor, RandomAttractors, SliderAttractor
 from mobee_drake.station.builder import MakeMobeeStation, Station
-from mobee_drake.station.config import StationConfig, StationConfigErrors
+from mobee_drake.station.config import StationConfig, StationConfigErrors, Visualization
 from mobee_drake.station.executor import StateActionAttractor
 from mobee_drake.station.runner import RunStation, RunSummary
 from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
@@ -96,6 +97,19 @@ def LoadScenario(
     return scenario
 
 
+def ResumableConfiguration(scenario: Scenario) -> str:
+    """The configuration a checkpoint of ``scenario`` records and must match to be resumed:
+    the package's version and the scenario, but for what may change between a run and its
+    resumption (the duration, the viewer, the simulator's pacing)."""
+    kept = dc.replace(
+        scenario,
+        duration=Scenario.duration,
+        visualization=Visualization(),
+        simulator_config=SimulatorConfig(),
+    )
+    return f"mobee_drake_version: {__version__}\n" + yaml_dump_typed(kept)
+
+
 def BuildScenario(scenario: Scenario, meshcat: Meshcat | None = None) -> Station:
     """The station of ``scenario`` with its client (``station.client``); with ``meshcat``, also
     the viewer."""
@@ -124,4 +138,5 @@ def RunScenario(
         realtime_rate=realtime_rate,
         progress=progress,
         checkpoint=checkpoint,
+        configuration=ResumableConfiguration(scenario),
     )

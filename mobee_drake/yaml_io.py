@@ -66,3 +66,44 @@ def LoadYamlFile(*, schema, filename, child_name: str | None = None, defaults=No
         line = LineOf(text, re.findall(r"'([^']+)'", str(e)))
         where = f"{path}:{line}" if line else f"{path}"
         raise YamlFileError(f"{where}: {e}") from e
+
+
+class _TaggedLoader(yaml.SafeLoader):
+    """Reads YAML that Drake's ``yaml_dump_typed`` wrote, a tagged value as ``{"!Tag": value}``."""
+
+
+def _Tagged(loader: yaml.SafeLoader, suffix: str, node: yaml.Node):
+    if isinstance(node, yaml.MappingNode):
+        return {"!" + suffix: loader.construct_mapping(node, deep=True)}
+    if isinstance(node, yaml.SequenceNode):
+        return {"!" + suffix: loader.construct_sequence(node, deep=True)}
+    return {"!" + suffix: loader.construct_scalar(node)}
+
+
+_TaggedLoader.add_multi_constructor("!", _Tagged)
+
+
+def _Flatten(data, prefix: str = "") -> dict[str, object]:
+    if isinstance(data, dict) and data:
+        flat = {}
+        for key, value in data.items():
+            flat.update(_Flatten(value, f"{prefix}.{key}" if prefix else str(key)))
+        return flat
+    if isinstance(data, list) and data:
+        flat = {}
+        for i, value in enumerate(data):
+            flat.update(_Flatten(value, f"{prefix}[{i}]"))
+        return flat
+    return {prefix: data}
+
+
+def YamlDifferences(before: str, after: str) -> list[str]:
+    """What differs between two YAML texts of the same schema: ``key: old -> new`` for every
+    leaf (a missing one shown as ``-``), in key order."""
+    old = _Flatten(yaml.load(before, Loader=_TaggedLoader))
+    new = _Flatten(yaml.load(after, Loader=_TaggedLoader))
+    return [
+        f"{key}: {old.get(key, '-')} -> {new.get(key, '-')}"
+        for key in sorted(old.keys() | new.keys())
+        if old.get(key, "-") != new.get(key, "-")
+    ]

@@ -10,12 +10,13 @@ from pydrake.systems.analysis import InitializeParams
 from pydrake.systems.framework import LeafSystem
 
 from mobee_drake import cli
+from mobee_drake.atomic_files import CurrentGeneration
 from mobee_drake.mobee.fields import FieldPairs
 from mobee_drake.planning.state_space import Lattice
-from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario
+from mobee_drake.scenario import BuildScenario, LoadScenario, ResumableConfiguration, RunScenario
 from mobee_drake.station.attractors import RandomAttractorSource
 from mobee_drake.station.builder import MakeMobeeStation
-from mobee_drake.station.checkpoint import LoadCheckpoint, SaveCheckpoint
+from mobee_drake.station.checkpoint import LoadCheckpoint, ReadCheckpointFiles, SaveCheckpoint
 from mobee_drake.station.config import Dynamic
 from mobee_drake.station.runner import Advance
 from mobee_drake.station.safety import SafetyMonitor
@@ -493,7 +494,7 @@ class TestCheckpoints(unittest.TestCase):
         simulator.AdvanceTo(30.0)
         for a, b in zip(expected, Final(second, simulator)):
             np.testing.assert_array_equal(a, b)
-        self.assertTrue((folder / "run" / "right_arm.npz").is_file())
+        self.assertTrue((CurrentGeneration(folder / "run") / "right_arm.npz").is_file())
 
     def test_runner_saves_after_actions_and_resumes(self):
         folder = pathlib.Path(tempfile.mkdtemp()) / "run"
@@ -503,9 +504,16 @@ class TestCheckpoints(unittest.TestCase):
         scenario.duration = 30.0
         second = RunScenario(scenario, checkpoint=str(folder))  # resumes at 20 s
         self.assertAlmostEqual(second.simulated_time, 10.0)
-        other = BuildScenario(LoadScenario(REACH, "{mover: !Dynamic {}}"))
+        reach = LoadScenario(REACH, "{mover: !Dynamic {}}")
+        other = BuildScenario(reach)
+        with self.assertRaisesRegex(ValueError, "another configuration .*attractor"):
+            LoadCheckpoint(
+                other, other.diagram.CreateDefaultContext(), folder, ResumableConfiguration(reach)
+            )
         with self.assertRaisesRegex(ValueError, "no saved state for 'plant'"):
-            LoadCheckpoint(other, other.diagram.CreateDefaultContext(), folder)
+            ReadCheckpointFiles(
+                other, other.diagram.CreateDefaultContext(), CurrentGeneration(folder)
+            )
 
 
 class TestInteractive(unittest.TestCase):

@@ -7,6 +7,10 @@ A battery is a list of jobs (:class:`Job`), each a module-level function called 
 - ``runs/<name>/result.json``: the job's result, checked as strict JSON (a NaN or an infinity
   fails the job, naming it) and written atomically by the runner when the job returns. A job whose
   result file exists is not run again: its stored result is returned (run-if-missing).
+- ``runs/<name>/job.json``: the job's function and arguments, written before it first runs. A
+  battery whose job finds its folder holding a run of other arguments (a result or a checkpoint
+  made with other settings) is refused before anything runs, naming what differs, so that a
+  result is never reused, nor a run resumed, under settings it was not made with.
 - ``runs/<name>/progress.json``: the last count the job gave :meth:`RunFolder.Progress`, from
   which the parent draws the run's bar (a battery bar counts the runs, a bar per running job
   counts its units; the parent reads the records every :data:`POLL_SECONDS`).
@@ -14,7 +18,9 @@ A battery is a list of jobs (:class:`Job`), each a module-level function called 
   there (atomically, see :mod:`mobee_drake.atomic_files`) and starts from it when it finds one
   resumes exactly after a kill, on either backend.
 
-The results are returned, keyed by job name in job order, as parsed from their files, so a
+The output folder is claimed and locked while the battery runs (:mod:`mobee_drake.owned_folders`):
+a folder of the user's is refused, and so is a second battery on the same folder. The results are
+returned, keyed by job name in job order, as parsed from their files, so a
 result computed now and one loaded later are equal. Jobs are deterministic functions of their
 kwargs and the runner adds nothing to their results, so a job gives the same bytes on every
 backend, and a battery interrupted on one backend finishes on another. (The environment is the
@@ -82,9 +88,13 @@ from typing import ClassVar
 from tqdm import tqdm
 
 from mobee_drake.atomic_files import WriteJsonAtomically, WriteTextAtomically
+from mobee_drake.owned_folders import OwnedFolder
+from mobee_drake.yaml_io import YamlDifferences
 
 RESULT = "result.json"
 PROGRESS = "progress.json"
+# A job's arguments, as it was first run with them.
+ARGUMENTS = "job.json"
 # How often the parent reads the running jobs' progress records (s).
 POLL_SECONDS = 1.0
 RAY_MISSING = '--ray needs the optional extra: pip install "mobee-drake[ray]"'
@@ -402,11 +412,64 @@ def RunBattery(
 
     Raises:
         BatteryError: When jobs failed, after the others finished.
+        ValueError: Before anything runs, when job names repeat or a job's folder holds a run
+            of other arguments (naming what differs).
+        FolderError: When ``output`` is not ours or another battery is using it.
     """
     jobs, output = list(jobs), pathlib.Path(output).absolute()  # Workers have their own cwd.
     names = [job.name for job in jobs]
     if len(set(names)) != len(names):
         raise ValueError(f"job names repeat: {sorted({n for n in names if names.count(n) > 1})}")
+    with OwnedFolder(output, "battery"):
+        _CheckArguments(jobs, output)
+        return _RunJobs(jobs, output, backend or LocalProcesses(workers), progress, description)
+
+
+def _Plain(value):
+    """JSON for what a job's arguments hold besides JSON's own types."""
+    if dataclasses.is_dataclass(value):
+        return {type(value).__name__: dataclasses.asdict(value)}
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    return str(value)
+
+
+def _ArgumentsText(job: Job) -> str:
+    arguments = dict(function=f"{job.function.__module__}.{job.function.__qualname__}")
+    arguments.update(job.kwargs)
+    return json.dumps(arguments, default=_Plain, sort_keys=True, indent=1)
+
+
+def _CheckArguments(jobs: list[Job], output: pathlib.Path) -> None:
+    """Records each job's arguments in its folder (``job.json``), or, when the folder holds
+    a run of other arguments, refuses the battery naming what differs."""
+    mismatches = []
+    for job in jobs:
+        path, text = output / "runs" / job.name / ARGUMENTS, _ArgumentsText(job)
+        if not path.is_file():
+            if (output / "runs" / job.name).is_dir() and any(
+                (output / "runs" / job.name).iterdir()
+            ):
+                mismatches.append(f"{job.name}: its folder holds a run without recorded arguments")
+            continue
+        if path.read_text() != text:
+            differences = YamlDifferences(path.read_text(), text)
+            mismatches.append(f"{job.name}: {'; '.join(differences[:3])}")
+    if mismatches:
+        raise ValueError(
+            f"{output}: holds runs of other arguments ({' | '.join(mismatches[:3])}"
+            + (f" | and {len(mismatches) - 3} more" if len(mismatches) > 3 else "")
+            + "); use another output folder for these settings"
+        )
+    for job in jobs:
+        if not (output / "runs" / job.name / ARGUMENTS).is_file():
+            WriteTextAtomically(output / "runs" / job.name / ARGUMENTS, _ArgumentsText(job))
+
+
+def _RunJobs(
+    jobs: list[Job], output: pathlib.Path, backend: Backend, progress: bool, description: str
+) -> dict[str, dict]:
+    names = [job.name for job in jobs]
     results = {job.name: _StoredResult(output, job.name) for job in jobs}
     queue = collections.deque(job for job in jobs if results[job.name] is None)
     if not queue:
@@ -414,7 +477,6 @@ def RunBattery(
     # Records of an interrupted battery would show bars for jobs not yet started.
     for job in queue:
         (output / "runs" / job.name / PROGRESS).unlink(missing_ok=True)
-    backend = backend or LocalProcesses(workers)
     errors = {}
     display = _Display(output, len(jobs), len(jobs) - len(queue), description, progress)
     try:

@@ -40,7 +40,7 @@ import numpy as np
 from pydrake.geometry import StartMeshcat
 from scipy.stats import ttest_ind
 
-from mobee_drake.atomic_files import WriteFolderAtomically
+from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     Backend,
@@ -81,7 +81,7 @@ def _Robot() -> IcubConfig:
 def TrainMdp(folder: pathlib.Path, min_tries: int, seed: int = 0, progress=None):
     """The curious agent's model of the rank-3 lattice, learned once (kept in ``folder``);
     ``progress(n)``, if given, is told the actions done as the agent learns."""
-    if not (folder / f"{AGENT}.npz").is_file():
+    if CurrentGeneration(folder) is None:
         agent = ExploringAgent(name=AGENT, joints=RIGHT_ARM, levels=LEVELS)
         Explore(
             ExplorationScenario([agent], robot=_Robot(), random_seed=seed),
@@ -141,15 +141,17 @@ def ReachRobot(
 def _Checkpoint(
     folder: pathlib.Path, robot: SimulatedRobot, learner: ReachLearner, data: dict
 ) -> None:
-    """Saves the simulation, the learner and ``data`` (evaluations, wall time) atomically."""
+    """Saves the simulation, the learner and ``data`` (evaluations, wall time) as the newest
+    generation of ``folder``."""
 
     def Write(staging: pathlib.Path) -> None:
+        (staging / "simulation").mkdir()
         robot.Save(staging / "simulation")
         arrays, learner_data = learner.ToArrays()
         np.savez(staging / "learner.npz", **arrays)
         (staging / "learner.json").write_text(json.dumps(dict(learner=learner_data, **data)))
 
-    WriteFolderAtomically(folder, Write)
+    WriteGeneration(folder, Write)
 
 
 def RunOne(
@@ -185,10 +187,11 @@ def RunOne(
     robot = ReachRobot(model.space, grid.radius, settings.reach_force, meshcat)
     checkpoint = run_dir / "checkpoint"
     data = dict(evaluations={}, wall_seconds=0.0, target=None)
-    if checkpoint.is_dir():
-        saved = json.loads((checkpoint / "learner.json").read_text())
-        learner.LoadArrays(np.load(checkpoint / "learner.npz"), saved.pop("learner"))
-        robot.Load(checkpoint / "simulation")
+    generation = CurrentGeneration(checkpoint)
+    if generation is not None:
+        saved = json.loads((generation / "learner.json").read_text())
+        learner.LoadArrays(np.load(generation / "learner.npz"), saved.pop("learner"))
+        robot.Load(generation / "simulation")
         data = saved
         if data["target"] is not None:
             robot.SetProblem(np.array(data["target"]))
@@ -243,9 +246,11 @@ def RunOne(
     return result
 
 
-def ReachJob(run: RunFolder, mdp_dir: str, settings: dict) -> dict:
-    """The battery job of one reach-learning run (``settings``: a :class:`RunSettings`)."""
-    return RunOne(run.path, pathlib.Path(mdp_dir), RunSettings(**settings), progress=run.Progress)
+def ReachJob(run: RunFolder, mdp: str, settings: dict) -> dict:
+    """The battery job of one reach-learning run (``settings``: a :class:`RunSettings`) on the
+    MDP learned by the battery's job ``mdp``."""
+    mdp_dir = run.path.parent / mdp / "model"
+    return RunOne(run.path, mdp_dir, RunSettings(**settings), progress=run.Progress)
 
 
 def RunReachBattery(
@@ -271,7 +276,7 @@ def RunReachBattery(
             f"{strategy}_seed{seed}",
             ReachJob,
             dict(
-                mdp_dir=str(output / "runs" / mdp / "model"),
+                mdp=mdp,
                 settings=dc.asdict(dc.replace(settings, strategy=strategy, seed=seed)),
             ),
             total=settings.problem_tries,

@@ -18,6 +18,7 @@ import pathlib
 
 import numpy as np
 
+from mobee_drake.atomic_files import CurrentGeneration
 from mobee_drake.planning.curiosity import TransitionCounts
 from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.planning.strategies import STRATEGIES
@@ -141,13 +142,13 @@ def ExplorerFromArrays(
 
 
 def LoadAgentModel(folder: str, name: str, config: ExplorerConfig, seed: int = 0) -> Explorer:
-    """Agent ``name``'s model from a checkpoint folder, under ``config``, its generator seeded
-    with ``seed``.
+    """Agent ``name``'s model from a checkpoint folder (its newest generation, or the folder's
+    own files), under ``config``, its generator seeded with ``seed``.
 
     Raises:
         ValueError: naming the file, when the folder has no model for that agent.
     """
-    base = pathlib.Path(folder) / name
+    base = (CurrentGeneration(folder) or pathlib.Path(folder)) / name
     for suffix in (".npz", ".json"):
         if not base.with_suffix(suffix).is_file():
             raise ValueError(f"{base.with_suffix(suffix)}: no saved model of agent '{name}'")

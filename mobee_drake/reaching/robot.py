@@ -15,7 +15,7 @@ from pydrake.systems.analysis import InitializeParams
 from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.reaching.targets import TARGET_NAME, TargetObject
 from mobee_drake.station.builder import Station
-from mobee_drake.station.checkpoint import LoadCheckpoint, SaveCheckpoint
+from mobee_drake.station.checkpoint import ReadCheckpointFiles, WriteCheckpointFiles
 from mobee_drake.station.executor import StateActionExecutor
 from mobee_drake.station.world_events import MakeSimulator
 
@@ -134,10 +134,10 @@ class SimulatedRobot:
 
     def Save(self, folder) -> None:
         """Saves where the robot is (and the executor's state) as a simulation checkpoint."""
-        SaveCheckpoint(self.station, self.context, folder)
+        WriteCheckpointFiles(self.station, self.context, folder)
 
     def Load(self, folder) -> None:
-        LoadCheckpoint(self.station, self.context, folder)
+        ReadCheckpointFiles(self.station, self.context, folder)
         self.simulator.Initialize(InitializeParams(suppress_initialization_events=True))
 
     def PenetratingSteps(self) -> int:

@@ -9,10 +9,12 @@ state is more than numbers (an exploring agent's learned model in abstract state
 - ``WriteCheckpoint(context, folder)``: writes it into ``folder`` (its own context), and
 - ``ReadCheckpoint(context, folder)``: restores it,
 
-and the checkpoint calls both for every such system of the diagram, knowing none of them. The
-folder is written next to its destination and renamed into place, so a crash never leaves a
-half-written checkpoint, and loading it into the same scenario continues the run exactly where
-it was saved.
+and the checkpoint calls both for every such system of the diagram, knowing none of them.
+``configuration.yaml`` records the configuration the run was started with; a checkpoint is only
+resumed under the same one. A checkpoint folder keeps *generations* of these files
+(:func:`~mobee_drake.atomic_files.WriteGeneration`), so a kill at any moment leaves a complete
+checkpoint, and loading the newest into the same scenario continues the run exactly where it was
+saved.
 """
 
 import json
@@ -21,9 +23,17 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from mobee_drake.atomic_files import WriteFolderAtomically
+from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration
 from mobee_drake.station.builder import Station
+from mobee_drake.yaml_io import YamlDifferences
 
+
+class CheckpointError(ValueError):
+    """A checkpoint that cannot be resumed here; the message names its folder and why."""
+
+
+# The configuration a checkpoint was written with.
+CONFIGURATION = "configuration.yaml"
 # Systems whose state only serves the viewer: a checkpoint may have them or not.
 _VIEWER_SYSTEMS = ("trail",)
 
@@ -52,31 +62,28 @@ def _CheckpointedSystems(station: Station) -> list:
     return [s for s in station.diagram.GetSystems() if isinstance(s, CheckpointedSystem)]
 
 
-def SaveCheckpoint(station: Station, context, folder: str | pathlib.Path) -> None:
-    """Saves the state of ``context`` (the diagram's root context) into ``folder``."""
-
-    def Write(staging: pathlib.Path) -> None:
-        np.savez(
-            staging / "simulation.npz",
-            time=context.get_time(),
-            **{key: value for key, value in _DiscreteStates(station, context)},
-        )
-        (staging / "world.json").write_text(json.dumps(station.world.Snapshot(context)))
-        for system in _CheckpointedSystems(station):
-            system.WriteCheckpoint(system.GetMyContextFromRoot(context), staging)
-
-    WriteFolderAtomically(folder, Write)
+def WriteCheckpointFiles(station: Station, context, folder: pathlib.Path) -> None:
+    """Writes the state of ``context`` (the diagram's root context) into the existing
+    ``folder``: the files of one checkpoint (see the module)."""
+    np.savez(
+        folder / "simulation.npz",
+        time=context.get_time(),
+        **{key: value for key, value in _DiscreteStates(station, context)},
+    )
+    (folder / "world.json").write_text(json.dumps(station.world.Snapshot(context)))
+    for system in _CheckpointedSystems(station):
+        system.WriteCheckpoint(system.GetMyContextFromRoot(context), folder)
 
 
-def LoadCheckpoint(station: Station, context, folder: str | pathlib.Path) -> None:
-    """Restores a checkpoint of the same scenario into ``context`` (the diagram's root context).
+def ReadCheckpointFiles(station: Station, context, folder: pathlib.Path) -> None:
+    """Restores the files :func:`WriteCheckpointFiles` wrote into ``context``.
 
     Raises:
-        ValueError: naming the folder, when it does not hold a checkpoint of this diagram.
+        CheckpointError: naming the folder, when it does not hold a checkpoint of this diagram.
     """
     folder = pathlib.Path(folder)
     if not (folder / "simulation.npz").is_file():
-        raise ValueError(f"{folder}: not a checkpoint (no simulation.npz)")
+        raise CheckpointError(f"{folder}: not a checkpoint (no simulation.npz)")
     saved = np.load(folder / "simulation.npz")
     context.SetTime(float(saved["time"]))
     for key, current in _DiscreteStates(station, context):
@@ -84,12 +91,12 @@ def LoadCheckpoint(station: Station, context, folder: str | pathlib.Path) -> Non
         if key not in saved.files:
             if system_name in _VIEWER_SYSTEMS:
                 continue
-            raise ValueError(
+            raise CheckpointError(
                 f"{folder}: no saved state for '{system_name}': a checkpoint of another scenario?"
             )
         value = saved[key]
         if value.shape != current.shape:
-            raise ValueError(
+            raise CheckpointError(
                 f"{folder}: the saved state of '{system_name}' has shape "
                 f"{value.shape}, the scenario's {current.shape}"
             )
@@ -100,3 +107,48 @@ def LoadCheckpoint(station: Station, context, folder: str | pathlib.Path) -> Non
     station.world.Restore(context, json.loads((folder / "world.json").read_text()))
     for system in _CheckpointedSystems(station):
         system.ReadCheckpoint(system.GetMyMutableContextFromRoot(context), folder)
+
+
+def SaveCheckpoint(
+    station: Station, context, folder: str | pathlib.Path, configuration: str = ""
+) -> None:
+    """Saves the state of ``context`` (the diagram's root context) as the newest generation of
+    ``folder`` (see :func:`~mobee_drake.atomic_files.WriteGeneration`), with the
+    ``configuration`` it was run with (YAML text; see :func:`LoadCheckpoint`)."""
+
+    def Write(staging: pathlib.Path) -> None:
+        WriteCheckpointFiles(station, context, staging)
+        (staging / CONFIGURATION).write_text(configuration)
+
+    WriteGeneration(folder, Write)
+
+
+def HasCheckpoint(folder: str | pathlib.Path) -> bool:
+    return CurrentGeneration(folder) is not None
+
+
+def LoadCheckpoint(
+    station: Station, context, folder: str | pathlib.Path, configuration: str = ""
+) -> None:
+    """Restores the newest checkpoint in ``folder`` into ``context`` (the diagram's root
+    context).
+
+    Raises:
+        CheckpointError: naming the folder, when it holds no checkpoint, one of another diagram, or
+            one written with another ``configuration`` (naming what differs).
+    """
+    generation = CurrentGeneration(folder)
+    if generation is None:
+        raise CheckpointError(f"{folder}: holds no checkpoint")
+    saved = (
+        (generation / CONFIGURATION).read_text() if (generation / CONFIGURATION).is_file() else ""
+    )
+    if saved != configuration:
+        differences = YamlDifferences(saved or "{}", configuration or "{}")
+        raise CheckpointError(
+            f"{folder}: the checkpoint was written with another configuration ("
+            + "; ".join(differences[:4])
+            + (f"; and {len(differences) - 4} more" if len(differences) > 4 else "")
+            + "); resume with the same one, or start afresh in another folder"
+        )
+    ReadCheckpointFiles(station, context, generation)

@@ -1,5 +1,6 @@
 """Runs a built station: advances it with a progress bar, checkpoints it, reports."""
 
+import contextlib
 import dataclasses as dc
 import pathlib
 import time
@@ -9,8 +10,9 @@ from pydrake.systems.analysis import InitializeParams, Simulator, SimulatorConfi
 from tqdm import tqdm
 
 from mobee_drake.atomic_files import WriteTextAtomically
+from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.station.builder import Station
-from mobee_drake.station.checkpoint import LoadCheckpoint, SaveCheckpoint
+from mobee_drake.station.checkpoint import HasCheckpoint, LoadCheckpoint, SaveCheckpoint
 from mobee_drake.station.safety import SafetyReport
 from mobee_drake.station.world_events import MakeSimulator
 
@@ -21,13 +23,22 @@ class RunSummary:
     wall_time: float
     safety: SafetyReport
     recording: str | None = None
+    # Where a resumed run started (s), and, for a run its checkpoint had finished, where it was.
+    resumed_at: float | None = None
+    finished_before: float | None = None
 
     @property
     def realtime_factor(self) -> float:
         return self.simulated_time / self.wall_time if self.wall_time > 0 else float("inf")
 
     def Format(self) -> str:
-        lines = [
+        if self.finished_before is not None:
+            return (
+                f"nothing to do: the checkpoint is at {self.finished_before:.2f} s, at or past "
+                "the run's duration (give a longer --duration to go on)"
+            )
+        lines = [] if self.resumed_at is None else [f"resumed at {self.resumed_at:.2f} s"]
+        lines += [
             f"simulated {self.simulated_time:.2f} s in {self.wall_time:.2f} s "
             f"({self.realtime_factor:.1f}x real time)"
         ]
@@ -105,40 +116,78 @@ def RunStation(
     realtime_rate: float | None = None,
     progress: bool = False,
     checkpoint: str | None = None,
+    configuration: str = "",
 ) -> RunSummary:
     """Runs ``station`` until ``duration`` with Drake's ``simulator_config`` (``realtime_rate``,
     if given, overrides its target real-time rate); with ``record`` saves its Meshcat recording
     (HTML; the station must have been built with Meshcat).
 
-    With ``checkpoint`` (a folder), a run resumes from the checkpoint there if there is one, and
-    saves one whenever a client has completed an action (and at the end), so that an interrupted
-    run loses at most the actions in flight.
+    With ``checkpoint`` (a folder: new, empty or one of our checkpoints, and held by this run
+    alone; see :mod:`mobee_drake.owned_folders`), a run resumes from the checkpoint there if
+    there is one (written with the same ``configuration``, see
+    :func:`~mobee_drake.station.checkpoint.LoadCheckpoint`), and saves one whenever a client has
+    completed an action (and at the end), so that an interrupted run loses at most the actions in
+    flight. A run whose checkpoint is at or past ``duration`` has nothing left to do: it
+    simulates nothing and says so (``RunSummary.finished_before``).
     """
+    with contextlib.ExitStack() as stack:
+        if checkpoint:
+            stack.enter_context(OwnedFolder(checkpoint, "checkpoint"))
+        return _Run(
+            station,
+            duration,
+            record=record,
+            simulator_config=simulator_config,
+            realtime_rate=realtime_rate,
+            progress=progress,
+            checkpoint=checkpoint,
+            configuration=configuration,
+        )
+
+
+def _Run(
+    station: Station,
+    duration: float,
+    *,
+    record,
+    simulator_config,
+    realtime_rate,
+    progress: bool,
+    checkpoint,
+    configuration: str,
+) -> RunSummary:
     simulator = MakeSimulator(station, simulator_config)
     if realtime_rate is not None:
         simulator.set_target_realtime_rate(realtime_rate)
     context = simulator.get_mutable_context()
-    if checkpoint and (pathlib.Path(checkpoint) / "simulation.npz").is_file():
-        LoadCheckpoint(station, context, checkpoint)
+    resumed = None
+    if checkpoint and HasCheckpoint(checkpoint):
+        LoadCheckpoint(station, context, checkpoint, configuration)
         simulator.Initialize(InitializeParams(suppress_initialization_events=True))
+        resumed = context.get_time()
     else:
         simulator.Initialize()
+    report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
+    if resumed is not None and resumed >= duration:
+        return RunSummary(0.0, 0.0, report, finished_before=resumed)
     if record:
         station.visualizer.StartRecording()
     counters = ActionCounters(station)
     saved = [CompletedActions(counters, context)]
 
+    def Save(context) -> None:
+        SaveCheckpoint(station, context, checkpoint, configuration)
+
     def AfterChunk(context):
         done = CompletedActions(counters, context)
         if checkpoint and done > saved[0]:
-            SaveCheckpoint(station, context, checkpoint)
+            Save(context)
             saved[0] = done
 
     start = time.perf_counter()
-    simulated_before = context.get_time()
     Advance(station, simulator, duration, progress=progress, after_chunk=AfterChunk)
     if checkpoint:
-        SaveCheckpoint(station, context, checkpoint)
+        Save(context)
     wall = time.perf_counter() - start
     recording = None
     if record:
@@ -149,8 +198,9 @@ def RunStation(
         recording = str(path.resolve())
     report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
     return RunSummary(
-        simulated_time=context.get_time() - simulated_before,
+        simulated_time=context.get_time() - (resumed or 0.0),
         wall_time=wall,
         safety=report,
         recording=recording,
+        resumed_at=resumed,
     )
