@@ -1,0 +1,207 @@
+"""Nothing learned is lost or silently wrong: checkpoint generations that survive a kill at any
+step of their write, folders that are ours before we write into them and have one writer at a
+time, and checkpoints and battery runs tied to the configuration they were made with."""
+
+import contextlib
+import io
+import pathlib
+import shutil
+import subprocess
+import sys
+import tempfile
+import textwrap
+import unittest
+
+from battery_jobs import Count
+
+from mobee_drake import cli
+from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration
+from mobee_drake.experiments.battery import Job, RunBattery
+from mobee_drake.owned_folders import ClaimFolder, FolderError, OwnedFolder
+
+# The steps of a generation's write, as WriteGeneration marks them, and a kill inside the
+# caller's write (after its first file).
+STEPS = ("inside the write", "staged", "renamed", "pruned one")
+
+
+def _WriteTwoFiles(text: str):
+    def Write(staging: pathlib.Path) -> None:
+        (staging / "a.txt").write_text(text)
+        (staging / "b.txt").write_text(text)
+
+    return Write
+
+
+class TemporaryFolder(unittest.TestCase):
+    def setUp(self):
+        self.folder = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, self.folder, ignore_errors=True)
+
+
+class TestGenerations(TemporaryFolder):
+    def _KilledWrite(self, folder: pathlib.Path, step: str) -> int:
+        """Writes generation "new" over "old" in a process killed (os._exit) at ``step``."""
+        script = textwrap.dedent(
+            f"""
+            import os, pathlib
+            from mobee_drake import atomic_files
+
+            step = {step!r}
+            atomic_files._Step = lambda name: os._exit(9) if name == step else None
+
+            def Write(staging):
+                (staging / "a.txt").write_text("new")
+                if step == "inside the write":
+                    os._exit(9)
+                (staging / "b.txt").write_text("new")
+
+            atomic_files.WriteGeneration(pathlib.Path({str(folder)!r}), Write)
+            """
+        )
+        return subprocess.run([sys.executable, "-c", script]).returncode
+
+    def test_a_kill_at_every_step_leaves_a_complete_generation(self):
+        for step in STEPS:
+            with self.subTest(step):
+                folder = self.folder / step.replace(" ", "_")
+                WriteGeneration(folder, _WriteTwoFiles("old"))
+                WriteGeneration(folder, _WriteTwoFiles("old"))  # two old generations
+                self.assertEqual(self._KilledWrite(folder, step), 9)
+                current = CurrentGeneration(folder)
+                texts = {(current / n).read_text() for n in ("a.txt", "b.txt")}
+                # Before the rename the old checkpoint is the newest; from it on, the new one.
+                expected = "new" if step in ("renamed", "pruned one") else "old"
+                self.assertEqual(texts, {expected})
+                # The next write goes on from there and clears what the kill left.
+                WriteGeneration(folder, _WriteTwoFiles("next"))
+                self.assertEqual(
+                    [p.name for p in folder.iterdir()], [CurrentGeneration(folder).name]
+                )
+
+    def test_an_empty_folder_holds_no_generation(self):
+        self.assertIsNone(CurrentGeneration(self.folder / "none"))
+        self.assertIsNone(CurrentGeneration(self.folder))
+
+
+class TestOwnedFolders(TemporaryFolder):
+    def test_a_users_folder_or_file_is_refused_and_left_alone(self):
+        thesis = self.folder / "thesis.tex"
+        thesis.write_text("chapter 1")
+        with self.assertRaisesRegex(
+            FolderError, "not empty and not a mobee-drake checkpoint .*thesis.tex"
+        ):
+            ClaimFolder(self.folder, "checkpoint")
+        with self.assertRaisesRegex(FolderError, "thesis.tex: is a file"):
+            ClaimFolder(thesis, "checkpoint")
+        self.assertEqual(thesis.read_text(), "chapter 1")
+        self.assertEqual([p.name for p in self.folder.iterdir()], ["thesis.tex"])
+
+    def test_new_empty_and_own_folders_are_taken_other_kinds_refused(self):
+        ClaimFolder(self.folder / "new", "checkpoint")
+        (self.folder / "empty").mkdir()
+        ClaimFolder(self.folder / "empty", "checkpoint")
+        ClaimFolder(self.folder / "empty", "checkpoint")  # ours now
+        with self.assertRaisesRegex(FolderError, "holds a checkpoint, not a battery"):
+            ClaimFolder(self.folder / "empty", "battery")
+
+    def test_one_writer_at_a_time(self):
+        with OwnedFolder(self.folder / "run", "checkpoint"):
+            with self.assertRaisesRegex(FolderError, "in use by another run"):
+                with OwnedFolder(self.folder / "run", "checkpoint"):
+                    pass
+        with OwnedFolder(self.folder / "run", "checkpoint"):  # released
+            pass
+
+    def test_a_killed_writer_releases_its_folder(self):
+        holder = subprocess.Popen(
+            [
+                sys.executable,
+                "-c",
+                "import sys, time; from mobee_drake.owned_folders import OwnedFolder\n"
+                f"with OwnedFolder({str(self.folder / 'run')!r}, 'checkpoint'):\n"
+                "    print('held', flush=True); time.sleep(60)",
+            ],
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        self.addCleanup(holder.kill)
+        self.assertEqual(holder.stdout.readline().strip(), "held")
+        with self.assertRaisesRegex(FolderError, "in use"):
+            with OwnedFolder(self.folder / "run", "checkpoint"):
+                pass
+        holder.kill()
+        holder.wait()
+        with OwnedFolder(self.folder / "run", "checkpoint"):
+            pass
+
+
+class TestBatteryArguments(TemporaryFolder):
+    def test_a_result_is_not_reused_under_other_arguments(self):
+        calls = self.folder / "calls"
+        jobs = [Job("count", Count, dict(x=2, calls=str(calls)))]
+        RunBattery(jobs, self.folder / "out", backend=None, progress=False)
+        other = [Job("count", Count, dict(x=3, calls=str(calls)))]
+        with self.assertRaisesRegex(ValueError, r"other arguments \(count: x: 2 -> 3\)"):
+            RunBattery(other, self.folder / "out", progress=False)
+        self.assertEqual(calls.read_text().split(), ["count"])  # nothing ran again
+
+    def test_a_second_battery_on_the_same_folder_is_refused(self):
+        jobs = [Job("count", Count, dict(x=2, calls=str(self.folder / "calls")))]
+        with OwnedFolder(self.folder / "out", "battery"):
+            with self.assertRaisesRegex(FolderError, "in use by another run"):
+                RunBattery(jobs, self.folder / "out", progress=False)
+
+    def test_a_users_folder_is_refused(self):
+        (self.folder / "notes.txt").write_text("mine")
+        jobs = [Job("count", Count, dict(x=2, calls=str(self.folder / "calls")))]
+        with self.assertRaisesRegex(FolderError, "not a mobee-drake battery"):
+            RunBattery(jobs, self.folder, progress=False)
+
+
+class TestRunCheckpoints(TemporaryFolder):
+    def _Run(self, *args: str) -> tuple[int, str, str]:
+        out, err = io.StringIO(), io.StringIO()
+        code = 0
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                cli.main(["run", "explore_hypercube", "--no-meshcat", *args])
+            except SystemExit as e:
+                code = e.code
+        return code, out.getvalue(), err.getvalue()
+
+    def test_a_users_folder_or_file_is_never_a_checkpoint(self):
+        thesis = self.folder / "thesis.tex"
+        thesis.write_text("chapter 1")
+        for target in (self.folder, thesis):
+            code, _, err = self._Run("--duration", "1", "--checkpoint", str(target))
+            self.assertEqual(code, 2)
+            self.assertRegex(err, rf"^error: {target}: .*\n$")
+        self.assertEqual(thesis.read_text(), "chapter 1")
+        self.assertEqual([p.name for p in self.folder.iterdir()], ["thesis.tex"])
+
+    def test_resume_only_under_the_same_configuration_and_finished_runs_stay_finished(self):
+        checkpoint = str(self.folder / "run")
+        code, out, _ = self._Run("--duration", "3", "--checkpoint", checkpoint)
+        self.assertEqual(code, 0, out)
+        generation = CurrentGeneration(checkpoint)
+        saved = (generation / "simulation.npz").read_bytes()
+        code, out, _ = self._Run("--duration", "3", "--checkpoint", checkpoint)
+        self.assertEqual(code, 0)
+        self.assertIn("nothing to do: the checkpoint is at 3.00 s", out)
+        code, out, _ = self._Run("--duration", "2", "--checkpoint", checkpoint)
+        self.assertIn("nothing to do", out)
+        self.assertEqual(CurrentGeneration(checkpoint), generation)
+        self.assertEqual((generation / "simulation.npz").read_bytes(), saved)
+        code, _, err = self._Run(
+            "--duration", "4", "--checkpoint", checkpoint, "--set", "{random_seed: 5}"
+        )
+        self.assertEqual(code, 2)
+        self.assertIn("another configuration (random_seed: 0 -> 5)", err)
+        code, out, _ = self._Run("--duration", "4", "--checkpoint", checkpoint)
+        self.assertEqual(code, 0)
+        self.assertIn("resumed at 3.00 s", out)
+        self.assertIn("simulated 1.00 s", out)
+
+
+if __name__ == "__main__":
+    unittest.main()
