@@ -13,11 +13,16 @@ import textwrap
 import unittest
 
 from battery_jobs import Count
+import numpy as np
 
 from mobee_drake import cli
 from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration
 from mobee_drake.experiments.battery import Job, RunBattery
+from mobee_drake.experiments.ch7_model_learning import Stop
+from mobee_drake.experiments.exploration import ExplorationScenario, Explore
 from mobee_drake.owned_folders import ClaimFolder, FolderError, OwnedFolder
+from mobee_drake.planning.supervisor import ExploringAgent
+from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS
 
 # The steps of a generation's write, as WriteGeneration marks them, and a kill inside the
 # caller's write (after its first file).
@@ -156,6 +161,39 @@ class TestBatteryArguments(TemporaryFolder):
         jobs = [Job("count", Count, dict(x=2, calls=str(self.folder / "calls")))]
         with self.assertRaisesRegex(FolderError, "not a mobee-drake battery"):
             RunBattery(jobs, self.folder, progress=False)
+
+
+class TestExplorationCheckpoints(TemporaryFolder):
+    """An exploration (the ch. 8 MDP's training, ch. 7.4.1's) interrupted after a checkpoint
+    resumes to the model an uninterrupted one learns."""
+
+    def _Explore(self, folder: pathlib.Path, interrupt_at: int | None = None) -> dict:
+        agent = ExploringAgent(name="arm", joints=list(RIGHT_SHOULDER_ELBOW_JOINTS))
+
+        def Progress(done: int) -> None:  # Told after the chunk's checkpoint.
+            if interrupt_at is not None and done >= interrupt_at:
+                raise KeyboardInterrupt
+
+        Explore(
+            ExplorationScenario([agent], random_seed=4),
+            stop=Stop(actions=12),
+            checkpoint=folder,
+            progress=Progress,
+        )
+        return dict(np.load(CurrentGeneration(folder) / "arm.npz"))
+
+    def test_an_interrupted_exploration_resumes_exactly(self):
+        whole = self._Explore(self.folder / "whole")
+        with self.assertRaises(KeyboardInterrupt):
+            self._Explore(self.folder / "interrupted", interrupt_at=4)
+        saved = dict(np.load(CurrentGeneration(self.folder / "interrupted") / "arm.npz"))
+        self.assertLess(saved["tries"].sum(), whole["tries"].sum())
+        resumed = self._Explore(self.folder / "interrupted")
+        for key in ("counts", "rewards", "tries"):
+            np.testing.assert_array_equal(resumed[key], whole[key], key)
+        # Run again, it is done: the model does not change.
+        again = self._Explore(self.folder / "interrupted")
+        np.testing.assert_array_equal(again["counts"], whole["counts"])
 
 
 class TestRunCheckpoints(TemporaryFolder):

@@ -115,8 +115,9 @@ def ExploreJob(
     keep_model: bool = False,
 ) -> dict:
     """The battery job of one exploration run: ``agents`` explore among ``objects`` until
-    ``stop``; the result is :func:`Explore`'s data with ``labels``. With ``keep_model`` the final
-    checkpoint (the learned models) is kept in ``run.path / "model"``."""
+    ``stop``; the result is :func:`Explore`'s data with ``labels``. With ``keep_model`` the run is
+    checkpointed (and resumed after a kill) in ``run.path / "model"``, which keeps the final
+    learned models."""
     scenario = ExplorationScenario(agents, objects, random_seed=random_seed)
     scenario.world_events = list(world_events)
     data = Explore(
@@ -125,7 +126,7 @@ def ExploreJob(
         snapshots=snapshots,
         chunk=chunk,
         observer=_TableContacts if table_contacts else None,
-        keep=run.path / "model" if keep_model else None,
+        checkpoint=run.path / "model" if keep_model else None,
         progress=run.Progress,
     )
     return dict(**labels, **data)

@@ -79,17 +79,17 @@ def _Robot() -> IcubConfig:
 
 
 def TrainMdp(folder: pathlib.Path, min_tries: int, seed: int = 0, progress=None):
-    """The curious agent's model of the rank-3 lattice, learned once (kept in ``folder``);
-    ``progress(n)``, if given, is told the actions done as the agent learns."""
-    if CurrentGeneration(folder) is None:
-        agent = ExploringAgent(name=AGENT, joints=RIGHT_ARM, levels=LEVELS)
-        Explore(
-            ExplorationScenario([agent], robot=_Robot(), random_seed=seed),
-            chunk=5.0,
-            keep=folder,
-            stop=lambda records: records[0].explorer.tries.min() >= min_tries,
-            progress=progress,
-        )
+    """The curious agent's model of the rank-3 lattice, learned once (checkpointed in ``folder``
+    as it learns, resumed from there after a kill); ``progress(n)``, if given, is told the
+    actions done as the agent learns."""
+    agent = ExploringAgent(name=AGENT, joints=RIGHT_ARM, levels=LEVELS)
+    Explore(
+        ExplorationScenario([agent], robot=_Robot(), random_seed=seed),
+        chunk=5.0,
+        checkpoint=folder,
+        stop=lambda records: records[0].explorer.tries.min() >= min_tries,
+        progress=progress,
+    )
     return LoadAgentModel(str(folder), AGENT, ExplorerConfig())
 
 

@@ -5,11 +5,12 @@ import pathlib
 import time
 
 import numpy as np
+from pydrake.systems.analysis import InitializeParams
 
 from mobee_drake.planning.explorers import INITIALIZATIONS
 from mobee_drake.planning.supervisor import ExploreAttractor, ExploringAgent
-from mobee_drake.scenario import BuildScenario, Scenario
-from mobee_drake.station.checkpoint import SaveCheckpoint
+from mobee_drake.scenario import BuildScenario, ResumableConfiguration, Scenario
+from mobee_drake.station.checkpoint import HasCheckpoint, LoadCheckpoint, SaveCheckpoint
 from mobee_drake.station.runner import Advance
 from mobee_drake.station.world_events import MakeSimulator
 
@@ -29,12 +30,18 @@ def ExplorationScenario(
     return scenario
 
 
-def StartExploration(scenario: Scenario):
-    """The scenario built and initialised: the station, its simulator, the exploration
-    supervisor and the supervisor's context."""
+def StartExploration(scenario: Scenario, checkpoint: pathlib.Path | None = None):
+    """The scenario built and initialised (from the checkpoint in ``checkpoint``, if there is
+    one): the station, its simulator, the exploration supervisor and the supervisor's context."""
     station = BuildScenario(scenario)
     simulator = MakeSimulator(station)
-    simulator.Initialize()
+    if checkpoint is not None and HasCheckpoint(checkpoint):
+        LoadCheckpoint(
+            station, simulator.get_mutable_context(), checkpoint, ResumableConfiguration(scenario)
+        )
+        simulator.Initialize(InitializeParams(suppress_initialization_events=True))
+    else:
+        simulator.Initialize()
     supervisor = station.client
     return station, simulator, supervisor, supervisor.GetMyContextFromRoot(simulator.get_context())
 
@@ -52,23 +59,32 @@ def Explore(
     stop,
     snapshots=(),
     chunk: float = 2.0,
-    keep: pathlib.Path | None = None,
+    checkpoint: pathlib.Path | None = None,
     observer=None,
     progress=None,
 ) -> dict:
-    """Runs until ``stop(records)``; returns per-agent tries (and values at ``snapshots``); with
-    ``keep``, saves the final checkpoint there (the learned models, for a planner to reuse);
+    """Runs until ``stop(records)``; returns per-agent tries (and values at ``snapshots``).
+
+    With ``checkpoint`` (a checkpoint folder), the run resumes from the checkpoint there, saves
+    one after every chunk in which an action was completed, and keeps the final one (the learned
+    models, for a planner to reuse); the data returned then covers the run since it resumed.
     ``observer(station)``, if given, returns a callable run on the root context after every
     chunk of the simulation and a function giving its data for the result; ``progress(n)``, if
     given, is told the number of actions done after every chunk."""
-    station, simulator, supervisor, supervisor_context = StartExploration(scenario)
+    station, simulator, supervisor, supervisor_context = StartExploration(scenario, checkpoint)
     context = simulator.get_context()
+    configuration = ResumableConfiguration(scenario)
+    records = supervisor.Records(supervisor_context)
+    saved = sum(r.actions_done for r in records)
     observe, observed = observer(station) if observer else (None, dict)
     taken, coverage, start = {}, [], time.perf_counter()
-    while True:
+    while not stop(records):  # (A resumed run that was done stops at once.)
         Advance(station, simulator, context.get_time() + chunk, after_chunk=observe)
         records = supervisor.Records(supervisor_context)
         done = sum(r.actions_done for r in records)
+        if checkpoint is not None and done > saved:
+            SaveCheckpoint(station, context, checkpoint, configuration)
+            saved = done
         if progress is not None:
             progress(done)
         coverage.append([done] + [int((r.explorer.tries > 0).sum()) for r in records])
@@ -78,10 +94,8 @@ def Explore(
                     tries=records[0].explorer.tries.tolist(),
                     values=records[0].explorer.Values()[0].tolist(),
                 )
-        if stop(records):
-            break
-    if keep is not None:
-        SaveCheckpoint(station, context, keep)
+    if checkpoint is not None and not HasCheckpoint(checkpoint):  # (No action was completed.)
+        SaveCheckpoint(station, context, checkpoint, configuration)
     report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
     return dict(
         agents=supervisor.agent_names,
