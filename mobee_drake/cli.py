@@ -11,8 +11,9 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake import __version__
+from mobee_drake.experiments.arguments import PositiveFloat
 from mobee_drake.mobee.system import Mobee
-from mobee_drake.owned_folders import FolderError
+from mobee_drake.owned_folders import CanWrite, FolderError
 from mobee_drake.resources import ScenarioNames
 from mobee_drake.robots.icub import AddIcub, IcubConfig
 from mobee_drake.robots.model_cache import IcubModelNames
@@ -38,7 +39,9 @@ def _Run(args: list[str]) -> None:
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
     parser.add_argument("scenario", help="a scenario file or a shipped scenario's name")
-    parser.add_argument("--duration", type=float, help="seconds to simulate (default: the file's)")
+    parser.add_argument(
+        "--duration", type=PositiveFloat, help="seconds to simulate (default: the file's)"
+    )
     parser.add_argument("--record", help="save a replayable Meshcat recording to this HTML file")
     parser.add_argument("--no-record", action="store_true", help="do not save a recording")
     parser.add_argument(
@@ -71,6 +74,9 @@ def _Run(args: list[str]) -> None:
         record = known.record or str(
             pathlib.Path("results") / (pathlib.Path(known.scenario).stem + ".html")
         )
+    for output in (record, known.graphviz):  # Checked before the run, not after it.
+        if output and not CanWrite(output):
+            _Fail(f"{output}: cannot be written (its folder is missing, read-only or full?)")
     meshcat = None
     if known.meshcat and not known.no_meshcat:
         meshcat = StartMeshcat()
@@ -180,7 +186,15 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("command", choices=sorted(COMMANDS))
     parser.add_argument("args", nargs=argparse.REMAINDER)
     known = parser.parse_args(argv[:1])
-    COMMANDS[known.command](argv[1:])
+    try:
+        COMMANDS[known.command](argv[1:])
+    except KeyboardInterrupt:
+        # The workers are gone with the battery; runs resume from their last checkpoint.
+        print(
+            "interrupted: run the same command again to go on from the last checkpoints",
+            file=sys.stderr,
+        )
+        sys.exit(130)
 
 
 if __name__ == "__main__":

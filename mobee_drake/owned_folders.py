@@ -13,6 +13,7 @@ import fcntl
 import json
 import os
 import pathlib
+import tempfile
 
 MARKER = ".mobee-drake"
 _LOCK = ".mobee-drake.lock"
@@ -67,3 +68,19 @@ def OwnedFolder(folder: str | pathlib.Path, kind: str):
         yield folder
     finally:
         os.close(handle)
+
+
+def CanWrite(path: str | pathlib.Path) -> bool:
+    """Whether a file can be written at ``path`` now (its folder made if missing): tried with a
+    small file beside it, removed again."""
+    path = pathlib.Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.NamedTemporaryFile(
+            dir=path.parent, prefix=f".{path.name}.", suffix=".probe"
+        ) as probe:
+            probe.write(b"probe")
+            probe.flush()
+        return not path.is_dir()
+    except OSError:
+        return False

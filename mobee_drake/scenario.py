@@ -13,11 +13,13 @@ A client of your own is a dataclass with ``Validate()`` and ``AddToBuilder(parts
 """
 
 import dataclasses as dc
+import math
 import pathlib
 
 from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
 from pydrake.geometry import Meshcat
 from pydrake.systems.analysis import SimulatorConfig
+import yaml
 
 from mobee_drake import __version__
 from mobee_drake.planning.supervisor import ExploreAttractor
@@ -29,6 +31,9 @@ from mobee_drake.station.executor import StateActionAttractor
 from mobee_drake.station.runner import RunStation, RunSummary
 from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
 
+# The longest run a scenario may ask for (s; our choice: about 116 simulated days, far beyond any
+# experiment of the sources, and short enough that a typo like 1e308 is caught, not simulated).
+MAX_DURATION = 1e7
 # The clients a scenario file can name, by their YAML tags.
 CLIENTS = (
     FixedAttractor,
@@ -61,8 +66,8 @@ class Scenario(StationConfig):
 def ScenarioErrors(scenario: Scenario) -> list[str]:
     """What is wrong with ``scenario`` that its types cannot say (empty: nothing)."""
     errors = StationConfigErrors(scenario)
-    if not scenario.duration > 0:
-        errors.append(f"duration must be > 0, got {scenario.duration}")
+    if not (math.isfinite(scenario.duration) and 0 < scenario.duration <= MAX_DURATION):
+        errors.append(f"duration must be > 0 and <= {MAX_DURATION:g} s, got {scenario.duration}")
     try:
         scenario.attractor.Validate()
     except ValueError as e:
@@ -88,12 +93,15 @@ def LoadScenario(
     order (e.g. ``{mover: !Dynamic {control: force}}``)."""
     filename = ResolveScenarioFile(filename)
     scenario = LoadYamlFile(schema=Scenario, filename=filename, child_name=scenario_name)
+    ValidateScenario(scenario, str(filename))
     for text in [overrides] if isinstance(overrides, str) else overrides or []:
         try:
             scenario = yaml_load_typed(schema=Scenario, data=text, defaults=scenario)
-        except (RuntimeError, ValueError) as e:
+        except yaml.YAMLError as e:
+            raise YamlFileError(f"overrides '{text}': invalid YAML: {e.problem}") from None
+        except (RuntimeError, ValueError, TypeError) as e:
             raise YamlFileError(f"overrides '{text}': {e}") from e
-    ValidateScenario(scenario, str(filename))
+        ValidateScenario(scenario, f"overrides '{text}'")
     return scenario
 
 

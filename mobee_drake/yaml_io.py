@@ -52,7 +52,18 @@ def LoadYamlFile(*, schema, filename, child_name: str | None = None, defaults=No
     path = pathlib.Path(filename)
     if not path.is_file():
         raise YamlFileError(f"{path}: no such file")
-    text = path.read_text()
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError:
+        raise YamlFileError(f"{path}: not a text file (not UTF-8)") from None
+    except OSError as e:
+        raise YamlFileError(f"{path}: cannot be read: {e.strerror}") from None
+    if "\0" in text:
+        raise YamlFileError(f"{path}: not a text file")
+    if not text.strip() or all(
+        not line.strip() or line.lstrip().startswith("#") for line in text.splitlines()
+    ):
+        raise YamlFileError(f"{path}: empty (write {{}} for all the defaults)")
     try:
         kwargs = dict(schema=schema, data=text, child_name=child_name)
         if defaults is not None:

@@ -6,10 +6,12 @@ import contextlib
 import io
 import pathlib
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
 import textwrap
+import time
 import unittest
 
 from battery_jobs import Count
@@ -194,6 +196,30 @@ class TestExplorationCheckpoints(TemporaryFolder):
         # Run again, it is done: the model does not change.
         again = self._Explore(self.folder / "interrupted")
         np.testing.assert_array_equal(again["counts"], whole["counts"])
+
+
+class TestInterrupts(TemporaryFolder):
+    def test_ctrl_c_on_a_battery_ends_in_one_line_and_code_130(self):
+        output = self.folder / "out"
+        battery = subprocess.Popen(
+            [sys.executable, "-m", "mobee_drake.cli", "experiment", "saggriac", "--experiments",
+             "2", "--seeds", "1", "--methods", "SAGG-RIAC", "--budget-exp2", "100000000",
+             "--workers", "1", "--output", str(output)],
+            stderr=subprocess.PIPE,
+            text=True,
+        )  # fmt: skip
+        self.addCleanup(battery.kill)
+        deadline = time.monotonic() + 60
+        while not list(output.glob("runs/*/progress.json")) and time.monotonic() < deadline:
+            time.sleep(0.2)
+        battery.send_signal(signal.SIGINT)
+        _, err = battery.communicate(timeout=60)
+        self.assertEqual(battery.returncode, 130)
+        self.assertEqual(
+            err.strip().splitlines()[-1],
+            "interrupted: run the same command again to go on from the last checkpoints",
+        )
+        self.assertNotIn("Traceback", err)
 
 
 class TestRunCheckpoints(TemporaryFolder):

@@ -88,6 +88,7 @@ from typing import ClassVar
 from tqdm import tqdm
 
 from mobee_drake.atomic_files import WriteJsonAtomically, WriteTextAtomically
+from mobee_drake.experiments.arguments import PositiveInt
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.yaml_io import YamlDifferences
 
@@ -516,7 +517,10 @@ def _RunJobs(
 def AddBackendArguments(parser, workers: int = 1) -> None:
     """Adds ``--workers`` and ``--ray [ADDRESS]`` to an experiment's command line."""
     parser.add_argument(
-        "--workers", type=int, default=workers, help="local worker processes (default %(default)s)"
+        "--workers",
+        type=PositiveInt,
+        default=workers,
+        help="local worker processes (default %(default)s)",
     )
     parser.add_argument(
         "--ray",

@@ -25,6 +25,7 @@ import time
 import numpy as np
 from pydrake.systems.primitives import LogVectorOutput
 
+from mobee_drake.experiments.arguments import PositiveFloat, PositiveInt
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
@@ -99,8 +100,8 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
         prog="mobee-drake bench babbling", description=__doc__.split("\n")[0]
     )
-    parser.add_argument("--seeds", type=int, default=5)
-    parser.add_argument("--minutes", type=float, default=5.0)
+    parser.add_argument("--seeds", type=PositiveInt, default=5)
+    parser.add_argument("--minutes", type=PositiveFloat, default=5.0)
     parser.add_argument("--scenario", default=SCENARIO)
     parser.add_argument(
         "--output", default=None, help="keep the runs here (default: a temporary folder)"

@@ -21,6 +21,7 @@ import numpy as np
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
+from mobee_drake.experiments.arguments import NonNegativeInt, PositiveInt
 from mobee_drake.experiments.plots import plt
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.icub import IcubConfig
@@ -144,9 +145,11 @@ def main(argv=None) -> None:
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
     parser.add_argument("--robot", choices=sorted(ROBOTS), nargs="+", default=["icub"])
-    parser.add_argument("--obstacles", type=int, nargs="+", default=[0, 10, 30, 100, 300])
-    parser.add_argument("--poses", type=int, default=2000, help="evaluations per sweep")
-    parser.add_argument("--repeats", type=int, default=5, help="sweeps per row")
+    parser.add_argument(
+        "--obstacles", type=NonNegativeInt, nargs="+", default=[0, 10, 30, 100, 300]
+    )
+    parser.add_argument("--poses", type=PositiveInt, default=2000, help="evaluations per sweep")
+    parser.add_argument("--repeats", type=PositiveInt, default=5, help="sweeps per row")
     parser.add_argument(
         "--amplitude",
         type=float,
@@ -159,7 +162,7 @@ def main(argv=None) -> None:
         help="remove one box and insert another before every evaluation (Alg. 1)",
     )
     parser.add_argument("--plot", default="", help="save the curves (like Fig. 2.4) to this PNG")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seed", type=NonNegativeInt, default=0)
     args = parser.parse_args(argv)
     print(
         "| robot | boxes | evaluations/s (best) | evaluations/s (median) | us/evaluation (best) "

@@ -28,6 +28,7 @@ import numpy as np
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.solvers import Solve
 
+from mobee_drake.experiments.arguments import NonNegativeInt, PositiveInt
 from mobee_drake.ngik.costs import CollisionCost, MarkerOrientationCost, MarkerPositionCost
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.ngik.nes import NesConfig
@@ -214,8 +215,8 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
         prog="mobee-drake bench ik", description=__doc__.split("\n")[0]
     )
-    parser.add_argument("--problems", type=int, default=50)
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--problems", type=PositiveInt, default=50)
+    parser.add_argument("--seed", type=NonNegativeInt, default=0)
     args = parser.parse_args(argv)
     print(Format(Run(args.problems, args.seed), args.problems))
 

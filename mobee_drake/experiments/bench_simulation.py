@@ -11,6 +11,7 @@ Run: ``mobee-drake bench simulation [--seconds 600] [--controls position velocit
 
 import argparse
 
+from mobee_drake.experiments.arguments import PositiveFloat
 from mobee_drake.scenario import LoadScenario, RunScenario
 
 SCENARIO = "motor_babbling"
@@ -20,7 +21,9 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
-    parser.add_argument("--seconds", type=float, default=600.0, help="simulated time per run")
+    parser.add_argument(
+        "--seconds", type=PositiveFloat, default=600.0, help="simulated time per run"
+    )
     parser.add_argument(
         "--controls",
         nargs="*",

@@ -40,6 +40,7 @@ from pydrake.geometry import SceneGraph
 from pydrake.multibody.plant import MultibodyPlant
 from scipy.stats import spearmanr
 
+from mobee_drake.experiments.arguments import PositiveInt
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     Backend,
@@ -731,10 +732,10 @@ def main(argv=None) -> None:
         "--experiment", choices=["7.1", "7.2", "7.2i", "7.3", "7.4", "7.4.1"], required=True
     )
     parser.add_argument("--output", default="results/ch7")
-    parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--runs", type=PositiveInt, default=5)
     parser.add_argument(
         "--transitions",
-        type=int,
+        type=PositiveInt,
         default=None,
         help="7.2: per run (default 2500); 7.3: per lattice (default: the "
         "source's 14,597 and 26,963); 7.4: in all (default 18,000)",

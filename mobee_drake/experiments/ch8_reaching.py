@@ -41,6 +41,7 @@ from pydrake.geometry import StartMeshcat
 from scipy.stats import ttest_ind
 
 from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration
+from mobee_drake.experiments.arguments import NonNegativeInt, PositiveFloat, PositiveInt
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     Backend,
@@ -507,23 +508,23 @@ def main(argv=None) -> None:
     parser.add_argument(
         "--strategies", nargs="+", choices=list(REACH_STRATEGIES), default=list(SOURCE_STRATEGIES)
     )
-    parser.add_argument("--seeds", type=int, default=5)
-    parser.add_argument("--problem-tries", type=int, default=6400)
+    parser.add_argument("--seeds", type=PositiveInt, default=5)
+    parser.add_argument("--problem-tries", type=PositiveInt, default=6400)
     parser.add_argument(
         "--stages",
-        type=int,
+        type=NonNegativeInt,
         nargs="+",
         default=None,
         help="when to evaluate (default: the source's 100, 200, ..., 6400 up to --problem-tries)",
     )
-    parser.add_argument("--evaluations", type=int, default=5)
+    parser.add_argument("--evaluations", type=PositiveInt, default=5)
     parser.add_argument(
         "--mdp-tries",
-        type=int,
+        type=PositiveInt,
         default=5,
         help="the MDP is learned until every state-action was tried this often",
     )
-    parser.add_argument("--checkpoint-every", type=int, default=50)
+    parser.add_argument("--checkpoint-every", type=PositiveInt, default=50)
     parser.add_argument(
         "--watch",
         action="store_true",
@@ -546,13 +547,13 @@ def main(argv=None) -> None:
     )
     parser.add_argument(
         "--reach-force",
-        type=float,
+        type=PositiveFloat,
         default=ReachForcing().force,
         help="the reach's force on the palm in N (use another --output)",
     )
     parser.add_argument(
         "--distance-unit",
-        type=float,
+        type=PositiveFloat,
         default=PredictorConfig().distance_unit,
         help="the length in m that counts as 1 in the rewards and predictions "
         "of eq. 8.1-8.7, e.g. 0.01 for centimetres (use another --output)",

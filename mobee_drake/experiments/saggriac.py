@@ -24,6 +24,7 @@ import numpy as np
 from scipy import stats
 
 from mobee_drake.atomic_files import WriteTextAtomically
+from mobee_drake.experiments.arguments import NonNegativeInt, PositiveInt
 from mobee_drake.experiments.battery import (
     RESULT,
     AddBackendArguments,
@@ -401,13 +402,17 @@ def main(argv=None) -> None:
     )
     parser.add_argument("--experiments", type=int, nargs="+", choices=[1, 2], default=[1, 2])
     parser.add_argument("--methods", nargs="+", choices=list(METHODS), default=list(METHODS))
-    parser.add_argument("--seeds", type=int, default=15, help="number of seeds (paper: 15)")
-    parser.add_argument("--first-seed", type=int, default=0)
-    parser.add_argument("--budget-exp1", type=int, default=50_000, help="paper: 50,000 movements")
+    parser.add_argument("--seeds", type=PositiveInt, default=15, help="number of seeds (paper: 15)")
+    parser.add_argument("--first-seed", type=NonNegativeInt, default=0)
     parser.add_argument(
-        "--budget-exp2", type=int, default=200_000, help="paper: 200,000 time steps"
+        "--budget-exp1", type=PositiveInt, default=50_000, help="paper: 50,000 movements"
     )
-    parser.add_argument("--checkpoints", type=int, default=20, help="evaluations after step 0")
+    parser.add_argument(
+        "--budget-exp2", type=PositiveInt, default=200_000, help="paper: 200,000 time steps"
+    )
+    parser.add_argument(
+        "--checkpoints", type=PositiveInt, default=20, help="evaluations after step 0"
+    )
     parser.add_argument("--output", type=pathlib.Path, default=pathlib.Path("saggriac_results"))
     parser.add_argument(
         "--analyse-only", action="store_true", help="only rebuild the report from run files"

@@ -16,6 +16,7 @@ import pathlib
 import numpy as np
 from pydrake.geometry import Meshcat
 
+from mobee_drake.experiments.arguments import NonNegativeInt, PositiveInt
 from mobee_drake.experiments.plots import plt
 from mobee_drake.trm.display import MarkerCloud, PathMotion, RecordMotion, ShowRoadmap
 from mobee_drake.trm.examples import EXAMPLES, OpenBox, TrmExample
@@ -116,8 +117,8 @@ def main(argv: list[str] | None = None) -> None:
     )
     parser.add_argument("--output", required=True)
     parser.add_argument("--examples", nargs="+", choices=sorted(EXAMPLES), default=list(EXAMPLES))
-    parser.add_argument("--max-vertices", type=int, default=TrmConfig.max_vertices)
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--max-vertices", type=PositiveInt, default=TrmConfig.max_vertices)
+    parser.add_argument("--seed", type=NonNegativeInt, default=0)
     args = parser.parse_args(argv)
     output = pathlib.Path(args.output)
     output.mkdir(parents=True, exist_ok=True)

@@ -343,9 +343,25 @@ class ExploreAttractor:
     timing: ActionTiming = dc.field(default_factory=ActionTiming)
 
     def Validate(self) -> None:
+        self.timing.Validate()
         names = [agent.name for agent in self.agents]
-        if len(set(names)) != len(names):
-            raise ValueError(f"exploring agents need unique names, got {names}")
+        if not names:
+            raise ValueError("exploring agents: there is none")
+        if len(set(names)) != len(names) or not all(names):
+            raise ValueError(f"exploring agents need unique, non-empty names, got {names}")
+        for agent in self.agents:
+            where = f"exploring agent '{agent.name}'"
+            if not agent.joints or len(set(agent.joints)) != len(agent.joints):
+                raise ValueError(f"{where}: needs joints, each once, got {agent.joints}")
+            if not agent.roadmap and not (
+                agent.levels and all(0 <= level <= 1 for level in agent.levels)
+            ):
+                raise ValueError(
+                    f"{where}: levels must be fractions of each joint's range in [0, 1], "
+                    f"got {agent.levels}"
+                )
+            if agent.nearest < 0:
+                raise ValueError(f"{where}: nearest must be >= 0, got {agent.nearest}")
 
     def AddToBuilder(self, parts: StationParts) -> ClientPorts:
         mobee = parts.mobee

@@ -20,6 +20,7 @@ saved.
 import json
 import pathlib
 from typing import Protocol, runtime_checkable
+import zipfile
 
 import numpy as np
 
@@ -79,16 +80,31 @@ def ReadCheckpointFiles(station: Station, context, folder: pathlib.Path) -> None
     """Restores the files :func:`WriteCheckpointFiles` wrote into ``context``.
 
     Raises:
-        CheckpointError: naming the folder, when it does not hold a checkpoint of this diagram.
+        CheckpointError: naming the folder (and file), when it does not hold a checkpoint of this
+            diagram, or a file of it is missing, truncated or holds NaN.
     """
     folder = pathlib.Path(folder)
     if not (folder / "simulation.npz").is_file():
         raise CheckpointError(f"{folder}: not a checkpoint (no simulation.npz)")
-    saved = np.load(folder / "simulation.npz")
+    try:
+        _ReadFiles(station, context, folder)
+    except CheckpointError:
+        raise
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as error:
+        raise CheckpointError(
+            f"{folder}: a damaged checkpoint ({type(error).__name__}: {error})"
+        ) from None
+
+
+def _ReadFiles(station: Station, context, folder: pathlib.Path) -> None:
+    saved = dict(np.load(folder / "simulation.npz"))
+    for key, value in saved.items():
+        if np.issubdtype(value.dtype, np.floating) and np.isnan(value).any():
+            raise CheckpointError(f"{folder / 'simulation.npz'}: '{key}' holds NaN")
     context.SetTime(float(saved["time"]))
     for key, current in _DiscreteStates(station, context):
         system_name, group = key.rsplit("/", 1)
-        if key not in saved.files:
+        if key not in saved:
             if system_name in _VIEWER_SYSTEMS:
                 continue
             raise CheckpointError(

@@ -14,6 +14,7 @@ tagged choices, so that no illegal combination can be written:
 """
 
 import dataclasses as dc
+import math
 
 from pydrake.multibody.plant import MultibodyPlantConfig
 
@@ -22,9 +23,29 @@ from mobee_drake.mobee.reflex import ReflexParams
 from mobee_drake.robots.icub import IcubConfig
 from mobee_drake.robots.zero_position import ZeroPositionConfig
 from mobee_drake.station.attractors import FixedAttractor, RandomAttractors
-from mobee_drake.world.objects import OBJECT_ROLES, SceneObject, WorldEvent
+from mobee_drake.world.objects import OBJECT_ROLES, Box, Cylinder, SceneObject, Sphere, WorldEvent
 
 CONTROL_MODALITIES = ("position", "velocity", "force")
+# The longest period MoBeE may run at (s; our choice: the original ran at 20 ms, and at 0.1 s a
+# hand at 1 m/s already moves 10 cm, more than MoBeE's fields, between two reactions).
+MAX_TIME_STEP = 0.1
+
+
+def _Finite(values) -> bool:
+    return all(math.isfinite(v) for v in values)
+
+
+def _ShapeErrors(name: str, shape) -> list[str]:
+    sizes = {
+        Box: lambda s: list(s.size),
+        Sphere: lambda s: [s.radius],
+        Cylinder: lambda s: [s.radius, s.length],
+    }[type(shape)](shape)
+    if isinstance(shape, Box) and len(sizes) != 3:
+        return [f"object '{name}': a box's size needs three numbers, got {sizes}"]
+    if not (_Finite(sizes) and min(sizes) > 0):
+        return [f"object '{name}': its shape's sizes must be finite and > 0, got {sizes}"]
+    return []
 
 
 def _Zeros3() -> list[float]:
@@ -113,14 +134,18 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
             errors.append(
                 f"mover control must be one of {CONTROL_MODALITIES}, got '{mover.control}'"
             )
-        if not mover.plant_config.time_step > 0:
-            errors.append(f"plant_config time_step must be > 0, got {mover.plant_config.time_step}")
+        step = mover.plant_config.time_step
+        if not (math.isfinite(step) and 0 < step <= config.time_step):
+            errors.append(f"plant_config time_step must be > 0 and <= time_step, got {step}")
     if isinstance(mover, Reflex) and not (
-        mover.speed_deg > 0 and mover.history >= 2 and mover.tolerance_deg > 0
+        _Finite([mover.speed_deg, mover.tolerance_deg])
+        and mover.speed_deg > 0
+        and mover.history >= 2
+        and mover.tolerance_deg > 0
     ):
-        errors.append("reflex: speed_deg and tolerance_deg must be > 0 and history >= 2")
-    if not config.time_step > 0:
-        errors.append(f"time_step must be > 0, got {config.time_step}")
+        errors.append("reflex: speed_deg and tolerance_deg must be finite and > 0, history >= 2")
+    if not (math.isfinite(config.time_step) and 0 < config.time_step <= MAX_TIME_STEP):
+        errors.append(f"time_step must be > 0 and <= {MAX_TIME_STEP} s, got {config.time_step}")
     names = set()
     for obj in config.objects:
         if not obj.name or obj.name in names:
@@ -132,6 +157,9 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
             )
         if not (len(obj.position) == 3 and len(obj.rpy_deg) == 3):
             errors.append(f"object '{obj.name}': position and rpy_deg need three numbers")
+        elif not _Finite(obj.position + obj.rpy_deg):
+            errors.append(f"object '{obj.name}': position and rpy_deg must be finite")
+        errors += _ShapeErrors(obj.name, obj.shape)
     for event in config.world_events:
         where = f"world event at {event.time} s"
         if event.object not in names:
@@ -140,6 +168,8 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
             errors.append(f"{where}: role must be one of {OBJECT_ROLES}, got '{event.role}'")
         if len(event.position) not in (0, 3):
             errors.append(f"{where}: position needs three numbers")
+        if not (_Finite([event.time, *event.position]) and event.time >= 0):
+            errors.append(f"{where}: its time must be >= 0 and its numbers finite")
     for companion in config.companions:
         if isinstance(mover, Dynamic):
             errors.append(
@@ -153,6 +183,8 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
         names.add(companion.name)
         if not (len(companion.position) == 3 and len(companion.rpy_deg) == 3):
             errors.append(f"companion '{companion.name}': position and rpy_deg need three numbers")
+        elif not _Finite(companion.position + companion.rpy_deg):
+            errors.append(f"companion '{companion.name}': position and rpy_deg must be finite")
         try:
             companion.attractor.Validate()
         except ValueError as e:

@@ -230,7 +230,12 @@ class StateActionAttractor:
     timing: ActionTiming = dc.field(default_factory=ActionTiming)
 
     def Validate(self) -> None:
-        if not (self.forcing.force > 0 and self.forcing.softening > 0):
+        self.timing.Validate()
+        if not (
+            np.isfinite([self.forcing.force, self.forcing.softening]).all()
+            and self.forcing.force > 0
+            and self.forcing.softening > 0
+        ):
             raise ValueError(
                 f"reach forcing: force and softening must be > 0, got "
                 f"{self.forcing.force} and {self.forcing.softening}"

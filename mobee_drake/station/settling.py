@@ -20,6 +20,18 @@ class ActionTiming:
     min_duration: float = 0.5  # s before an action may end
     timeout: float = 20.0  # s
 
+    def Validate(self) -> None:
+        """Raises ValueError naming the first value out of range."""
+        for name, value, low in (
+            ("settle_speed", self.settle_speed, 0.0),
+            ("timeout", self.timeout, 0.0),
+        ):
+            if not (np.isfinite(value) and value > low):
+                raise ValueError(f"timing: {name} must be finite and > 0, got {value}")
+        for name, value in (("settle_time", self.settle_time), ("min_duration", self.min_duration)):
+            if not (np.isfinite(value) and value >= 0):
+                raise ValueError(f"timing: {name} must be finite and >= 0, got {value}")
+
     def SlowSince(self, slow_since: float, now: float, v: np.ndarray) -> float:
         """Since when the joints with velocities ``v`` have been slow, given ``slow_since`` at
         the previous poll (inf: not slow now)."""
