@@ -12,6 +12,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake import __version__
 from mobee_drake.experiments.arguments import PositiveFloat
+from mobee_drake.experiments.battery import BatteryRefused
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.owned_folders import CanWrite, FolderError
 from mobee_drake.resources import ScenarioNames
@@ -113,7 +114,10 @@ def _Dispatch(prog: str, args: list[str], modules: dict[str, str]) -> None:
         parser = argparse.ArgumentParser(prog=prog)
         parser.add_argument("which", choices=sorted(modules))
         parser.parse_args(args[:1])
-    importlib.import_module(modules[args[0]]).main(args[1:])
+    try:
+        importlib.import_module(modules[args[0]]).main(args[1:])
+    except (FolderError, BatteryRefused) as e:  # Raised before anything runs.
+        _Fail(str(e))
 
 
 def _Bench(args: list[str]) -> None:

@@ -150,6 +150,10 @@ class BatteryError(RuntimeError):
     """Jobs of a battery failed (the message names them); the others' results are on disk."""
 
 
+class BatteryRefused(ValueError):
+    """A battery that may not run in its folder (runs of other arguments are there)."""
+
+
 def _RunJob(job: Job, output: pathlib.Path) -> str:
     """Runs ``job`` wherever the backend put it; writes its result and returns it as JSON."""
     run = RunFolder(output / "runs" / job.name)
@@ -413,8 +417,9 @@ def RunBattery(
 
     Raises:
         BatteryError: When jobs failed, after the others finished.
-        ValueError: Before anything runs, when job names repeat or a job's folder holds a run
-            of other arguments (naming what differs).
+        ValueError: Before anything runs, when job names repeat.
+        BatteryRefused: Before anything runs, when a job's folder holds a run of other arguments
+            (naming what differs).
         FolderError: When ``output`` is not ours or another battery is using it.
     """
     jobs, output = list(jobs), pathlib.Path(output).absolute()  # Workers have their own cwd.
@@ -457,7 +462,7 @@ def _CheckArguments(jobs: list[Job], output: pathlib.Path) -> None:
             differences = YamlDifferences(path.read_text(), text)
             mismatches.append(f"{job.name}: {'; '.join(differences[:3])}")
     if mismatches:
-        raise ValueError(
+        raise BatteryRefused(
             f"{output}: holds runs of other arguments ({' | '.join(mismatches[:3])}"
             + (f" | and {len(mismatches) - 3} more" if len(mismatches) > 3 else "")
             + "); use another output folder for these settings"

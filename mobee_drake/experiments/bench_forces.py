@@ -142,7 +142,9 @@ def MeasureForceEvaluations(
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+        prog="mobee-drake bench forces",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--robot", choices=sorted(ROBOTS), nargs="+", default=["icub"])
     parser.add_argument(

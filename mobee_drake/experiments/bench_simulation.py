@@ -19,7 +19,9 @@ SCENARIO = "motor_babbling"
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+        prog="mobee-drake bench simulation",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
         "--seconds", type=PositiveFloat, default=600.0, help="simulated time per run"

@@ -726,7 +726,9 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+        prog="mobee-drake experiment ch7",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
         "--experiment", choices=["7.1", "7.2", "7.2i", "7.3", "7.4", "7.4.1"], required=True

@@ -398,7 +398,9 @@ def main(argv=None) -> None:
         argv: Arguments (default: sys.argv[1:]).
     """
     parser = argparse.ArgumentParser(
-        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+        prog="mobee-drake experiment saggriac",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--experiments", type=int, nargs="+", choices=[1, 2], default=[1, 2])
     parser.add_argument("--methods", nargs="+", choices=list(METHODS), default=list(METHODS))
