@@ -15,7 +15,9 @@ the contract, ``docs/architecture.md`` the map):
 - :mod:`mobee_drake.station`: robot, world, MoBeE, the mover and the viewer, knowing no client;
 - :mod:`~mobee_drake.mobee` (MoBeE 2.0 and 1.0's reflex), :mod:`~mobee_drake.world` and
   :mod:`~mobee_drake.robots`: the controllers, the robot's surroundings and its models;
-- :mod:`~mobee_drake.yaml_io`, :mod:`~mobee_drake.atomic_files`, :mod:`~mobee_drake.resources`.
+- :mod:`~mobee_drake.yaml_io`, :mod:`~mobee_drake.atomic_files` (and checkpoint generations),
+  :mod:`~mobee_drake.owned_folders` (folders claimed and locked before a run writes),
+  :mod:`~mobee_drake.resources`.
 """
 
 import importlib.metadata
