@@ -12,7 +12,14 @@ import time
 import numpy as np
 
 from mobee_drake.atomic_files import WriteJsonAtomically, WriteTextAtomically
-from mobee_drake.experiments.battery import Job, LocalProcesses, Ray, RunBattery
+from mobee_drake.experiments.battery import (
+    Job,
+    JobStopped,
+    LocalProcesses,
+    Ray,
+    RunBattery,
+    StopRequested,
+)
 
 
 def Count(run, x: int, calls: str) -> dict:
@@ -48,10 +55,15 @@ def Walk(run, steps: int, seed: int, die_at: int | None = None, pause: float = 0
     return dict(steps=step, position=position, next=rng.normal())
 
 
-def Sleep(run, pids: str, seconds: float) -> dict:
-    """Writes its process id to ``pids/<run name>``, then sleeps."""
+def Sleep(run, pids: str, seconds: float, cooperative: bool = True) -> dict:
+    """Writes its process id to ``pids/<run name>``, then sleeps; a cooperative sleeper stops
+    when the battery asks (:func:`StopRequested`), the other only when killed."""
     WriteTextAtomically(pathlib.Path(pids) / run.path.name, str(os.getpid()))
-    time.sleep(seconds)
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        if cooperative and StopRequested():
+            raise JobStopped(run.path.name)
+        time.sleep(0.05)
     return dict(seconds=seconds)
 
 
@@ -62,3 +74,23 @@ def Main(backend: str, output: str, pids: str) -> None:
     RunBattery(
         jobs, output, backend=LocalProcesses(3) if backend == "local" else Ray(), progress=False
     )
+
+
+def StopWalk(run, steps: int, seed: int, pause: float) -> dict:
+    """A random walk that saves its checkpoint only when the battery asks it to stop."""
+    checkpoint = run.path / "checkpoint.json"
+    rng, step, position = np.random.default_rng(seed), 0, 0.0
+    if checkpoint.is_file():
+        saved = json.loads(checkpoint.read_text())
+        step, position, rng.bit_generator.state = saved["step"], saved["position"], saved["rng"]
+    while step < steps:
+        position += rng.normal()
+        step += 1
+        run.Progress(step)
+        time.sleep(pause)
+        if StopRequested():
+            WriteJsonAtomically(
+                checkpoint, dict(step=step, position=position, rng=rng.bit_generator.state)
+            )
+            raise JobStopped(f"stopped at step {step}")
+    return dict(steps=step, position=position, next=rng.normal())

@@ -4,6 +4,8 @@ time, and checkpoints and battery runs tied to the configuration they were made 
 
 import contextlib
 import io
+import json
+import os
 import pathlib
 import shutil
 import signal
@@ -14,12 +16,12 @@ import textwrap
 import time
 import unittest
 
-from battery_jobs import Count
+from battery_jobs import Count, StopWalk
 import numpy as np
 
 from mobee_drake import cli
 from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration
-from mobee_drake.experiments.battery import Job, RunBattery
+from mobee_drake.experiments.battery import InProcess, Job, RunBattery
 from mobee_drake.experiments.ch7_model_learning import Stop
 from mobee_drake.experiments.exploration import ExplorationScenario, Explore
 from mobee_drake.owned_folders import ClaimFolder, FolderError, OwnedFolder
@@ -220,6 +222,49 @@ class TestInterrupts(TemporaryFolder):
             "interrupted: run the same command again to go on from the last checkpoints",
         )
         self.assertNotIn("Traceback", err)
+
+
+class TestGracefulStop(TemporaryFolder):
+    def test_ctrl_c_lets_a_running_job_save_and_stop(self):
+        output = self.folder / "out"
+        jobs = "[Job('walk', StopWalk, dict(steps=150, seed=1, pause=0.02))]"
+        battery = subprocess.Popen(
+            [
+                sys.executable,
+                "-c",
+                "from battery_jobs import StopWalk\n"
+                "from mobee_drake.experiments.battery import Job, LocalProcesses, RunBattery\n"
+                f"RunBattery({jobs}, {str(output)!r}, backend=LocalProcesses(1), progress=False)",
+            ],
+            env={**os.environ, "PYTHONPATH": str(pathlib.Path(__file__).parent)},
+            stderr=subprocess.DEVNULL,
+        )
+        self.addCleanup(battery.kill)
+        progress = output / "runs" / "walk" / "progress.json"
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            with contextlib.suppress(OSError, ValueError):
+                if json.loads(progress.read_text())["done"] >= 10:
+                    break
+            time.sleep(0.05)
+        battery.send_signal(signal.SIGINT)
+        self.assertNotEqual(battery.wait(timeout=60), 0)
+        saved = json.loads((output / "runs" / "walk" / "checkpoint.json").read_text())
+        self.assertGreaterEqual(saved["step"], 10)  # It saved when asked, not at the start.
+        self.assertFalse((output / "runs" / "walk" / "result.json").exists())
+        whole = RunBattery(
+            [Job("walk", StopWalk, dict(steps=150, seed=1, pause=0.0))],
+            self.folder / "whole",
+            backend=InProcess(),
+            progress=False,
+        )
+        resumed = RunBattery(
+            [Job("walk", StopWalk, dict(steps=150, seed=1, pause=0.02))],
+            output,
+            backend=InProcess(),
+            progress=False,
+        )
+        self.assertEqual(resumed["walk"]["position"], whole["walk"]["position"])
 
 
 class TestRunCheckpoints(TemporaryFolder):

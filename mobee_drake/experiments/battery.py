@@ -32,15 +32,17 @@ Backends (``Session()`` gives a ``submit(job, output)`` that returns a
 :class:`concurrent.futures.Future` of the result's JSON text; ``capacity`` is how many jobs the
 parent keeps submitted):
 
-- :class:`LocalProcesses`, the default: a pool of ``workers`` spawned processes. Each worker
-  asks Linux for SIGKILL when its parent dies (``prctl(PR_SET_PDEATHSIG)``; it checks right after
-  that the parent is still the one that started it) and ignores SIGINT, so a Ctrl-C in a terminal
-  reaches only the parent, which kills its workers and re-raises. During a battery, SIGTERM
-  raises :class:`SystemExit` in the parent (as SIGINT raises :class:`KeyboardInterrupt`), so the
-  same clean-up runs; after a SIGKILL of the parent the kernel kills the workers (processes
-  that a job starts itself are the job's to tie to its own life). A worker that dies (say, at the
-  hands of the OOM killer) breaks the pool: the battery stops with :class:`BatteryError`, and
-  running it again resumes.
+- :class:`LocalProcesses`, the default: a pool of ``workers`` spawned processes. Each worker asks
+  Linux for SIGKILL when its parent dies (``prctl(PR_SET_PDEATHSIG)``; it checks right after that
+  the parent is still the one that started it) and ignores SIGINT, so a Ctrl-C in a terminal reaches
+  only the parent. The parent then stops the queue, asks the running jobs to stop (SIGUSR1:
+  :func:`StopRequested` turns True, and a job that checkpoints saves and stops at its next safe
+  point), waits for them up to :data:`STOP_SECONDS`, kills the workers and re-raises. During a
+  battery, SIGTERM raises :class:`SystemExit` in the parent (as SIGINT raises
+  :class:`KeyboardInterrupt`), so the same clean-up runs; after a SIGKILL of the parent the kernel
+  kills the workers (processes that a job starts itself are the job's to tie to its own life). A
+  worker that dies (say, at the hands of the OOM killer) breaks the pool: the battery stops with
+  :class:`BatteryError`, and running it again resumes.
 - :class:`Ray`: tasks on a Ray cluster (``ray.init(address)``; no address, a local instance, or
   the cluster ``RAY_ADDRESS`` names). When Ray is already initialised, the battery uses that
   connection (so a caller can pass ``runtime_env`` and other options to :func:`ray.init` itself)
@@ -70,7 +72,6 @@ import concurrent.futures
 import contextlib
 import ctypes
 import dataclasses
-import functools
 import json
 import math
 import multiprocessing
@@ -98,6 +99,8 @@ PROGRESS = "progress.json"
 ARGUMENTS = "job.json"
 # How often the parent reads the running jobs' progress records (s).
 POLL_SECONDS = 1.0
+# How long an interrupted battery waits for its running jobs to save and stop (s).
+STOP_SECONDS = 30.0
 RAY_MISSING = '--ray needs the optional extra: pip install "mobee-drake[ray]"'
 _NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._+=-]*")
 
@@ -192,9 +195,30 @@ class InProcess:
         yield _RunHere
 
 
+class JobStopped(Exception):
+    """A job that, asked to stop (:func:`StopRequested`), saved its checkpoint and stopped."""
+
+
+_stop_requested = False
+
+
+def StopRequested() -> bool:
+    """Whether the battery has asked its running jobs to stop (Ctrl-C or SIGTERM in the parent,
+    local processes). A job that checkpoints asks at its safe points; when True, it saves its
+    checkpoint and raises :class:`JobStopped`, so that it resumes from there."""
+    return _stop_requested
+
+
+def _RequestStop(signum, frame) -> None:
+    global _stop_requested
+    _stop_requested = True
+
+
 def _DieWithParent(parent: int) -> None:
-    """The local workers' initializer: SIGKILL when the parent dies (Linux); no SIGINT."""
+    """The local workers' initializer: SIGKILL when the parent dies (Linux); no SIGINT; SIGUSR1
+    asks the job to stop (see :func:`StopRequested`)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGUSR1, _RequestStop)
     if sys.platform.startswith("linux"):
         PR_SET_PDEATHSIG = 1
         if ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0):
@@ -221,11 +245,25 @@ class LocalProcesses:
             initializer=_DieWithParent,
             initargs=(os.getpid(),),
         )
+        submitted = []
+
+        def Submit(job: Job, output: pathlib.Path) -> concurrent.futures.Future:
+            submitted.append(pool.submit(_RunJob, job, output))
+            return submitted[-1]
+
         try:
-            yield functools.partial(pool.submit, _RunJob)
+            yield Submit
         except BaseException:
-            # Interrupted: no worker outlives the battery (Python 3.11 has no public way).
-            for process in list(pool._processes.values()):
+            # Interrupted: the queue stops, the running jobs are asked to save and stop, and
+            # after STOP_SECONDS no worker outlives the battery (Python 3.11 has no public way).
+            for future in submitted:
+                future.cancel()
+            processes = list(pool._processes.values())
+            for process in processes:
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(process.pid, signal.SIGUSR1)
+            concurrent.futures.wait(submitted, STOP_SECONDS)
+            for process in processes:
                 process.kill()
             raise
         finally:

@@ -48,6 +48,7 @@ from mobee_drake.experiments.battery import (
     Job,
     RunBattery,
     RunFolder,
+    StopRequested,
 )
 from mobee_drake.experiments.exploration import (
     ExplorationScenario,
@@ -129,6 +130,7 @@ def ExploreJob(
         observer=_TableContacts if table_contacts else None,
         checkpoint=run.path / "model" if keep_model else None,
         progress=run.Progress,
+        should_stop=StopRequested if keep_model else None,
     )
     return dict(**labels, **data)
 

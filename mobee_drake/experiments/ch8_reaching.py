@@ -47,8 +47,10 @@ from mobee_drake.experiments.battery import (
     Backend,
     BackendOf,
     Job,
+    JobStopped,
     RunBattery,
     RunFolder,
+    StopRequested,
 )
 from mobee_drake.experiments.exploration import ExplorationScenario, Explore
 from mobee_drake.experiments.plots import StackedBars, plt
@@ -79,7 +81,7 @@ def _Robot() -> IcubConfig:
     return IcubConfig(controlled_joints=RIGHT_ARM)
 
 
-def TrainMdp(folder: pathlib.Path, min_tries: int, seed: int = 0, progress=None):
+def TrainMdp(folder: pathlib.Path, min_tries: int, seed: int = 0, progress=None, should_stop=None):
     """The curious agent's model of the rank-3 lattice, learned once (checkpointed in ``folder``
     as it learns, resumed from there after a kill); ``progress(n)``, if given, is told the
     actions done as the agent learns."""
@@ -90,13 +92,16 @@ def TrainMdp(folder: pathlib.Path, min_tries: int, seed: int = 0, progress=None)
         checkpoint=folder,
         stop=lambda records: records[0].explorer.tries.min() >= min_tries,
         progress=progress,
+        should_stop=should_stop,
     )
     return LoadAgentModel(str(folder), AGENT, ExplorerConfig())
 
 
 def MdpJob(run: RunFolder, min_tries: int) -> dict:
     """The battery job that learns the MDP (in ``run.path / "model"``)."""
-    model = TrainMdp(run.path / "model", min_tries, progress=run.Progress)
+    model = TrainMdp(
+        run.path / "model", min_tries, progress=run.Progress, should_stop=StopRequested
+    )
     return dict(min_tries=int(model.tries.min()), actions=int(model.tries.sum()))
 
 
@@ -161,10 +166,12 @@ def RunOne(
     settings: RunSettings,
     meshcat=None,
     progress=None,
+    should_stop=None,
 ) -> dict:
     """One run of the battery (resumes from ``run_dir/checkpoint``); returns its result. With
     ``meshcat``, the run is shown there in real time; ``progress(n)``, if given, is told the
-    problem-tries done at every checkpoint."""
+    problem-tries done at every checkpoint; ``should_stop()``, if given, is asked after every
+    problem-try, and when True the run saves its checkpoint and raises JobStopped."""
     run_dir.mkdir(parents=True, exist_ok=True)
     simultaneous = settings.mdp == "simultaneous"
     # The optimistic initial model of the MDP's lattice, or the model learned first.
@@ -218,6 +225,9 @@ def RunOne(
         learner.Explore(robot)
         if (done + 1) % settings.checkpoint_every == 0:
             Save()
+        if should_stop is not None and should_stop():
+            Save()
+            raise JobStopped(f"{run_dir.name}: stopped after {done + 1} problem-tries")
     Save()
     arrays, _ = learner.ToArrays()
     extra = {}
@@ -251,7 +261,13 @@ def ReachJob(run: RunFolder, mdp: str, settings: dict) -> dict:
     """The battery job of one reach-learning run (``settings``: a :class:`RunSettings`) on the
     MDP learned by the battery's job ``mdp``."""
     mdp_dir = run.path.parent / mdp / "model"
-    return RunOne(run.path, mdp_dir, RunSettings(**settings), progress=run.Progress)
+    return RunOne(
+        run.path,
+        mdp_dir,
+        RunSettings(**settings),
+        progress=run.Progress,
+        should_stop=StopRequested,
+    )
 
 
 def RunReachBattery(

@@ -7,6 +7,7 @@ import time
 import numpy as np
 from pydrake.systems.analysis import InitializeParams
 
+from mobee_drake.experiments.battery import JobStopped
 from mobee_drake.planning.explorers import INITIALIZATIONS
 from mobee_drake.planning.supervisor import ExploreAttractor, ExploringAgent
 from mobee_drake.scenario import BuildScenario, ResumableConfiguration, Scenario
@@ -62,6 +63,7 @@ def Explore(
     checkpoint: pathlib.Path | None = None,
     observer=None,
     progress=None,
+    should_stop=None,
 ) -> dict:
     """Runs until ``stop(records)``; returns per-agent tries (and values at ``snapshots``).
 
@@ -70,7 +72,9 @@ def Explore(
     models, for a planner to reuse); the data returned then covers the run since it resumed.
     ``observer(station)``, if given, returns a callable run on the root context after every
     chunk of the simulation and a function giving its data for the result; ``progress(n)``, if
-    given, is told the number of actions done after every chunk."""
+    given, is told the number of actions done after every chunk; ``should_stop()``, if given, is
+    asked after every chunk, and when True the run saves its checkpoint (if it has one) and raises
+    :class:`~mobee_drake.experiments.battery.JobStopped`."""
     station, simulator, supervisor, supervisor_context = StartExploration(scenario, checkpoint)
     context = simulator.get_context()
     configuration = ResumableConfiguration(scenario)
@@ -87,6 +91,10 @@ def Explore(
             saved = done
         if progress is not None:
             progress(done)
+        if should_stop is not None and should_stop():
+            if checkpoint is not None:
+                SaveCheckpoint(station, context, checkpoint, configuration)
+            raise JobStopped(f"stopped after {done} actions")
         coverage.append([done] + [int((r.explorer.tries > 0).sum()) for r in records])
         for count in snapshots:
             if count not in taken and records[0].actions_done >= count:
