@@ -52,25 +52,10 @@ def _StagedFolder(folder: pathlib.Path):
         raise
 
 
-def WriteFolderAtomically(folder: str | pathlib.Path, write) -> None:
-    """Calls ``write(staging)`` on a new folder beside ``folder``, then renames it into place, so
-    that ``folder`` is always either the old or the new whole."""
-    folder = pathlib.Path(folder)
-    with _StagedFolder(folder) as staging:
-        write(staging)
-    if folder.exists():
-        old = folder.with_name(f".{folder.name}-old")
-        shutil.rmtree(old, ignore_errors=True)
-        os.replace(folder, old)
-        os.replace(staging, folder)
-        shutil.rmtree(old, ignore_errors=True)
-    else:
-        os.replace(staging, folder)
-
-
 def WriteFolderOnce(folder: str | pathlib.Path, write) -> None:
-    """As :func:`WriteFolderAtomically`, for a cache entry that never changes once written: when
-    another writer put its whole copy in place first, that copy stays and this one is dropped."""
+    """Calls ``write(staging)`` on a new folder beside ``folder``, then renames it to ``folder``:
+    for a cache entry that never changes once written. When another writer put its whole copy in
+    place first, that copy stays and this one is dropped."""
     folder = pathlib.Path(folder)
     with _StagedFolder(folder) as staging:
         write(staging)

@@ -29,7 +29,7 @@ import time
 
 import numpy as np
 
-from mobee_drake.atomic_files import WriteFolderAtomically
+from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration
 from mobee_drake.ngik.nes import Minimize, NesConfig
 from mobee_drake.ngik.solver import IkProblem
 from mobee_drake.roadmaps.graph_paths import ShortestPath
@@ -108,7 +108,8 @@ class TaskRelevantRoadmap:
         return ShortestPath(self.q, np.vstack([self.edges, self.edges[:, ::-1]]), start, goal)
 
     def Save(self, folder: str | pathlib.Path) -> None:
-        """Writes ``roadmap.npz`` and ``roadmap.json`` into ``folder`` atomically."""
+        """Writes ``roadmap.npz`` and ``roadmap.json`` as the newest generation of ``folder``
+        (see :func:`~mobee_drake.atomic_files.WriteGeneration`)."""
 
         def Write(staging: pathlib.Path) -> None:
             np.savez(
@@ -130,11 +131,12 @@ class TaskRelevantRoadmap:
                 )
             )
 
-        WriteFolderAtomically(pathlib.Path(folder), Write)
+        WriteGeneration(folder, Write)
 
     @staticmethod
     def Load(folder: str | pathlib.Path) -> "TaskRelevantRoadmap":
-        folder = pathlib.Path(folder)
+        """The roadmap saved in ``folder`` (its newest generation)."""
+        folder = CurrentGeneration(folder) or pathlib.Path(folder)
         for name in ("roadmap.npz", "roadmap.json"):
             if not (folder / name).is_file():
                 raise FileNotFoundError(f"{folder}: no {name}; is this a saved roadmap?")
