@@ -72,6 +72,7 @@ import concurrent.futures
 import contextlib
 import ctypes
 import dataclasses
+import hashlib
 import json
 import math
 import multiprocessing
@@ -88,6 +89,7 @@ from typing import ClassVar
 
 from tqdm import tqdm
 
+from mobee_drake import __version__
 from mobee_drake.atomic_files import WriteJsonAtomically, WriteTextAtomically
 from mobee_drake.experiments.arguments import PositiveInt
 from mobee_drake.owned_folders import OwnedFolder
@@ -479,7 +481,10 @@ def _Plain(value):
 
 
 def _ArgumentsText(job: Job) -> str:
-    arguments = dict(function=f"{job.function.__module__}.{job.function.__qualname__}")
+    arguments = dict(
+        mobee_drake_version=__version__,
+        function=f"{job.function.__module__}.{job.function.__qualname__}",
+    )
     arguments.update(job.kwargs)
     return json.dumps(arguments, default=_Plain, sort_keys=True, indent=1)
 
@@ -555,6 +560,15 @@ def _RunJobs(
             f"{len(errors)} of {len(jobs)} jobs failed:\n" + "\n".join(failures)
         ) from next(iter(errors.values()))
     return results
+
+
+def Provenance(output: str | pathlib.Path) -> str:
+    """A line for a report: the package's version and a fingerprint of the arguments of every
+    run in ``output`` (the SHA-256 of their ``job.json`` files, in name order)."""
+    digest = hashlib.sha256()
+    for path in sorted(pathlib.Path(output).glob(f"runs/*/{ARGUMENTS}")):
+        digest.update(path.parent.name.encode() + b"\0" + path.read_bytes())
+    return f"mobee-drake {__version__}; the runs' arguments: sha256 {digest.hexdigest()[:16]}"
 
 
 def AddBackendArguments(parser, workers: int = 1) -> None:

@@ -46,6 +46,7 @@ from mobee_drake.experiments.battery import (
     Backend,
     BackendOf,
     Job,
+    Provenance,
     RunBattery,
     RunFolder,
     StopRequested,
@@ -766,7 +767,7 @@ def main(argv=None) -> None:
     report = output / f"report_{args.experiment}.md"
     report.write_text(
         f"# Experiment {args.experiment}\n\n`mobee-drake experiment ch7 "
-        f"{' '.join(argv)}`\n\n" + "\n".join(table) + "\n"
+        f"{' '.join(argv)}` ({Provenance(output)})\n\n" + "\n".join(table) + "\n"
     )
     print(report.read_text())
 

@@ -48,6 +48,7 @@ from mobee_drake.experiments.battery import (
     BackendOf,
     Job,
     JobStopped,
+    Provenance,
     RunBattery,
     RunFolder,
     StopRequested,
@@ -606,7 +607,7 @@ def main(argv=None) -> None:
     report = output / "report.md"
     report.write_text(
         f"# Reach learning (ch. 8.4)\n\n`mobee-drake experiment ch8 "
-        f"{' '.join(argv)}`\n\n" + Report(output, results) + "\n"
+        f"{' '.join(argv)}` ({Provenance(output)})\n\n" + Report(output, results) + "\n"
     )
     print(report.read_text())
 

@@ -31,6 +31,7 @@ from mobee_drake.experiments.battery import (
     Backend,
     BackendOf,
     Job,
+    Provenance,
     RunBattery,
     RunFolder,
 )
@@ -322,7 +323,7 @@ def WriteReport(
     lines = [
         "# SAGG-RIAC experiments (Baranes & Oudeyer, IROS 2010, Sec. IV)",
         "",
-        f"Command: `{command}`",
+        f"Command: `{command}` ({Provenance(path.parent)})",
         "",
     ]
     for experiment, runs in all_runs.items():
