@@ -3,7 +3,7 @@
 This is the composition root: the only module that knows the station and every client. A
 scenario (``diagrams/*.yaml``) is a :class:`~mobee_drake.station.config.StationConfig` (the robot,
 its world, MoBeE, what moves the robot, what to show, the random seed) plus the client that sets
-MoBeE's attractor (one tag of ``CLIENTS``) and the duration. :func:`LoadScenario` reads one (a
+MoBeE's attractor (one tag of ``Client``) and the duration. :func:`LoadScenario` reads one (a
 file, or the name of a shipped scenario); errors name the file, the key and, where YAML gives it,
 the line. :func:`BuildScenario` builds it; :func:`RunScenario` runs it.
 
@@ -35,12 +35,8 @@ from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
 # experiment of the sources, and short enough that a typo like 1e308 is caught, not simulated).
 MAX_DURATION = 1e7
 # The clients a scenario file can name, by their YAML tags.
-CLIENTS = (
-    FixedAttractor,
-    RandomAttractors,
-    SliderAttractor,
-    ExploreAttractor,
-    StateActionAttractor,
+Client = (
+    FixedAttractor | RandomAttractors | SliderAttractor | ExploreAttractor | StateActionAttractor
 )
 
 
@@ -48,14 +44,8 @@ CLIENTS = (
 class Scenario(StationConfig):
     """Everything a run needs (see ``diagrams/`` for examples)."""
 
-    # What sets MoBeE's attractor: one of CLIENTS.
-    attractor: (
-        FixedAttractor
-        | RandomAttractors
-        | SliderAttractor
-        | ExploreAttractor
-        | StateActionAttractor
-    ) = dc.field(default_factory=FixedAttractor)
+    # What sets MoBeE's attractor: one of the Client tags.
+    attractor: Client = dc.field(default_factory=FixedAttractor)
     # Seconds to simulate.
     duration: float = 10.0
     # Drake's simulator settings (the target real-time rate; the station's systems are discrete,

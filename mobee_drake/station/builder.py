@@ -49,7 +49,7 @@ from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.assembly import JointStateSelector
 from mobee_drake.robots.overlay import RobotOverlay
 from mobee_drake.robots.scenario_robot import AddScenarioRobot
-from mobee_drake.station.config import Dynamic, Kinematic, Reflex, StationConfig
+from mobee_drake.station.config import Dynamic, Kinematic, Mover, Reflex, StationConfig
 from mobee_drake.station.parts import ClientPorts, StationParts
 from mobee_drake.station.safety import SafetyMonitor
 from mobee_drake.station.viewer import AddViewer
@@ -101,7 +101,7 @@ def _AddMobee(
     joints: list[str],
     params: MobeeParams,
     time_step: float,
-    mover_config: Kinematic | Dynamic | Reflex,
+    mover_config: Mover,
     prefix: str = "",
 ):
     """One robot's MoBeE, what moves it (its virtual dynamics, eq. 5.7, or MoBeE 1.0's reflex

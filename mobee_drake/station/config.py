@@ -115,7 +115,7 @@ class StationConfig:
     companions: list[Companion] = dc.field(default_factory=list)
     mobee: MobeeParams = dc.field(default_factory=MobeeParams)
     # What moves the robot (see the module).
-    mover: Kinematic | Dynamic | Reflex = dc.field(default_factory=Kinematic)
+    mover: Mover = dc.field(default_factory=Kinematic)
     # MoBeE's period (s): the kinematic robot's integration step, the dynamic robot's control rate.
     time_step: float = 0.01
     # Scripted changes of the world.
