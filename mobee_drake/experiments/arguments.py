@@ -5,34 +5,26 @@ import argparse
 import math
 
 
-def PositiveInt(text: str) -> int:
-    """A whole number >= 1."""
+def _Checked(text: str, convert, accept, what: str):
     try:
-        value = int(text)
+        value = convert(text)
     except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got '{text}'")
+        value = None
+    if value is None or not accept(value):
+        raise argparse.ArgumentTypeError(f"must be {what}, got '{text}'")
     return value
+
+
+def PositiveInt(text: str) -> int:
+    """A whole number >= 1 (a count)."""
+    return _Checked(text, int, lambda v: v >= 1, "a whole number >= 1")
 
 
 def NonNegativeInt(text: str) -> int:
     """A whole number >= 0 (a seed, a first seed)."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 0, got '{text}'")
-    return value
+    return _Checked(text, int, lambda v: v >= 0, "a whole number >= 0")
 
 
 def PositiveFloat(text: str) -> float:
-    """A finite number > 0."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got '{text}'")
-    return value
+    """A finite number > 0 (a duration, a force)."""
+    return _Checked(text, float, lambda v: math.isfinite(v) and v > 0, "a finite number > 0")
