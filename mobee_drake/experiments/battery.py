@@ -159,8 +159,38 @@ class BatteryRefused(ValueError):
     """A battery that may not run in its folder (runs of other arguments are there)."""
 
 
+class JobStopped(Exception):
+    """A job that, asked to stop (:func:`StopRequested`), saved its checkpoint and stopped."""
+
+
+_stop_requested = False
+_job_asks = False
+
+
+def StopRequested() -> bool:
+    """Whether the battery has asked its running jobs to stop.
+
+    The parent asks on Ctrl-C or SIGTERM (local processes). A job that checkpoints asks at its
+    safe points; when True, it saves its checkpoint and raises :class:`JobStopped`, so that it
+    resumes from there. A job that never asks has nothing to save: asked to stop, its worker
+    exits at once.
+    """
+    global _job_asks
+    _job_asks = True
+    return _stop_requested
+
+
+def _RequestStop(signum, frame) -> None:
+    global _stop_requested
+    if not _job_asks:
+        os._exit(1)
+    _stop_requested = True
+
+
 def _RunJob(job: Job, output: pathlib.Path) -> str:
     """Runs ``job`` wherever the backend put it; writes its result and returns it as JSON."""
+    global _job_asks
+    _job_asks = False  # Until this job asks (see StopRequested).
     run = RunFolder(output / "runs" / job.name)
     run.path.mkdir(parents=True, exist_ok=True)
     run.Progress(0)
@@ -195,25 +225,6 @@ class InProcess:
     @contextlib.contextmanager
     def Session(self):
         yield _RunHere
-
-
-class JobStopped(Exception):
-    """A job that, asked to stop (:func:`StopRequested`), saved its checkpoint and stopped."""
-
-
-_stop_requested = False
-
-
-def StopRequested() -> bool:
-    """Whether the battery has asked its running jobs to stop (Ctrl-C or SIGTERM in the parent,
-    local processes). A job that checkpoints asks at its safe points; when True, it saves its
-    checkpoint and raises :class:`JobStopped`, so that it resumes from there."""
-    return _stop_requested
-
-
-def _RequestStop(signum, frame) -> None:
-    global _stop_requested
-    _stop_requested = True
 
 
 def _DieWithParent(parent: int) -> None:
