@@ -35,9 +35,15 @@ def WriteTextAtomically(path: str | pathlib.Path, text: str) -> None:
         raise
 
 
+def StrictJson(data, **options) -> str:
+    """``data`` as strict JSON (no NaN or Infinity, which JSON has not: a ValueError instead);
+    ``options`` as for :func:`json.dumps`. Every JSON file the package writes goes through it."""
+    return json.dumps(data, allow_nan=False, **options)
+
+
 def WriteJsonAtomically(path: str | pathlib.Path, data) -> None:
-    """Writes ``data`` as JSON to ``path`` (see :func:`WriteTextAtomically`)."""
-    WriteTextAtomically(path, json.dumps(data))
+    """Writes ``data`` as strict JSON to ``path`` (see :func:`WriteTextAtomically`)."""
+    WriteTextAtomically(path, StrictJson(data))
 
 
 @contextlib.contextmanager

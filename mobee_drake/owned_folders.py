@@ -15,6 +15,8 @@ import os
 import pathlib
 import tempfile
 
+from mobee_drake.atomic_files import StrictJson
+
 MARKER = ".mobee-drake"
 _LOCK = ".mobee-drake.lock"
 
@@ -49,7 +51,7 @@ def ClaimFolder(folder: str | pathlib.Path, kind: str) -> pathlib.Path:
             "choose an empty or new folder"
         )
     try:
-        marker.write_text(json.dumps({"kind": kind}))
+        marker.write_text(StrictJson({"kind": kind}))
     except OSError as error:
         raise FolderError(f"{folder}: cannot be written: {error.strerror}") from None
     return folder

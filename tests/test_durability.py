@@ -21,12 +21,14 @@ import numpy as np
 
 from mobee_drake import cli
 from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration
+from mobee_drake.experiments import ch7_model_learning, saggriac
 from mobee_drake.experiments.battery import InProcess, Job, RunBattery
 from mobee_drake.experiments.ch7_model_learning import Stop
 from mobee_drake.experiments.exploration import ExplorationScenario, Explore
 from mobee_drake.owned_folders import ClaimFolder, FolderError, OwnedFolder
 from mobee_drake.planning.supervisor import ExploringAgent
 from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS
+from mobee_drake.scenario import LoadScenario, RunScenario
 
 # The steps of a generation's write, as WriteGeneration marks them, and a kill inside the
 # caller's write (after its first file).
@@ -265,6 +267,41 @@ class TestGracefulStop(TemporaryFolder):
             progress=False,
         )
         self.assertEqual(resumed["walk"]["position"], whole["walk"]["position"])
+
+
+def _NoConstant(name: str):
+    raise ValueError(f"{name} is not JSON")
+
+
+class TestStrictJson(TemporaryFolder):
+    def test_every_json_file_of_runs_and_batteries_is_strict(self):
+        RunScenario(
+            LoadScenario("explore_hypercube", "{duration: 3}"), checkpoint=str(self.folder / "run")
+        )
+        with contextlib.redirect_stdout(io.StringIO()):
+            saggriac.main(
+                [
+                    "--smoke",
+                    "--experiments",
+                    "1",
+                    "--seeds",
+                    "2",
+                    "--output",
+                    str(self.folder / "s"),
+                ]
+            )
+            ch7_model_learning.main(
+                ["--experiment", "7.4.1", "--transitions", "3", "--runs", "1", "--output",
+                 str(self.folder / "c7")]
+            )  # fmt: skip
+        files = sorted(self.folder.rglob("*.json"))
+        kinds = {path.name for path in files}
+        for expected in ("right_arm.json", "world.json", "job.json", "result.json"):
+            self.assertIn(expected, kinds)
+        self.assertIn("statistics.json", kinds)  # with p-values that could not be computed
+        for path in files:
+            with self.subTest(str(path.relative_to(self.folder))):
+                json.loads(path.read_text(), parse_constant=_NoConstant)
 
 
 class TestRunCheckpoints(TemporaryFolder):

@@ -90,7 +90,7 @@ from typing import ClassVar
 from tqdm import tqdm
 
 from mobee_drake import __version__
-from mobee_drake.atomic_files import WriteJsonAtomically, WriteTextAtomically
+from mobee_drake.atomic_files import StrictJson, WriteJsonAtomically, WriteTextAtomically
 from mobee_drake.experiments.arguments import PositiveInt
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.yaml_io import YamlDifferences
@@ -497,7 +497,7 @@ def _ArgumentsText(job: Job) -> str:
         function=f"{job.function.__module__}.{job.function.__qualname__}",
     )
     arguments.update(job.kwargs)
-    return json.dumps(arguments, default=_Plain, sort_keys=True, indent=1)
+    return StrictJson(arguments, default=_Plain, sort_keys=True, indent=1)
 
 
 def _CheckArguments(jobs: list[Job], output: pathlib.Path) -> None:

@@ -40,7 +40,7 @@ import numpy as np
 from pydrake.geometry import StartMeshcat
 from scipy.stats import ttest_ind
 
-from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration
+from mobee_drake.atomic_files import CurrentGeneration, StrictJson, WriteGeneration
 from mobee_drake.experiments.arguments import NonNegativeInt, PositiveFloat, PositiveInt
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
@@ -55,6 +55,7 @@ from mobee_drake.experiments.battery import (
 )
 from mobee_drake.experiments.exploration import ExplorationScenario, Explore
 from mobee_drake.experiments.plots import StackedBars, plt
+from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig, LoadAgentModel
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import ExploringAgent
@@ -156,7 +157,7 @@ def _Checkpoint(
         robot.Save(staging / "simulation")
         arrays, learner_data = learner.ToArrays()
         np.savez(staging / "learner.npz", **arrays)
-        (staging / "learner.json").write_text(json.dumps(dict(learner=learner_data, **data)))
+        (staging / "learner.json").write_text(StrictJson(dict(learner=learner_data, **data)))
 
     WriteGeneration(folder, Write)
 
@@ -595,11 +596,13 @@ def main(argv=None) -> None:
         args.reach_force,
         args.distance_unit,
     )
-    if args.watch:
-        mdp_dir = output / "runs" / f"mdp_tries{args.mdp_tries}" / "model"
-        if settings.mdp == "learned_first":
-            TrainMdp(mdp_dir, args.mdp_tries)
-        RunOne(output / "runs" / f"watch_{settings.strategy}", mdp_dir, settings, StartMeshcat())
+    if args.watch:  # In the battery's folder, beside its runs.
+        watch = output / "watch"
+        with OwnedFolder(output, "battery"):
+            mdp_dir = watch / f"mdp_tries{args.mdp_tries}"
+            if settings.mdp == "learned_first":
+                TrainMdp(mdp_dir, args.mdp_tries)
+            RunOne(watch / settings.strategy, mdp_dir, settings, StartMeshcat())
         return
     results = RunReachBattery(
         output, args.strategies, args.seeds, settings, args.mdp_tries, BackendOf(args)

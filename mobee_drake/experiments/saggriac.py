@@ -16,6 +16,7 @@ import argparse
 import csv
 import dataclasses
 import json
+import math
 import pathlib
 import sys
 import time
@@ -23,7 +24,7 @@ import time
 import numpy as np
 from scipy import stats
 
-from mobee_drake.atomic_files import WriteTextAtomically
+from mobee_drake.atomic_files import StrictJson, WriteTextAtomically
 from mobee_drake.experiments.arguments import NonNegativeInt, PositiveInt
 from mobee_drake.experiments.battery import (
     RESULT,
@@ -370,6 +371,17 @@ def WriteReport(
     WriteTextAtomically(path, "\n".join(lines) + "\n")
 
 
+def _NoNan(value):
+    """``value`` with every NaN (a statistic that could not be computed) made None."""
+    if isinstance(value, float) and math.isnan(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _NoNan(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_NoNan(v) for v in value]
+    return value
+
+
 def Analyse(specs: list[RunSpec], output: pathlib.Path, methods: list[str], command: str) -> None:
     """Writes curves CSV, plots, statistics JSON and report.md from the run files present."""
     experiments = sorted({spec.experiment for spec in specs})
@@ -387,7 +399,8 @@ def Analyse(specs: list[RunSpec], output: pathlib.Path, methods: list[str], comm
             PlotGoalHistograms(sagg_riac_runs[0], output / f"exp{experiment}_goals.png")
     WriteTextAtomically(
         output / "statistics.json",
-        json.dumps({str(key): value for key, value in statistics.items()}, indent=1),
+        # A test that could not be computed (NaN) is written null.
+        StrictJson({str(key): _NoNan(value) for key, value in statistics.items()}, indent=1),
     )
     WriteReport(all_runs, statistics, methods, command, output / "report.md")
 

@@ -23,6 +23,7 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 
+from mobee_drake.atomic_files import StrictJson
 from mobee_drake.planning.explorers import (
     Explorer,
     ExplorerConfig,
@@ -289,15 +290,19 @@ class ExplorationSupervisor(LeafSystem):
             arrays, data = ExplorerToArrays(record.explorer)
             np.savez(folder / f"{name}.npz", **arrays)
             data["record"] = {k: v for k, v in dc.asdict(record).items() if k != "explorer"}
-            data["record"]["slow_since"] = float(record.slow_since)
-            (folder / f"{name}.json").write_text(json.dumps(data, indent=1))
+            # Not slow (inf) is written null: JSON has no infinity.
+            slow = float(record.slow_since)
+            data["record"]["slow_since"] = slow if np.isfinite(slow) else None
+            (folder / f"{name}.json").write_text(StrictJson(data, indent=1))
 
     def ReadCheckpoint(self, context, folder: pathlib.Path) -> None:
         records = []
         for name in self.agent_names:
             data = json.loads((folder / f"{name}.json").read_text())
             explorer = ExplorerFromArrays(np.load(folder / f"{name}.npz"), data)
-            records.append(AgentRecord(explorer=explorer, **data["record"]))
+            record = data["record"]
+            record["slow_since"] = np.inf if record["slow_since"] is None else record["slow_since"]
+            records.append(AgentRecord(explorer=explorer, **record))
         self.SetRecords(context, tuple(records))
 
 

@@ -24,7 +24,7 @@ import zipfile
 
 import numpy as np
 
-from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration
+from mobee_drake.atomic_files import CurrentGeneration, StrictJson, WriteGeneration
 from mobee_drake.station.builder import Station
 from mobee_drake.yaml_io import YamlDifferences
 
@@ -71,7 +71,7 @@ def WriteCheckpointFiles(station: Station, context, folder: pathlib.Path) -> Non
         time=context.get_time(),
         **{key: value for key, value in _DiscreteStates(station, context)},
     )
-    (folder / "world.json").write_text(json.dumps(station.world.Snapshot(context)))
+    (folder / "world.json").write_text(StrictJson(station.world.Snapshot(context)))
     for system in _CheckpointedSystems(station):
         system.WriteCheckpoint(system.GetMyContextFromRoot(context), folder)
 

@@ -29,7 +29,7 @@ import time
 
 import numpy as np
 
-from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration
+from mobee_drake.atomic_files import CurrentGeneration, StrictJson, WriteGeneration
 from mobee_drake.ngik.nes import Minimize, NesConfig
 from mobee_drake.ngik.solver import IkProblem
 from mobee_drake.roadmaps.graph_paths import ShortestPath
@@ -121,7 +121,7 @@ class TaskRelevantRoadmap:
                 simplices=np.array(self.simplices, dtype=int),
             )
             (staging / "roadmap.json").write_text(
-                json.dumps(
+                StrictJson(
                     {
                         "joints": self.joints,
                         "build_seconds": self.build_seconds,
