@@ -11,6 +11,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake import __version__
+from mobee_drake.atomic_files import WriteJsonAtomically
 from mobee_drake.experiments.arguments import PositiveFloat
 from mobee_drake.experiments.battery import BatteryRefused
 from mobee_drake.mobee.system import Mobee
@@ -75,7 +76,11 @@ def _Run(args: list[str]) -> None:
         record = known.record or str(
             pathlib.Path("results") / (pathlib.Path(known.scenario).stem + ".html")
         )
-    for output in (record, known.graphviz):  # Checked before the run, not after it.
+    # The summary's figures go beside the recording (or where it would be).
+    summary_file = pathlib.Path(
+        record or pathlib.Path("results") / (pathlib.Path(known.scenario).stem + ".html")
+    ).with_suffix(".summary.json")
+    for output in (record, known.graphviz, summary_file):  # Checked before the run, not after.
         if output and not CanWrite(output):
             _Fail(f"{output}: cannot be written (its folder is missing, read-only or full?)")
     meshcat = None
@@ -106,6 +111,9 @@ def _Run(args: list[str]) -> None:
     except (FolderError, CheckpointError) as e:  # Raised before anything is simulated.
         _Fail(str(e))
     print(summary.Format())
+    if summary.finished_before is None:
+        WriteJsonAtomically(summary_file, summary.ToJson())
+        print(f"summary: {summary_file.resolve()}")
 
 
 def _Dispatch(prog: str, args: list[str], modules: dict[str, str]) -> None:

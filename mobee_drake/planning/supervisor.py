@@ -283,6 +283,24 @@ class ExplorationSupervisor(LeafSystem):
     def CompletedActions(self, context) -> int:
         return sum(record.actions_done for record in self.Records(context))
 
+    def Outcome(self, context) -> dict:
+        """Per agent: actions taken, state-actions tried of all, and the value-iteration
+        residual of its model (the largest change another sweep of Alg. 7 would make)."""
+        outcome = {}
+        for name, record in zip(self.agent_names, self.Records(context)):
+            explorer = record.explorer
+            q, v = explorer.Values()
+            T = explorer.transitions.Probabilities()
+            gamma = explorer.config.gamma
+            residual = np.abs(explorer.rewards + gamma * T @ v - q).max(initial=0.0)
+            outcome[name] = {
+                "actions": record.actions_done,
+                "state_actions_tried": int((explorer.tries > 0).sum()),
+                "state_actions": explorer.space.num_state_actions,
+                "value_iteration_residual": float(residual),
+            }
+        return {"agents": outcome}
+
     def WriteCheckpoint(self, context, folder: pathlib.Path) -> None:
         """Writes ``<agent>.npz`` (the learned model) and ``<agent>.json`` (its configuration,
         its generator's state and the action in flight) for every agent."""

@@ -216,6 +216,15 @@ class StateActionExecutor(LeafSystem):
         """Where the marker was when the last reach's forcing stopped (world, m)."""
         return self._Vector(context)[self._REACHED].copy()
 
+    def Outcome(self, context) -> dict:
+        """The actions finished and, after a reach, the marker's distance to its target then."""
+        x = self._Vector(context)
+        outcome = {"finished_actions": int(x[self._FINISHED])}
+        if np.any(x[self._TARGET] != 0):
+            distance = np.linalg.norm(x[self._REACHED] - x[self._TARGET])
+            outcome["last_reach_distance_to_target_m"] = float(distance)
+        return outcome
+
     def FeltObject(self, context) -> bool:
         """Whether MoBeE's fields felt a workspace object during the last (or current) action."""
         return bool(self._Vector(context)[self._FELT_OBJECT])

@@ -13,6 +13,7 @@ from mobee_drake.atomic_files import WriteTextAtomically
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.station.builder import Station
 from mobee_drake.station.checkpoint import HasCheckpoint, LoadCheckpoint, SaveCheckpoint
+from mobee_drake.station.outcome import RunOutcome
 from mobee_drake.station.safety import SafetyReport
 from mobee_drake.station.world_events import MakeSimulator
 
@@ -26,6 +27,14 @@ class RunSummary:
     # Where a resumed run started (s), and, for a run its checkpoint had finished, where it was.
     resumed_at: float | None = None
     finished_before: float | None = None
+    # What the run achieved (see :mod:`mobee_drake.station.outcome`).
+    outcome: dict = dc.field(default_factory=dict)
+
+    def ToJson(self) -> dict:
+        """The summary as strict-JSON data (a distance never reached is null)."""
+        data = dc.asdict(self)
+        data["realtime_factor"] = self.realtime_factor if self.wall_time > 0 else None
+        return data
 
     @property
     def realtime_factor(self) -> float:
@@ -49,9 +58,23 @@ class RunSummary:
             f"penetrations of solid geometry: {self.safety.penetrating_steps} control "
             f"periods, deepest {1000 * self.safety.deepest_penetration:.2f} mm"
         )
+        for group, figures in self.outcome.items():
+            lines.append(f"outcome, {group}:")
+            lines += [f"  {line}" for line in _Lines(figures)]
         if self.recording:
             lines.append(f"recording: {self.recording}")
         return "\n".join(lines)
+
+
+def _Lines(figures: dict, prefix: str = "") -> list[str]:
+    lines = []
+    for key, value in figures.items():
+        if isinstance(value, dict):
+            lines += _Lines(value, f"{prefix}{key}: ")
+        else:
+            shown = f"{value:.4g}" if isinstance(value, float) else value
+            lines.append(f"{prefix}{key}: {shown}")
+    return lines
 
 
 def Advance(
@@ -203,4 +226,5 @@ def _Run(
         safety=report,
         recording=recording,
         resumed_at=resumed,
+        outcome=RunOutcome(station, context),
     )
