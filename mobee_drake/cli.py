@@ -2,6 +2,7 @@
 
 import argparse
 import importlib
+import logging
 import pathlib
 import sys
 
@@ -12,7 +13,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake import __version__
 from mobee_drake.atomic_files import WriteJsonAtomically
-from mobee_drake.experiments.arguments import PositiveFloat
+from mobee_drake.experiments.arguments import HelpFormatter, PositiveFloat
 from mobee_drake.experiments.battery import BatteryRefused
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.owned_folders import CanWrite, FolderError
@@ -23,9 +24,15 @@ from mobee_drake.scenario import BuildScenario, LoadScenario, ResumableConfigura
 from mobee_drake.station.checkpoint import CheckpointError
 from mobee_drake.station.runner import RunStation
 
+# Whether a user's mistake shows its traceback (``--debug``).
+_debug = False
+
 
 def _Fail(message: str) -> None:
-    """Ends the command on a user's mistake: one line on stderr, exit code 2."""
+    """Ends the command on a user's mistake: one line on stderr, exit code 2 (with ``--debug``,
+    the exception being handled is raised again, with its traceback)."""
+    if _debug and sys.exc_info()[1] is not None:
+        raise
     print(f"error: {message}", file=sys.stderr)
     sys.exit(2)
 
@@ -38,7 +45,7 @@ def _Run(args: list[str]) -> None:
         + ", ".join(ScenarioNames())
         + "). Headless by default: the run is recorded to results/<scenario>.html unless "
         "--record or --no-record says otherwise; --meshcat serves the live view.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        formatter_class=HelpFormatter,
     )
     parser.add_argument("scenario", help="a scenario file or a shipped scenario's name")
     parser.add_argument(
@@ -110,6 +117,11 @@ def _Run(args: list[str]) -> None:
         )
     except (FolderError, CheckpointError) as e:  # Raised before anything is simulated.
         _Fail(str(e))
+    if summary.finished_before is not None and summary.finished_before > scenario.duration:
+        _Fail(
+            f"{known.checkpoint}: the checkpoint is at {summary.finished_before:.2f} s, past "
+            f"the duration {scenario.duration:g} s; give a duration of at least that"
+        )
     print(summary.Format())
     if summary.finished_before is None:
         WriteJsonAtomically(summary_file, summary.ToJson())
@@ -119,8 +131,8 @@ def _Run(args: list[str]) -> None:
 def _Dispatch(prog: str, args: list[str], modules: dict[str, str]) -> None:
     """Runs ``main(rest)`` of the module named by the first argument (its own --help included)."""
     if not args or args[0] not in modules:
-        parser = argparse.ArgumentParser(prog=prog)
-        parser.add_argument("which", choices=sorted(modules))
+        parser = argparse.ArgumentParser(prog=prog, formatter_class=HelpFormatter)
+        parser.add_argument("which", choices=sorted(modules), help="which one (its own --help)")
         parser.parse_args(args[:1])
     try:
         importlib.import_module(modules[args[0]]).main(args[1:])
@@ -162,13 +174,18 @@ def _Experiment(args: list[str]) -> None:
 
 def _Info(args: list[str]) -> None:
     """Prints the iCub model, its controlled joints, overlay geometry, markers and clauses."""
-    parser = argparse.ArgumentParser(prog="mobee-drake info")
-    parser.add_argument("--model", default=None, help="an icub-models robot name")
+    parser = argparse.ArgumentParser(
+        prog="mobee-drake info", description=_Info.__doc__, formatter_class=HelpFormatter
+    )
+    parser.add_argument("--model", default=IcubConfig().model, help="an icub-models robot name")
     known = parser.parse_args(args)
-    config = IcubConfig() if known.model is None else IcubConfig(model=known.model)
+    config = IcubConfig(model=known.model)
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
-    robot = AddIcub(plant, scene_graph, config)
+    try:
+        robot = AddIcub(plant, scene_graph, config)
+    except ValueError as e:
+        _Fail(str(e))
     plant.Finalize()
     mobee = Mobee(plant, robot, joints=config.controlled_joints)
     print(f"model: {config.model} (available: {', '.join(IcubModelNames())})")
@@ -192,14 +209,26 @@ COMMANDS = {"bench": _Bench, "experiment": _Experiment, "info": _Info, "run": _R
 def main(argv: list[str] | None = None) -> None:
     argv = sys.argv[1:] if argv is None else argv
     parser = argparse.ArgumentParser(
-        prog="mobee-drake", description="MoBeE 2.0 on Drake for the iCub."
+        prog="mobee-drake",
+        description="MoBeE 2.0 on Drake for the iCub.",
+        formatter_class=HelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
-    parser.add_argument("command", choices=sorted(COMMANDS))
-    parser.add_argument("args", nargs=argparse.REMAINDER)
-    known = parser.parse_args(argv[:1])
+    parser.add_argument(
+        "--debug", action="store_true", help="show the traceback of a user's mistake too"
+    )
+    parser.add_argument("-v", "--verbose", action="store_true", help="log details (DEBUG)")
+    parser.add_argument("-q", "--quiet", action="store_true", help="log warnings and errors only")
+    parser.add_argument("command", choices=sorted(COMMANDS), help="what to do")
+    parser.add_argument("args", nargs=argparse.REMAINDER, help="the command's own arguments")
+    known = parser.parse_args(argv)
+    global _debug
+    _debug = known.debug
+    level = logging.DEBUG if known.verbose else logging.WARNING if known.quiet else logging.INFO
+    logging.basicConfig(level=level, format="%(levelname)s:%(name)s:%(message)s")
+    logging.getLogger("drake").setLevel(level)
     try:
-        COMMANDS[known.command](argv[1:])
+        COMMANDS[known.command](known.args)
     except KeyboardInterrupt:
         # The workers are gone with the battery; runs resume from their last checkpoint.
         print(

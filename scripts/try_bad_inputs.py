@@ -32,6 +32,8 @@ def Trials(folder: pathlib.Path) -> list[tuple[str, list[str]]]:
         ("a run to 3 s with a checkpoint", [*run, "--duration", "3", "--checkpoint", checkpoint]),
         ("the same run again (finished)", [*run, "--duration", "3", "--checkpoint", checkpoint]),
         ("the checkpoint later than --duration", [*run, "--duration", "1", "--checkpoint", checkpoint]),
+        ("an unknown model in info", ["info", "--model", "iCubMars"]),
+        ("a trail marker that does not exist", ["run", "reach_around_ball", "--duration", "0.1", "--set", "{visualization: {trail_marker: nose}}"]),
         ("resume with another seed", [*run, "--duration", "4", "--checkpoint", checkpoint, "--set", "{random_seed: 5}"]),
         ("resume with another time step", [*run, "--duration", "4", "--checkpoint", checkpoint, "--set", "{time_step: 0.01}"]),
         ("resume with another strategy", [*run, "--duration", "4", "--checkpoint", checkpoint, "--set", "{attractor: !ExploreAttractor {agents: [{name: right_arm, joints: [r_shoulder_pitch, r_shoulder_roll, r_shoulder_yaw, r_elbow], explorer: {strategy: random}}]}}"]),

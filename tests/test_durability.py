@@ -334,8 +334,9 @@ class TestRunCheckpoints(TemporaryFolder):
         code, out, _ = self._Run("--duration", "3", "--checkpoint", checkpoint)
         self.assertEqual(code, 0)
         self.assertIn("nothing to do: the checkpoint is at 3.00 s", out)
-        code, out, _ = self._Run("--duration", "2", "--checkpoint", checkpoint)
-        self.assertIn("nothing to do", out)
+        code, _, err = self._Run("--duration", "2", "--checkpoint", checkpoint)
+        self.assertEqual(code, 2)  # A shorter run than its checkpoint is a mistake.
+        self.assertIn("the checkpoint is at 3.00 s, past the duration 2 s", err)
         self.assertEqual(CurrentGeneration(checkpoint), generation)
         self.assertEqual((generation / "simulation.npz").read_bytes(), saved)
         code, _, err = self._Run(

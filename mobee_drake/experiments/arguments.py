@@ -28,3 +28,7 @@ def NonNegativeInt(text: str) -> int:
 def PositiveFloat(text: str) -> float:
     """A finite number > 0 (a duration, a force)."""
     return _Checked(text, float, lambda v: math.isfinite(v) and v > 0, "a finite number > 0")
+
+
+class HelpFormatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
+    """Every command's help: its description as written, each option with its default."""

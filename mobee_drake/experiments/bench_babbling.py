@@ -25,7 +25,7 @@ import time
 import numpy as np
 from pydrake.systems.primitives import LogVectorOutput
 
-from mobee_drake.experiments.arguments import PositiveFloat, PositiveInt
+from mobee_drake.experiments.arguments import HelpFormatter, PositiveFloat, PositiveInt
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
@@ -98,11 +98,17 @@ def RunOne(run: RunFolder, controller: str, seed: int, minutes: float, scenario_
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
-        prog="mobee-drake bench babbling", description=__doc__.split("\n")[0]
+        prog="mobee-drake bench babbling",
+        description=__doc__.split("\n")[0],
+        formatter_class=HelpFormatter,
     )
-    parser.add_argument("--seeds", type=PositiveInt, default=5)
-    parser.add_argument("--minutes", type=PositiveFloat, default=5.0)
-    parser.add_argument("--scenario", default=SCENARIO)
+    parser.add_argument("--seeds", type=PositiveInt, default=5, help="seeds per controller")
+    parser.add_argument(
+        "--minutes", type=PositiveFloat, default=5.0, help="simulated minutes per run"
+    )
+    parser.add_argument(
+        "--scenario", default=SCENARIO, help="the babbling scenario (a file or a shipped name)"
+    )
     parser.add_argument(
         "--output", default=None, help="keep the runs here (default: a temporary folder)"
     )

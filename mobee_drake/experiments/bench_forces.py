@@ -21,7 +21,7 @@ import numpy as np
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
-from mobee_drake.experiments.arguments import NonNegativeInt, PositiveInt
+from mobee_drake.experiments.arguments import HelpFormatter, NonNegativeInt, PositiveInt
 from mobee_drake.experiments.plots import plt
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.icub import IcubConfig
@@ -144,11 +144,17 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
         prog="mobee-drake bench forces",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=HelpFormatter,
     )
-    parser.add_argument("--robot", choices=sorted(ROBOTS), nargs="+", default=["icub"])
     parser.add_argument(
-        "--obstacles", type=NonNegativeInt, nargs="+", default=[0, 10, 30, 100, 300]
+        "--robot", choices=sorted(ROBOTS), nargs="+", default=["icub"], help="the robots to measure"
+    )
+    parser.add_argument(
+        "--obstacles",
+        type=NonNegativeInt,
+        nargs="+",
+        default=[0, 10, 30, 100, 300],
+        help="numbers of random boxes, one row each",
     )
     parser.add_argument("--poses", type=PositiveInt, default=2000, help="evaluations per sweep")
     parser.add_argument("--repeats", type=PositiveInt, default=5, help="sweeps per row")
@@ -164,7 +170,9 @@ def main(argv=None) -> None:
         help="remove one box and insert another before every evaluation (Alg. 1)",
     )
     parser.add_argument("--plot", default="", help="save the curves (like Fig. 2.4) to this PNG")
-    parser.add_argument("--seed", type=NonNegativeInt, default=0)
+    parser.add_argument(
+        "--seed", type=NonNegativeInt, default=0, help="seed of the boxes and the oscillators"
+    )
     args = parser.parse_args(argv)
     print(
         "| robot | boxes | evaluations/s (best) | evaluations/s (median) | us/evaluation (best) "

@@ -28,7 +28,7 @@ import numpy as np
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.solvers import Solve
 
-from mobee_drake.experiments.arguments import NonNegativeInt, PositiveInt
+from mobee_drake.experiments.arguments import HelpFormatter, NonNegativeInt, PositiveInt
 from mobee_drake.ngik.costs import CollisionCost, MarkerOrientationCost, MarkerPositionCost
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.ngik.nes import NesConfig
@@ -213,10 +213,16 @@ def Format(rows: list[dict], problems: int) -> str:
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
-        prog="mobee-drake bench ik", description=__doc__.split("\n")[0]
+        prog="mobee-drake bench ik",
+        description=__doc__.split("\n")[0],
+        formatter_class=HelpFormatter,
     )
-    parser.add_argument("--problems", type=PositiveInt, default=50)
-    parser.add_argument("--seed", type=NonNegativeInt, default=0)
+    parser.add_argument(
+        "--problems", type=PositiveInt, default=50, help="random IK problems per solver"
+    )
+    parser.add_argument(
+        "--seed", type=NonNegativeInt, default=0, help="seed of the problems and the solvers"
+    )
     args = parser.parse_args(argv)
     print(Format(Run(args.problems, args.seed), args.problems))
 

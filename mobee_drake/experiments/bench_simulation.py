@@ -11,7 +11,7 @@ Run: ``mobee-drake bench simulation [--seconds 600] [--controls position velocit
 
 import argparse
 
-from mobee_drake.experiments.arguments import PositiveFloat
+from mobee_drake.experiments.arguments import HelpFormatter, PositiveFloat
 from mobee_drake.scenario import LoadScenario, RunScenario
 
 SCENARIO = "motor_babbling"
@@ -21,7 +21,7 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
         prog="mobee-drake bench simulation",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=HelpFormatter,
     )
     parser.add_argument(
         "--seconds", type=PositiveFloat, default=600.0, help="simulated time per run"
@@ -32,7 +32,9 @@ def main(argv=None) -> None:
         default=["position"],
         help="dynamic-robot modalities to run (none: kinematic only)",
     )
-    parser.add_argument("--scenario", default=str(SCENARIO))
+    parser.add_argument(
+        "--scenario", default=str(SCENARIO), help="the scenario run (a file or a shipped name)"
+    )
     args = parser.parse_args(argv)
     runs = [("kinematic", "-")] + [("dynamic", control) for control in args.controls]
     print(f"{args.scenario}, {args.seconds:g} s simulated per run")

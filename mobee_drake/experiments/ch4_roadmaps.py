@@ -23,7 +23,7 @@ import time
 import numpy as np
 from pydrake.geometry import StartMeshcat
 
-from mobee_drake.experiments.arguments import NonNegativeInt
+from mobee_drake.experiments.arguments import HelpFormatter, NonNegativeInt
 from mobee_drake.ngik.costs import CollisionCost, HomeCost, MarkerPositionCost
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.ngik.nes import NesConfig
@@ -192,9 +192,13 @@ def AdaptiveReplanning(seed: int = 0, *, meshcat=None) -> ReplanningResult:
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
-        prog="mobee-drake experiment roadmaps", description=__doc__.split("\n")[0]
+        prog="mobee-drake experiment roadmaps",
+        description=__doc__.split("\n")[0],
+        formatter_class=HelpFormatter,
     )
-    parser.add_argument("--seed", type=NonNegativeInt, default=0)
+    parser.add_argument(
+        "--seed", type=NonNegativeInt, default=0, help="seed of the roadmap and its exploration"
+    )
     parser.add_argument("--meshcat", action="store_true", help="watch the robot in Meshcat")
     args = parser.parse_args(argv)
     meshcat = None

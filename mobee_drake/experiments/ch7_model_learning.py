@@ -40,7 +40,7 @@ from pydrake.geometry import SceneGraph
 from pydrake.multibody.plant import MultibodyPlant
 from scipy.stats import spearmanr
 
-from mobee_drake.experiments.arguments import PositiveInt
+from mobee_drake.experiments.arguments import HelpFormatter, PositiveInt
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     Backend,
@@ -731,13 +731,18 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
         prog="mobee-drake experiment ch7",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=HelpFormatter,
     )
     parser.add_argument(
-        "--experiment", choices=["7.1", "7.2", "7.2i", "7.3", "7.4", "7.4.1"], required=True
+        "--experiment",
+        choices=["7.1", "7.2", "7.2i", "7.3", "7.4", "7.4.1"],
+        required=True,
+        help="which experiment of ch. 7",
     )
-    parser.add_argument("--output", default="results/ch7")
-    parser.add_argument("--runs", type=PositiveInt, default=5)
+    parser.add_argument(
+        "--output", default="results/ch7", help="the battery folder (runs, plots, report)"
+    )
+    parser.add_argument("--runs", type=PositiveInt, default=5, help="runs (seeds) per setting")
     parser.add_argument(
         "--transitions",
         type=PositiveInt,

@@ -41,7 +41,12 @@ from pydrake.geometry import StartMeshcat
 from scipy.stats import ttest_ind
 
 from mobee_drake.atomic_files import CurrentGeneration, StrictJson, WriteGeneration
-from mobee_drake.experiments.arguments import NonNegativeInt, PositiveFloat, PositiveInt
+from mobee_drake.experiments.arguments import (
+    HelpFormatter,
+    NonNegativeInt,
+    PositiveFloat,
+    PositiveInt,
+)
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     Backend,
@@ -520,14 +525,22 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
         prog="mobee-drake experiment ch8",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=HelpFormatter,
     )
-    parser.add_argument("--output", default="results/ch8")
     parser.add_argument(
-        "--strategies", nargs="+", choices=list(REACH_STRATEGIES), default=list(SOURCE_STRATEGIES)
+        "--output", default="results/ch8", help="the battery folder (runs, plots, report)"
     )
-    parser.add_argument("--seeds", type=PositiveInt, default=5)
-    parser.add_argument("--problem-tries", type=PositiveInt, default=6400)
+    parser.add_argument(
+        "--strategies",
+        nargs="+",
+        choices=list(REACH_STRATEGIES),
+        default=list(SOURCE_STRATEGIES),
+        help="exploration strategies, one run per seed each",
+    )
+    parser.add_argument("--seeds", type=PositiveInt, default=5, help="seeds per strategy")
+    parser.add_argument(
+        "--problem-tries", type=PositiveInt, default=6400, help="exploratory problem-tries per run"
+    )
     parser.add_argument(
         "--stages",
         type=NonNegativeInt,
@@ -535,14 +548,21 @@ def main(argv=None) -> None:
         default=None,
         help="when to evaluate (default: the source's 100, 200, ..., 6400 up to --problem-tries)",
     )
-    parser.add_argument("--evaluations", type=PositiveInt, default=5)
+    parser.add_argument(
+        "--evaluations", type=PositiveInt, default=5, help="exploitation evaluations at each stage"
+    )
     parser.add_argument(
         "--mdp-tries",
         type=PositiveInt,
         default=5,
         help="the MDP is learned until every state-action was tried this often",
     )
-    parser.add_argument("--checkpoint-every", type=PositiveInt, default=50)
+    parser.add_argument(
+        "--checkpoint-every",
+        type=PositiveInt,
+        default=50,
+        help="problem-tries between two checkpoints of a run",
+    )
     parser.add_argument(
         "--watch",
         action="store_true",

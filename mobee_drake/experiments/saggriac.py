@@ -25,7 +25,7 @@ import numpy as np
 from scipy import stats
 
 from mobee_drake.atomic_files import StrictJson, WriteTextAtomically
-from mobee_drake.experiments.arguments import NonNegativeInt, PositiveInt
+from mobee_drake.experiments.arguments import HelpFormatter, NonNegativeInt, PositiveInt
 from mobee_drake.experiments.battery import (
     RESULT,
     AddBackendArguments,
@@ -414,12 +414,25 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(
         prog="mobee-drake experiment saggriac",
         description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=HelpFormatter,
     )
-    parser.add_argument("--experiments", type=int, nargs="+", choices=[1, 2], default=[1, 2])
-    parser.add_argument("--methods", nargs="+", choices=list(METHODS), default=list(METHODS))
+    parser.add_argument(
+        "--experiments",
+        type=int,
+        nargs="+",
+        choices=[1, 2],
+        default=[1, 2],
+        help="which experiments of Sec. IV",
+    )
+    parser.add_argument(
+        "--methods",
+        nargs="+",
+        choices=list(METHODS),
+        default=list(METHODS),
+        help="the learners compared",
+    )
     parser.add_argument("--seeds", type=PositiveInt, default=15, help="number of seeds (paper: 15)")
-    parser.add_argument("--first-seed", type=NonNegativeInt, default=0)
+    parser.add_argument("--first-seed", type=NonNegativeInt, default=0, help="the first seed")
     parser.add_argument(
         "--budget-exp1", type=PositiveInt, default=50_000, help="paper: 50,000 movements"
     )
@@ -429,7 +442,12 @@ def main(argv=None) -> None:
     parser.add_argument(
         "--checkpoints", type=PositiveInt, default=20, help="evaluations after step 0"
     )
-    parser.add_argument("--output", type=pathlib.Path, default=pathlib.Path("saggriac_results"))
+    parser.add_argument(
+        "--output",
+        type=pathlib.Path,
+        default=pathlib.Path("saggriac_results"),
+        help="the battery folder (runs, curves, report)",
+    )
     parser.add_argument(
         "--analyse-only", action="store_true", help="only rebuild the report from run files"
     )

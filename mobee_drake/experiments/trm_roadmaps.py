@@ -16,7 +16,7 @@ import pathlib
 import numpy as np
 from pydrake.geometry import Meshcat
 
-from mobee_drake.experiments.arguments import NonNegativeInt, PositiveInt
+from mobee_drake.experiments.arguments import HelpFormatter, NonNegativeInt, PositiveInt
 from mobee_drake.experiments.plots import plt
 from mobee_drake.trm.display import MarkerCloud, PathMotion, RecordMotion, ShowRoadmap
 from mobee_drake.trm.examples import EXAMPLES, OpenBox, TrmExample
@@ -113,12 +113,27 @@ def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) ->
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(
-        prog="mobee-drake experiment trm", description=__doc__.split("\n")[0]
+        prog="mobee-drake experiment trm",
+        description=__doc__.split("\n")[0],
+        formatter_class=HelpFormatter,
     )
-    parser.add_argument("--output", required=True)
-    parser.add_argument("--examples", nargs="+", choices=sorted(EXAMPLES), default=list(EXAMPLES))
-    parser.add_argument("--max-vertices", type=PositiveInt, default=TrmConfig.max_vertices)
-    parser.add_argument("--seed", type=NonNegativeInt, default=0)
+    parser.add_argument("--output", required=True, help="where the roadmaps, figures and report go")
+    parser.add_argument(
+        "--examples",
+        nargs="+",
+        choices=sorted(EXAMPLES),
+        default=list(EXAMPLES),
+        help="the examples of ch. 3.4 to build",
+    )
+    parser.add_argument(
+        "--max-vertices",
+        type=PositiveInt,
+        default=TrmConfig.max_vertices,
+        help="the largest roadmap built",
+    )
+    parser.add_argument(
+        "--seed", type=NonNegativeInt, default=0, help="seed of the roadmap builder"
+    )
     args = parser.parse_args(argv)
     output = pathlib.Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
