@@ -13,7 +13,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake import __version__
 from mobee_drake.atomic_files import WriteJsonAtomically
-from mobee_drake.experiments.arguments import HelpFormatter, PositiveFloat
+from mobee_drake.experiments.arguments import CommandParser, PositiveFloat
 from mobee_drake.experiments.battery import BatteryRefused
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.owned_folders import CanWrite, FolderError
@@ -39,13 +39,12 @@ def _Fail(message: str) -> None:
 
 def _Run(args: list[str]) -> None:
     """Runs a scenario and prints its summary."""
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="mobee-drake run",
         description="Simulate a scenario: a file, or the name of a shipped one ("
         + ", ".join(ScenarioNames())
         + "). Headless by default: the run is recorded to results/<scenario>.html unless "
         "--record or --no-record says otherwise; --meshcat serves the live view.",
-        formatter_class=HelpFormatter,
     )
     parser.add_argument("scenario", help="a scenario file or a shipped scenario's name")
     parser.add_argument(
@@ -131,7 +130,7 @@ def _Run(args: list[str]) -> None:
 def _Dispatch(prog: str, args: list[str], modules: dict[str, str]) -> None:
     """Runs ``main(rest)`` of the module named by the first argument (its own --help included)."""
     if not args or args[0] not in modules:
-        parser = argparse.ArgumentParser(prog=prog, formatter_class=HelpFormatter)
+        parser = CommandParser(prog=prog)
         parser.add_argument("which", choices=sorted(modules), help="which one (its own --help)")
         parser.parse_args(args[:1])
     try:
@@ -174,9 +173,7 @@ def _Experiment(args: list[str]) -> None:
 
 def _Info(args: list[str]) -> None:
     """Prints the iCub model, its controlled joints, overlay geometry, markers and clauses."""
-    parser = argparse.ArgumentParser(
-        prog="mobee-drake info", description=_Info.__doc__, formatter_class=HelpFormatter
-    )
+    parser = CommandParser(prog="mobee-drake info", description=_Info.__doc__)
     parser.add_argument("--model", default=IcubConfig().model, help="an icub-models robot name")
     known = parser.parse_args(args)
     config = IcubConfig(model=known.model)
@@ -208,10 +205,9 @@ COMMANDS = {"bench": _Bench, "experiment": _Experiment, "info": _Info, "run": _R
 
 def main(argv: list[str] | None = None) -> None:
     argv = sys.argv[1:] if argv is None else argv
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="mobee-drake",
         description="MoBeE 2.0 on Drake for the iCub.",
-        formatter_class=HelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument(

@@ -32,3 +32,14 @@ def PositiveFloat(text: str) -> float:
 
 class HelpFormatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
     """Every command's help: its description as written, each option with its default."""
+
+
+class CommandParser(argparse.ArgumentParser):
+    """A command's parser: help with defaults, and a mistake in one line (no usage dump)."""
+
+    def __init__(self, **kwargs):
+        kwargs.setdefault("formatter_class", HelpFormatter)
+        super().__init__(**kwargs)
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message}\n")

@@ -588,7 +588,7 @@ def AddBackendArguments(parser, workers: int = 1) -> None:
         "--workers",
         type=PositiveInt,
         default=workers,
-        help="local worker processes (default %(default)s)",
+        help="local worker processes",
     )
     parser.add_argument(
         "--ray",

@@ -17,7 +17,6 @@ sequence of commands. For each we count, per simulated minute:
 Run: ``mobee-drake bench babbling [--seeds 5] [--minutes 5]``.
 """
 
-import argparse
 import contextlib
 import tempfile
 import time
@@ -25,7 +24,7 @@ import time
 import numpy as np
 from pydrake.systems.primitives import LogVectorOutput
 
-from mobee_drake.experiments.arguments import HelpFormatter, PositiveFloat, PositiveInt
+from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
@@ -97,10 +96,9 @@ def RunOne(run: RunFolder, controller: str, seed: int, minutes: float, scenario_
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="mobee-drake bench babbling",
         description=__doc__.split("\n")[0],
-        formatter_class=HelpFormatter,
     )
     parser.add_argument("--seeds", type=PositiveInt, default=5, help="seeds per controller")
     parser.add_argument(

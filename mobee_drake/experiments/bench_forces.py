@@ -13,7 +13,6 @@ Run: ``mobee-drake bench forces [--robot katana] [--churn] [--plot FILE.png]`` (
 ``python -m mobee_drake.experiments.bench_forces``).
 """
 
-import argparse
 import dataclasses as dc
 import time
 
@@ -21,7 +20,7 @@ import numpy as np
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
-from mobee_drake.experiments.arguments import HelpFormatter, NonNegativeInt, PositiveInt
+from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
 from mobee_drake.experiments.plots import plt
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.icub import IcubConfig
@@ -141,10 +140,9 @@ def MeasureForceEvaluations(
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="mobee-drake bench forces",
         description=__doc__,
-        formatter_class=HelpFormatter,
     )
     parser.add_argument(
         "--robot", choices=sorted(ROBOTS), nargs="+", default=["icub"], help="the robots to measure"

@@ -19,7 +19,6 @@ meeting every term. One process, one core.
 Run: ``mobee-drake bench ik [--problems 50] [--seed 0]``.
 """
 
-import argparse
 import dataclasses as dc
 import time
 
@@ -28,7 +27,7 @@ import numpy as np
 from pydrake.multibody.inverse_kinematics import InverseKinematics
 from pydrake.solvers import Solve
 
-from mobee_drake.experiments.arguments import HelpFormatter, NonNegativeInt, PositiveInt
+from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
 from mobee_drake.ngik.costs import CollisionCost, MarkerOrientationCost, MarkerPositionCost
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.ngik.nes import NesConfig
@@ -212,10 +211,9 @@ def Format(rows: list[dict], problems: int) -> str:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="mobee-drake bench ik",
         description=__doc__.split("\n")[0],
-        formatter_class=HelpFormatter,
     )
     parser.add_argument(
         "--problems", type=PositiveInt, default=50, help="random IK problems per solver"

@@ -9,19 +9,16 @@ closest approach to the table and of the robot to itself.
 Run: ``mobee-drake bench simulation [--seconds 600] [--controls position velocity force]``.
 """
 
-import argparse
-
-from mobee_drake.experiments.arguments import HelpFormatter, PositiveFloat
+from mobee_drake.experiments.arguments import CommandParser, PositiveFloat
 from mobee_drake.scenario import LoadScenario, RunScenario
 
 SCENARIO = "motor_babbling"
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="mobee-drake bench simulation",
         description=__doc__,
-        formatter_class=HelpFormatter,
     )
     parser.add_argument(
         "--seconds", type=PositiveFloat, default=600.0, help="simulated time per run"

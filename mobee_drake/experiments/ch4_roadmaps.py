@@ -16,14 +16,13 @@
 Run: ``mobee-drake experiment roadmaps [--seed S] [--meshcat]``.
 """
 
-import argparse
 import dataclasses as dc
 import time
 
 import numpy as np
 from pydrake.geometry import StartMeshcat
 
-from mobee_drake.experiments.arguments import HelpFormatter, NonNegativeInt
+from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt
 from mobee_drake.ngik.costs import CollisionCost, HomeCost, MarkerPositionCost
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.ngik.nes import NesConfig
@@ -191,10 +190,9 @@ def AdaptiveReplanning(seed: int = 0, *, meshcat=None) -> ReplanningResult:
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="mobee-drake experiment roadmaps",
         description=__doc__.split("\n")[0],
-        formatter_class=HelpFormatter,
     )
     parser.add_argument(
         "--seed", type=NonNegativeInt, default=0, help="seed of the roadmap and its exploration"

@@ -30,7 +30,6 @@ and a ``report_<experiment>.md``. Run:
 ``mobee-drake experiment ch7 --experiment 7.1 --output results/ch7``.
 """
 
-import argparse
 import dataclasses as dc
 import pathlib
 import sys
@@ -40,7 +39,7 @@ from pydrake.geometry import SceneGraph
 from pydrake.multibody.plant import MultibodyPlant
 from scipy.stats import spearmanr
 
-from mobee_drake.experiments.arguments import HelpFormatter, PositiveInt
+from mobee_drake.experiments.arguments import CommandParser, PositiveInt
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     Backend,
@@ -728,10 +727,9 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="mobee-drake experiment ch7",
         description=__doc__,
-        formatter_class=HelpFormatter,
     )
     parser.add_argument(
         "--experiment",

@@ -29,7 +29,6 @@ Run: ``mobee-drake experiment ch8 --output results/ch8`` (the whole battery), or
 ``mobee-drake experiment ch8 --watch --strategies intrinsic``.
 """
 
-import argparse
 import dataclasses as dc
 import json
 import pathlib
@@ -42,7 +41,7 @@ from scipy.stats import ttest_ind
 
 from mobee_drake.atomic_files import CurrentGeneration, StrictJson, WriteGeneration
 from mobee_drake.experiments.arguments import (
-    HelpFormatter,
+    CommandParser,
     NonNegativeInt,
     PositiveFloat,
     PositiveInt,
@@ -522,10 +521,9 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="mobee-drake experiment ch8",
         description=__doc__,
-        formatter_class=HelpFormatter,
     )
     parser.add_argument(
         "--output", default="results/ch8", help="the battery folder (runs, plots, report)"

@@ -12,7 +12,6 @@ Usage::
     mobee-drake experiment saggriac --smoke --output /tmp/saggriac_smoke [--ray [ADDRESS]]
 """
 
-import argparse
 import csv
 import dataclasses
 import json
@@ -25,7 +24,7 @@ import numpy as np
 from scipy import stats
 
 from mobee_drake.atomic_files import StrictJson, WriteTextAtomically
-from mobee_drake.experiments.arguments import HelpFormatter, NonNegativeInt, PositiveInt
+from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
 from mobee_drake.experiments.battery import (
     RESULT,
     AddBackendArguments,
@@ -411,10 +410,9 @@ def main(argv=None) -> None:
     Args:
         argv: Arguments (default: sys.argv[1:]).
     """
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="mobee-drake experiment saggriac",
         description=__doc__,
-        formatter_class=HelpFormatter,
     )
     parser.add_argument(
         "--experiments",

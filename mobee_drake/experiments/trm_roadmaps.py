@@ -10,13 +10,12 @@ Run: ``mobee-drake experiment trm --output DIR [--examples reach_into raise_a_gl
 [--max-vertices N] [--seed S]``.
 """
 
-import argparse
 import pathlib
 
 import numpy as np
 from pydrake.geometry import Meshcat
 
-from mobee_drake.experiments.arguments import HelpFormatter, NonNegativeInt, PositiveInt
+from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
 from mobee_drake.experiments.plots import plt
 from mobee_drake.trm.display import MarkerCloud, PathMotion, RecordMotion, ShowRoadmap
 from mobee_drake.trm.examples import EXAMPLES, OpenBox, TrmExample
@@ -112,10 +111,9 @@ def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) ->
 
 
 def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="mobee-drake experiment trm",
         description=__doc__.split("\n")[0],
-        formatter_class=HelpFormatter,
     )
     parser.add_argument("--output", required=True, help="where the roadmaps, figures and report go")
     parser.add_argument(

@@ -346,6 +346,8 @@ def MakeMobeeStation(
     attractor, marker_forces = _ConnectClient(
         builder, client, mobee, mover, isinstance(mover_config, Reflex)
     )
+    if config.visualization.trail_marker:
+        mobee.marker_index(config.visualization.trail_marker)  # Checked with or without a viewer.
     visualizer = None
     if meshcat is not None:
         visualizer = AddViewer(

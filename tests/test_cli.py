@@ -1,0 +1,95 @@
+"""The command line: help with defaults for every command, one-line mistakes with exit code 2,
+``--debug`` for their tracebacks, and the logging level."""
+
+import contextlib
+import io
+import logging
+import re
+import unittest
+
+from mobee_drake import cli
+
+COMMANDS = [
+    ["run"],
+    ["info"],
+    ["experiment", "ch7"],
+    ["experiment", "ch8"],
+    ["experiment", "saggriac"],
+    ["experiment", "trm"],
+    ["experiment", "roadmaps"],
+    ["bench", "forces"],
+    ["bench", "simulation"],
+    ["bench", "ik"],
+    ["bench", "babbling"],
+]
+
+
+def _Call(*args: str) -> tuple[int, str, str]:
+    out, err = io.StringIO(), io.StringIO()
+    code = 0
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            cli.main(list(args))
+        except SystemExit as e:
+            code = e.code
+    return code, out.getvalue(), err.getvalue()
+
+
+class TestHelp(unittest.TestCase):
+    def test_every_option_of_every_command_has_help_and_its_default(self):
+        for command in COMMANDS:
+            with self.subTest(" ".join(command)):
+                code, text, _ = _Call(*command, "--help")
+                self.assertEqual(code, 0)
+                options = re.findall(r"^  (--[a-z-]+)", text, flags=re.MULTILINE)
+                self.assertTrue(options)
+                # Each option's entry (up to the next one) says its default.
+                entries = re.split(r"\n  (?=--)", text.split("options:")[1])[1:]
+                for entry in entries:
+                    if not entry.startswith("--help"):
+                        self.assertIn("(default:", entry, entry.split()[0])
+
+    def test_version(self):
+        code, text, _ = _Call("--version")
+        self.assertEqual(code, 0)
+        self.assertRegex(text, r"^mobee-drake \d+\.\d+\.\d+")
+
+
+class TestMistakes(unittest.TestCase):
+    def test_a_mistake_is_one_line_and_exit_code_2(self):
+        for args, message in (
+            (["info", "--model", "iCubMars"], "unknown iCub model 'iCubMars'"),
+            (["run", "reach_around_ball", "--duration", "-5"], "--duration: must be a finite"),
+            (["run", "reach_around_ball", "--set", "{duration: ["], "invalid YAML"),
+            (
+                [
+                    "run",
+                    "reach_around_ball",
+                    "--no-meshcat",
+                    "--set",
+                    "{visualization: {trail_marker: nose}}",
+                ],
+                "",
+            ),  # fmt: skip
+        ):
+            with self.subTest(args):
+                code, _, err = _Call(*args)
+                self.assertEqual(code, 2)
+                self.assertEqual(len(err.strip().splitlines()), 1, err)
+                self.assertIn(message, err)
+                self.assertNotIn("Traceback", err)
+
+    def test_debug_shows_the_traceback(self):
+        with self.assertRaisesRegex(ValueError, "unknown iCub model"):
+            cli.main(["--debug", "info", "--model", "iCubMars"])
+
+    def test_quiet_and_verbose_set_the_logging_level(self):
+        for flag, level in (("-q", logging.WARNING), ("-v", logging.DEBUG)):
+            with self.subTest(flag):
+                _Call(flag, "info", "--model", "iCubMars")
+                self.assertEqual(logging.getLogger("drake").level, level)
+        logging.getLogger("drake").setLevel(logging.INFO)
+
+
+if __name__ == "__main__":
+    unittest.main()
