@@ -48,7 +48,7 @@ def _Run(args: list[str]) -> None:
     )
     parser.add_argument("scenario", help="a scenario file or a shipped scenario's name")
     parser.add_argument(
-        "--duration", type=PositiveFloat, help="seconds to simulate (default: the file's)"
+        "--duration", type=PositiveFloat, help="seconds to simulate instead of the scenario's"
     )
     parser.add_argument("--record", help="save a replayable Meshcat recording to this HTML file")
     parser.add_argument("--no-record", action="store_true", help="do not save a recording")
