@@ -17,6 +17,7 @@ the contract, ``docs/architecture.md`` the map):
   :mod:`~mobee_drake.robots`: the controllers, the robot's surroundings and its models;
 - :mod:`~mobee_drake.yaml_io`, :mod:`~mobee_drake.atomic_files` (and checkpoint generations),
   :mod:`~mobee_drake.owned_folders` (folders claimed and locked before a run writes),
+  :mod:`~mobee_drake.progress` (bars on a terminal, plain lines in a log),
   :mod:`~mobee_drake.resources`.
 """
 

@@ -109,8 +109,9 @@ class LocalBatteryTest(TemporaryFolder):
         stream = io.StringIO()
         with contextlib.redirect_stderr(stream):
             RunBattery(Walks(pause=0.2)[:2], self.folder, workers=2, description="walks")
-        self.assertIn("walks: 100%", stream.getvalue())
-        self.assertRegex(stream.getvalue(), r"walk0: +\d+%")
+        # Standard error is not a terminal here: plain lines, the battery's and the runs'.
+        self.assertIn("walks: 2/2 run", stream.getvalue())
+        self.assertRegex(stream.getvalue(), r"walk0: \d+/8 it")
 
     def test_without_ray_the_error_says_how_to_install_it(self):
         with mock.patch.dict(sys.modules, {"ray": None}):

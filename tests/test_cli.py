@@ -5,6 +5,8 @@ import contextlib
 import io
 import logging
 import re
+import subprocess
+import sys
 import unittest
 
 from mobee_drake import cli
@@ -89,6 +91,20 @@ class TestMistakes(unittest.TestCase):
                 _Call(flag, "info", "--model", "iCubMars")
                 self.assertEqual(logging.getLogger("drake").level, level)
         logging.getLogger("drake").setLevel(logging.INFO)
+
+
+class TestProgressInLogs(unittest.TestCase):
+    def test_a_log_file_gets_plain_lines_not_bars(self):
+        done = subprocess.run(
+            [sys.executable, "-m", "mobee_drake.cli", "-q", "run", "reach_around_ball",
+             "--duration", "2", "--no-meshcat"],
+            capture_output=True,
+            text=True,
+            check=True,
+        )  # fmt: skip
+        self.assertNotIn("\r", done.stderr)
+        self.assertNotIn("\x1b", done.stderr)
+        self.assertIn("simulated: 2/2 s", done.stderr)
 
 
 if __name__ == "__main__":

@@ -87,12 +87,11 @@ import sys
 import threading
 from typing import ClassVar
 
-from tqdm import tqdm
-
 from mobee_drake import __version__
 from mobee_drake.atomic_files import StrictJson, WriteJsonAtomically, WriteTextAtomically
 from mobee_drake.experiments.arguments import PositiveInt
 from mobee_drake.owned_folders import OwnedFolder
+from mobee_drake.progress import ProgressBar
 from mobee_drake.yaml_io import YamlDifferences
 
 RESULT = "result.json"
@@ -402,7 +401,7 @@ class _Display:
 
     def __init__(self, output: pathlib.Path, jobs: int, done: int, description: str, enabled: bool):
         self.output, self.enabled, self.runs = output, enabled, {}
-        self.battery = tqdm(
+        self.battery = ProgressBar(
             total=jobs,
             initial=done,
             desc=description or "battery",
@@ -424,7 +423,7 @@ class _Display:
             except (OSError, ValueError):  # Not started.
                 continue
             if name not in self.runs:
-                self.runs[name] = tqdm(
+                self.runs[name] = ProgressBar(
                     total=job.total or None,
                     initial=done,
                     desc=name,

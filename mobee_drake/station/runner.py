@@ -7,10 +7,10 @@ import time
 from typing import Protocol, runtime_checkable
 
 from pydrake.systems.analysis import InitializeParams, Simulator, SimulatorConfig
-from tqdm import tqdm
 
 from mobee_drake.atomic_files import WriteTextAtomically
 from mobee_drake.owned_folders import OwnedFolder
+from mobee_drake.progress import ProgressBar
 from mobee_drake.station.builder import Station
 from mobee_drake.station.checkpoint import HasCheckpoint, LoadCheckpoint, SaveCheckpoint
 from mobee_drake.station.outcome import RunOutcome
@@ -96,8 +96,10 @@ def Advance(
     chunks = max(1, min(500, int(round((until - start) / station.config.time_step))))
     bar = None
     if progress:
-        bar = tqdm(
+        bar = ProgressBar(
             total=round(until - start, 3),
+            desc="simulated",
+            unit="s",
             leave=False,
             bar_format="{l_bar}{bar}| {n:.1f}/{total:.1f} s simulated [{elapsed}<{remaining}]",
         )
