@@ -108,11 +108,16 @@ def _Flatten(data, prefix: str = "") -> dict[str, object]:
     return {prefix: data}
 
 
+def TaggedData(text: str):
+    """The plain data of YAML that Drake's ``yaml_dump_typed`` wrote, a tagged value (a union's
+    member) as ``{"!Tag": value}``: comparable by value, unlike Drake's config structs."""
+    return yaml.load(text, Loader=_TaggedLoader)
+
+
 def YamlDifferences(before: str, after: str) -> list[str]:
     """What differs between two YAML texts of the same schema: ``key: old -> new`` for every
     leaf (a missing one shown as ``-``), in key order."""
-    old = _Flatten(yaml.load(before, Loader=_TaggedLoader))
-    new = _Flatten(yaml.load(after, Loader=_TaggedLoader))
+    old, new = _Flatten(TaggedData(before)), _Flatten(TaggedData(after))
     return [
         f"{key}: {old.get(key, '-')} -> {new.get(key, '-')}"
         for key in sorted(old.keys() | new.keys())

@@ -10,7 +10,6 @@ import numpy as np
 from pydrake.common.yaml import yaml_dump_typed
 from pydrake.geometry import Meshcat
 from pydrake.systems.primitives import ConstantVectorSource
-import yaml
 
 from mobee_drake.resources import ScenarioNames
 from mobee_drake.scenario import BuildScenario, LoadScenario, Scenario
@@ -19,28 +18,14 @@ from mobee_drake.station.config import Dynamic
 from mobee_drake.station.parts import ClientPorts, StationParts
 from mobee_drake.station.runner import RunStation
 from mobee_drake.station.world_events import MakeSimulator
-from mobee_drake.yaml_io import YamlFileError
+from mobee_drake.yaml_io import TaggedData, YamlFileError
 
 TEST_SCENARIOS = pathlib.Path(__file__).with_name("test_scenarios.yaml")
 
 
-class _TaggedLoader(yaml.SafeLoader):
-    """Reads a dumped scenario, its tagged values as {tag: value}."""
-
-
-_TaggedLoader.add_multi_constructor(
-    "!",
-    lambda loader, tag, node: {
-        tag: loader.construct_mapping(node, deep=True)
-        if isinstance(node, yaml.MappingNode)
-        else loader.construct_scalar(node)
-    },
-)
-
-
 def _AsData(scenario: Scenario) -> dict:
     """The scenario as plain data (Drake's config structs compare by identity, not value)."""
-    return yaml.load(yaml_dump_typed(scenario), Loader=_TaggedLoader)
+    return TaggedData(yaml_dump_typed(scenario))
 
 
 class TestScenarioFile(unittest.TestCase):
@@ -54,7 +39,7 @@ class TestScenarioFile(unittest.TestCase):
         self.assertEqual(sorted(scenario), sorted(f.name for f in dc.fields(Scenario)))
         unchanged = [name for name in scenario if scenario[name] == defaults[name]]
         self.assertEqual(unchanged, [])
-        self.assertEqual(scenario["mover"]["Reflex"]["speed_deg"], 30.0)
+        self.assertEqual(scenario["mover"]["!Reflex"]["speed_deg"], 30.0)
 
     def test_every_test_scenario_builds_and_runs(self):
         for name in ("Defaults", "OneOfEverything", "DynamicForce"):

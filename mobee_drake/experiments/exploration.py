@@ -77,7 +77,7 @@ def Explore(
     :class:`~mobee_drake.experiments.battery.JobStopped`."""
     station, simulator, supervisor, supervisor_context = StartExploration(scenario, checkpoint)
     context = simulator.get_context()
-    configuration = ResumableConfiguration(scenario)
+    configuration = ResumableConfiguration(scenario) if checkpoint is not None else ""
     records = supervisor.Records(supervisor_context)
     saved = sum(r.actions_done for r in records)
     observe, observed = observer(station) if observer else (None, dict)

@@ -155,78 +155,53 @@ def RunStation(
     flight. A run whose checkpoint is at or past ``duration`` has nothing left to do: it
     simulates nothing and says so (``RunSummary.finished_before``).
     """
-    with contextlib.ExitStack() as stack:
+    with OwnedFolder(checkpoint, "checkpoint") if checkpoint else contextlib.nullcontext():
+        simulator = MakeSimulator(station, simulator_config)
+        if realtime_rate is not None:
+            simulator.set_target_realtime_rate(realtime_rate)
+        context = simulator.get_mutable_context()
+        resumed = None
+        if checkpoint and HasCheckpoint(checkpoint):
+            LoadCheckpoint(station, context, checkpoint, configuration)
+            simulator.Initialize(InitializeParams(suppress_initialization_events=True))
+            resumed = context.get_time()
+        else:
+            simulator.Initialize()
+        report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
+        if resumed is not None and resumed >= duration:
+            return RunSummary(0.0, 0.0, report, finished_before=resumed)
+        if record:
+            station.visualizer.StartRecording()
+        counters = ActionCounters(station)
+        saved = [CompletedActions(counters, context)]
+
+        def Save(context) -> None:
+            SaveCheckpoint(station, context, checkpoint, configuration)
+
+        def AfterChunk(context):
+            done = CompletedActions(counters, context)
+            if checkpoint and done > saved[0]:
+                Save(context)
+                saved[0] = done
+
+        start = time.perf_counter()
+        Advance(station, simulator, duration, progress=progress, after_chunk=AfterChunk)
         if checkpoint:
-            stack.enter_context(OwnedFolder(checkpoint, "checkpoint"))
-        return _Run(
-            station,
-            duration,
-            record=record,
-            simulator_config=simulator_config,
-            realtime_rate=realtime_rate,
-            progress=progress,
-            checkpoint=checkpoint,
-            configuration=configuration,
-        )
-
-
-def _Run(
-    station: Station,
-    duration: float,
-    *,
-    record,
-    simulator_config,
-    realtime_rate,
-    progress: bool,
-    checkpoint,
-    configuration: str,
-) -> RunSummary:
-    simulator = MakeSimulator(station, simulator_config)
-    if realtime_rate is not None:
-        simulator.set_target_realtime_rate(realtime_rate)
-    context = simulator.get_mutable_context()
-    resumed = None
-    if checkpoint and HasCheckpoint(checkpoint):
-        LoadCheckpoint(station, context, checkpoint, configuration)
-        simulator.Initialize(InitializeParams(suppress_initialization_events=True))
-        resumed = context.get_time()
-    else:
-        simulator.Initialize()
-    report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
-    if resumed is not None and resumed >= duration:
-        return RunSummary(0.0, 0.0, report, finished_before=resumed)
-    if record:
-        station.visualizer.StartRecording()
-    counters = ActionCounters(station)
-    saved = [CompletedActions(counters, context)]
-
-    def Save(context) -> None:
-        SaveCheckpoint(station, context, checkpoint, configuration)
-
-    def AfterChunk(context):
-        done = CompletedActions(counters, context)
-        if checkpoint and done > saved[0]:
             Save(context)
-            saved[0] = done
-
-    start = time.perf_counter()
-    Advance(station, simulator, duration, progress=progress, after_chunk=AfterChunk)
-    if checkpoint:
-        Save(context)
-    wall = time.perf_counter() - start
-    recording = None
-    if record:
-        station.visualizer.StopRecording()
-        station.visualizer.PublishRecording()
-        path = pathlib.Path(record)
-        WriteTextAtomically(path, station.meshcat.StaticHtml())
-        recording = str(path.resolve())
-    report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
-    return RunSummary(
-        simulated_time=context.get_time() - (resumed or 0.0),
-        wall_time=wall,
-        safety=report,
-        recording=recording,
-        resumed_at=resumed,
-        outcome=RunOutcome(station, context),
-    )
+        wall = time.perf_counter() - start
+        recording = None
+        if record:
+            station.visualizer.StopRecording()
+            station.visualizer.PublishRecording()
+            path = pathlib.Path(record)
+            WriteTextAtomically(path, station.meshcat.StaticHtml())
+            recording = str(path.resolve())
+        report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
+        return RunSummary(
+            simulated_time=context.get_time() - (resumed or 0.0),
+            wall_time=wall,
+            safety=report,
+            recording=recording,
+            resumed_at=resumed,
+            outcome=RunOutcome(station, context),
+        )

@@ -53,8 +53,7 @@ def RequestPorts(systems) -> list[OutputPort]:
 def ApplyWorldEvents(station, root_context) -> None:
     """Applies the station's due scripted events and new requests to ``root_context``."""
     ledger = station.event_ledger
-    ledger_context = ledger.GetMyMutableContextFromRoot(root_context)
-    before = ledger.Counts(ledger_context)
+    before = ledger.Counts(ledger.GetMyContextFromRoot(root_context))
     counts = before.copy()
     scripted, now = station.scripted_events, root_context.get_time()
     while counts[0] < len(scripted) and scripted[int(counts[0])].time <= now:
@@ -65,8 +64,8 @@ def ApplyWorldEvents(station, root_context) -> None:
         for event in issued[int(counts[i]) :]:
             station.world.Apply(root_context, event)
         counts[i] = len(issued)
-    if np.any(counts != before):
-        ledger.SetCounts(ledger_context, counts)
+    if np.any(counts != before):  # (Most steps change nothing: no mutable context then.)
+        ledger.SetCounts(ledger.GetMyMutableContextFromRoot(root_context), counts)
 
 
 def MakeSimulator(station, config: SimulatorConfig | None = None) -> Simulator:

@@ -123,7 +123,6 @@ class LiveWorld:
                 SpatialInertia.SolidSphereWithMass(1.0, 0.01),
             )
             plant.WeldFrames(plant.world_frame(), self._holder.body_frame())
-        self._names: list[str] = []
 
     def Register(self, obj: schema.SceneObject) -> GeometryId:
         """Adds ``obj`` to the plant before it is finalized (the scenario's initial objects)."""
@@ -136,13 +135,21 @@ class LiveWorld:
         # The same geometry carries the proximity role while it is an obstacle.
         if obj.role == "obstacle":
             self._scene_graph.AssignRole(self._source_id, geometry_id, _ProximityProperties())
-        self._names.append(obj.name)
         return geometry_id
 
     @property
     def names(self) -> list[str]:
         """The objects the station was built with (a Context may have added or removed some)."""
-        return list(self._names)
+        inspector = self._scene_graph.model_inspector()
+        return [inspector.GetName(g) for g in self._ObjectIds(inspector)]
+
+    def _ObjectIds(self, inspector) -> list[GeometryId]:
+        """The world objects among the geometries ``inspector`` sees (they carry their role)."""
+        return [
+            g
+            for g in inspector.GetGeometries(self._FrameId(), Role.kIllustration)
+            if inspector.GetIllustrationProperties(g).HasProperty(_ROLE_GROUP, _ROLE_PROPERTY)
+        ]
 
     def _FrameId(self):
         return self._plant.GetBodyFrameIdOrThrow(self._holder.index())
@@ -156,17 +163,16 @@ class LiveWorld:
 
     def Objects(self, root_context) -> dict[str, tuple[GeometryId, str, Shape, RigidTransform]]:
         """Name -> (geometry id, role, shape, X_WO) of every object in ``root_context``."""
-        inspector, objects = self._Inspector(root_context), {}
-        for geometry_id in inspector.GetGeometries(self._FrameId(), Role.kIllustration):
-            properties = inspector.GetIllustrationProperties(geometry_id)
-            if properties.HasProperty(_ROLE_GROUP, _ROLE_PROPERTY):
-                objects[inspector.GetName(geometry_id)] = (
-                    geometry_id,
-                    properties.GetProperty(_ROLE_GROUP, _ROLE_PROPERTY),
-                    inspector.GetShape(geometry_id).Clone(),  # (outlives a removal)
-                    inspector.GetPoseInFrame(geometry_id),  # The frame is the world's.
-                )
-        return objects
+        inspector = self._Inspector(root_context)
+        return {
+            inspector.GetName(g): (
+                g,
+                inspector.GetIllustrationProperties(g).GetProperty(_ROLE_GROUP, _ROLE_PROPERTY),
+                inspector.GetShape(g).Clone(),  # (outlives a removal)
+                inspector.GetPoseInFrame(g),  # The frame is the world's.
+            )
+            for g in self._ObjectIds(inspector)
+        }
 
     def _Get(self, root_context, name: str) -> tuple:
         objects = self.Objects(root_context)
