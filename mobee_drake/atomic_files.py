@@ -21,18 +21,24 @@ import shutil
 import tempfile
 
 
-def WriteTextAtomically(path: str | pathlib.Path, text: str) -> None:
-    """Writes ``text`` to ``path`` through a staging file in the same folder."""
+def WriteFileAtomically(path: str | pathlib.Path, write) -> None:
+    """Writes ``path`` through a staging file in the same folder: ``write(staging)`` writes the
+    staging file (a path), which then replaces ``path``."""
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     handle, staging = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(handle)
     try:
-        with os.fdopen(handle, "w") as stream:
-            stream.write(text)
+        write(staging)
         os.replace(staging, path)
     except BaseException:
         pathlib.Path(staging).unlink(missing_ok=True)
         raise
+
+
+def WriteTextAtomically(path: str | pathlib.Path, text: str) -> None:
+    """Writes ``text`` to ``path`` (see :func:`WriteFileAtomically`)."""
+    WriteFileAtomically(path, lambda staging: pathlib.Path(staging).write_text(text))
 
 
 def StrictJson(data, **options) -> str:

@@ -7,7 +7,7 @@ import pathlib
 import sys
 
 import numpy as np
-from pydrake.geometry import Meshcat, StartMeshcat
+from pydrake.geometry import StartMeshcat
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
@@ -23,6 +23,7 @@ from mobee_drake.robots.model_cache import IcubModelNames
 from mobee_drake.scenario import BuildScenario, LoadScenario, ResumableConfiguration
 from mobee_drake.station.checkpoint import CheckpointError
 from mobee_drake.station.runner import RunStation
+from mobee_drake.station.viewer import RecordingMeshcat
 
 # Whether a user's mistake shows its traceback (``--debug``).
 _debug = False
@@ -44,14 +45,25 @@ def _Run(args: list[str]) -> None:
         description="Simulate a scenario: a file, or the name of a shipped one ("
         + ", ".join(ScenarioNames())
         + "). Headless by default: the run is recorded to results/<scenario>.html unless "
-        "--record or --no-record says otherwise; --meshcat serves the live view.",
+        "--record or --no-record says otherwise (Drake's Meshcat records through its server: "
+        "that one listens on localhost only, silently), its data log written to "
+        "results/<scenario>.log.parquet and its summary to results/<scenario>.summary.json; "
+        "--meshcat serves the live view.",
     )
     parser.add_argument("scenario", help="a scenario file or a shipped scenario's name")
     parser.add_argument(
         "--duration", type=PositiveFloat, help="seconds to simulate instead of the scenario's"
     )
     parser.add_argument("--record", help="save a replayable Meshcat recording to this HTML file")
-    parser.add_argument("--no-record", action="store_true", help="do not save a recording")
+    parser.add_argument(
+        "--no-record", action="store_true", help="do not save a recording (opens no port)"
+    )
+    parser.add_argument(
+        "--log",
+        help="write the data log (Parquet) to this file instead of beside the summary; "
+        "full force vectors with --set '{data_log: {full_forces: true}}'",
+    )
+    parser.add_argument("--no-log", action="store_true", help="keep no data log")
     parser.add_argument(
         "--meshcat", action="store_true", help="serve the live view in Meshcat and run in real time"
     )
@@ -77,23 +89,27 @@ def _Run(args: list[str]) -> None:
     overrides = list(known.set)
     if known.duration is not None:
         overrides.append(f"{{duration: {known.duration}}}")
+    if known.no_log:
+        overrides.append("{data_log: {enabled: false}}")
+    default_record = pathlib.Path("results") / (pathlib.Path(known.scenario).stem + ".html")
     record = None
     if not (known.no_record or known.no_meshcat):
-        record = known.record or str(
-            pathlib.Path("results") / (pathlib.Path(known.scenario).stem + ".html")
+        record = known.record or str(default_record)
+    # The summary and the log go beside the recording (or where it would be).
+    summary_file = pathlib.Path(record or default_record).with_suffix(".summary.json")
+    data_log = None
+    if not known.no_log:
+        data_log = known.log or str(
+            pathlib.Path(record or default_record).with_suffix(".log.parquet")
         )
-    # The summary's figures go beside the recording (or where it would be).
-    summary_file = pathlib.Path(
-        record or pathlib.Path("results") / (pathlib.Path(known.scenario).stem + ".html")
-    ).with_suffix(".summary.json")
-    for output in (record, known.graphviz, summary_file):  # Checked before the run, not after.
+    for output in (record, data_log, known.graphviz, summary_file):  # Checked before the run.
         if output and not CanWrite(output):
             _Fail(f"{output}: cannot be written (its folder is missing, read-only or full?)")
     meshcat = None
     if known.meshcat and not known.no_meshcat:
         meshcat = StartMeshcat()
-    elif record:
-        meshcat = Meshcat()
+    elif record:  # Only to record: reachable from this machine alone.
+        meshcat = RecordingMeshcat()
     # A user's mistakes surface while the scenario is read and built; the run's own errors are
     # bugs, and keep their traceback.
     try:
@@ -113,6 +129,7 @@ def _Run(args: list[str]) -> None:
             progress=True,
             checkpoint=known.checkpoint,
             configuration=ResumableConfiguration(scenario),
+            data_log=data_log,
         )
     except (FolderError, CheckpointError) as e:  # Raised before anything is simulated.
         _Fail(str(e))

@@ -26,9 +26,10 @@ from mobee_drake.planning.supervisor import ExploreAttractor
 from mobee_drake.resources import ResolveScenarioFile
 from mobee_drake.station.attractors import FixedAttractor, RandomAttractors, SliderAttractor
 from mobee_drake.station.builder import MakeMobeeStation, Station
-from mobee_drake.station.config import StationConfig, StationConfigErrors, Visualization
+from mobee_drake.station.config import DataLog, StationConfig, StationConfigErrors, Visualization
 from mobee_drake.station.executor import StateActionAttractor
 from mobee_drake.station.runner import RunStation, RunSummary
+from mobee_drake.station.viewer import RecordingMeshcat
 from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
 
 # The longest run a scenario may ask for (s; our choice: about 116 simulated days, far beyond any
@@ -98,11 +99,12 @@ def LoadScenario(
 def ResumableConfiguration(scenario: Scenario) -> str:
     """The configuration a checkpoint of ``scenario`` records and must match to be resumed:
     the package's version and the scenario, but for what may change between a run and its
-    resumption (the duration, the viewer, the simulator's pacing)."""
+    resumption (the duration, the viewer, the data log, the simulator's pacing)."""
     kept = dc.replace(
         scenario,
         duration=Scenario.duration,
         visualization=Visualization(),
+        data_log=DataLog(),
         simulator_config=SimulatorConfig(),
     )
     return f"mobee_drake_version: {__version__}\n" + yaml_dump_typed(kept)
@@ -122,12 +124,13 @@ def RunScenario(
     realtime_rate: float | None = None,
     progress: bool = False,
     checkpoint: str | None = None,
+    data_log: str | None = None,
 ) -> RunSummary:
     """Builds and runs ``scenario`` for its duration (see
     :func:`~mobee_drake.station.runner.RunStation`); ``record`` (an HTML file) records the run in
-    ``meshcat``, or in a Meshcat of its own."""
+    ``meshcat``, or in a Meshcat of its own; ``data_log`` (a Parquet file) receives its log."""
     if record and meshcat is None:
-        meshcat = Meshcat()
+        meshcat = RecordingMeshcat()
     return RunStation(
         BuildScenario(scenario, meshcat),
         scenario.duration,
@@ -137,4 +140,5 @@ def RunScenario(
         progress=progress,
         checkpoint=checkpoint,
         configuration=ResumableConfiguration(scenario),
+        data_log=data_log,
     )

@@ -238,7 +238,7 @@ class TestSupervisor(unittest.TestCase):
         self.assertEqual(record.state, 0)
         goal = space.action_goal[record.state_action]
         expected = np.array([0.5, *(np.array([0, 0]) + space.centres[goal] * [2, 4])])
-        np.testing.assert_allclose(dut.get_output_port().Eval(context), expected)
+        np.testing.assert_allclose(dut.GetOutputPort("attractor").Eval(context), expected)
         # Polling while the robot is still: the action ends 0.5 s after it started being still.
         times = [0.2, 0.4, 0.6, 0.8]
         done = []
@@ -293,7 +293,7 @@ class TestSupervisor(unittest.TestCase):
         (record,) = dut.Records(context)
         self.assertEqual((record.state, record.explorer.config.goal_state), (0, 2))
         self.assertEqual(space.action_goal[record.state_action], 2)
-        np.testing.assert_allclose(dut.get_output_port().Eval(context), space.centres[2])
+        np.testing.assert_allclose(dut.GetOutputPort("attractor").Eval(context), space.centres[2])
         self.assertFalse(record.arrived)
         # The goal it is in already: it has arrived and stays.
         dut.SetPlannerGoal(context, "arm", 0)

@@ -651,12 +651,26 @@ class TestRunner(unittest.TestCase):
         for scene_path in (
             "/drake/illustration/icub_iCubGazeboV2_5",
             "/drake/illustration/attractor",
-            "/drake/illustration/ball",
+            "/drake/world/ball/0",
             "/trail",
         ):
             self.assertTrue(meshcat.HasPath(scene_path), scene_path)
         self.assertAlmostEqual(summary.simulated_time, 1.0)
         self.assertIn("penetrations of solid geometry: 0", summary.Format())
+
+    def test_a_recording_keeps_at_most_its_frames(self):
+        """The frame rate is the viewer's, or lower for a run longer than the most frames."""
+        from pydrake.geometry import Meshcat
+
+        folder = pathlib.Path(tempfile.mkdtemp())
+        for duration, max_frames, rate in ((1.0, 3600, 30.0), (2.0, 10, 5.0)):
+            meshcat = Meshcat()
+            scenario = LoadScenario(
+                REACH,
+                f"{{duration: {duration}, visualization: {{max_recorded_frames: {max_frames}}}}}",
+            )
+            RunScenario(scenario, meshcat=meshcat, record=str(folder / "run.html"))
+            self.assertEqual(meshcat.get_mutable_recording().frames_per_second(), rate)
 
     def test_cli_run(self):
         import contextlib

@@ -13,10 +13,10 @@ Run: ``mobee-drake experiment trm --output DIR [--examples reach_into raise_a_gl
 import pathlib
 
 import numpy as np
-from pydrake.geometry import Meshcat
 
 from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
 from mobee_drake.experiments.plots import plt
+from mobee_drake.station.viewer import RecordingMeshcat
 from mobee_drake.trm.display import MarkerCloud, PathMotion, RecordMotion, ShowRoadmap
 from mobee_drake.trm.examples import EXAMPLES, OpenBox, TrmExample
 from mobee_drake.trm.roadmap import BuildTrm, TaskRelevantRoadmap, TrmConfig
@@ -69,7 +69,7 @@ def Plot(
 
 
 def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) -> str:
-    meshcat = Meshcat()
+    meshcat = RecordingMeshcat()
     example = EXAMPLES[name](meshcat)
     roadmap = BuildTrm(
         example.problem, example.task_space, example.q_init, config, np.random.default_rng(seed)

@@ -26,6 +26,11 @@ from mobee_drake.robots.overlay import MarkerStates, RobotOverlay
 FORCE_TERMS = ("spring", "damping", "f_lim", "f_cst", "f_coll", "f_config", "f_work")
 
 
+def _WithTotal(terms: np.ndarray) -> np.ndarray:
+    """The force terms (one row each) and their total, as one vector."""
+    return np.concatenate([terms.ravel(), terms.sum(axis=0)])
+
+
 class Mobee(LeafSystem):
     """MoBeE 2.0: the forces of the dynamical system that moves the robot (eq. 5.7).
 
@@ -49,6 +54,7 @@ class Mobee(LeafSystem):
         - f_config
         - f_work
         - total
+        - forces
         - marker_positions
         - marker_directions
         - marker_jacobians
@@ -67,7 +73,8 @@ class Mobee(LeafSystem):
     ``M q'' = total``):
 
     - ``spring`` = -L(K(q - q*)), ``damping`` = -C q', ``f_lim``, ``f_cst``, ``f_coll``,
-      ``f_config``, ``f_work``, and ``total``, their sum.
+      ``f_config``, ``f_work``, and ``total``, their sum; ``forces`` (8n) all eight, in that
+      order, for loggers.
     - ``marker_positions`` (3m) and ``marker_directions`` (3m): in world, marker after marker.
     - ``marker_jacobians`` (3mn): the translational Jacobians dp_WM/dq, marker after marker, each
       3 x n in row-major order (reshape with ``(m, 3, n)``).
@@ -188,6 +195,15 @@ class Mobee(LeafSystem):
             n,
             lambda context, output: output.SetFromVector(
                 self._forces_entry.Eval(context).sum(axis=0)
+            ),
+            prerequisites_of_calc={self._forces_entry.ticket()},
+        )
+        # Every term and the total in one vector (term-major), for loggers: one read, not eight.
+        self.DeclareVectorOutputPort(
+            "forces",
+            (len(FORCE_TERMS) + 1) * n,
+            lambda context, output: output.SetFromVector(
+                _WithTotal(self._forces_entry.Eval(context))
             ),
             prerequisites_of_calc={self._forces_entry.ticket()},
         )

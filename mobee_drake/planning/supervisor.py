@@ -78,6 +78,7 @@ class ExplorationSupervisor(LeafSystem):
         - robot_state
         output_ports:
         - attractor
+        - data_log
 
     ``robot_state`` is (q, v) of MoBeE's joints ``joints``; ``attractor`` is q* for the same joints.
     """
@@ -139,6 +140,32 @@ class ExplorationSupervisor(LeafSystem):
             self._CalcAttractor,
             prerequisites_of_calc={self.abstract_state_ticket(self._records)},
         )
+        # What the station's data log keeps of each agent (see DataLogColumns).
+        self.DeclareVectorOutputPort(
+            "data_log",
+            3 * len(self._agents),
+            lambda context, output: output.SetFromVector(
+                [
+                    x
+                    for r in self.Records(context)
+                    for x in (r.state, r.state_action, r.actions_done)
+                ]
+            ),
+            prerequisites_of_calc={self.abstract_state_ticket(self._records)},
+        )
+
+    def DataLogColumns(self) -> list[tuple[str, str]]:
+        """Per agent: the state its action started from, the state-action in flight, and the
+        actions it has completed (see :mod:`mobee_drake.station.data_log`)."""
+        return [
+            (f"agent.{agent.name}.{column}", unit)
+            for agent in self._agents
+            for column, unit in (
+                ("state", "index"),
+                ("state_action", "index"),
+                ("actions_done", "count"),
+            )
+        ]
 
     def _StateOf(self, agent: Agent, columns: np.ndarray, q: np.ndarray) -> int:
         return agent.space.StateOfConfiguration(
@@ -424,4 +451,4 @@ class ExploreAttractor:
             ),
         )
         parts.builder.Connect(parts.robot_state, supervisor.GetInputPort("robot_state"))
-        return ClientPorts(system=supervisor, attractor=supervisor.get_output_port())
+        return ClientPorts(system=supervisor, attractor=supervisor.GetOutputPort("attractor"))

@@ -50,6 +50,7 @@ from mobee_drake.robots.assembly import JointStateSelector
 from mobee_drake.robots.overlay import RobotOverlay
 from mobee_drake.robots.scenario_robot import AddScenarioRobot
 from mobee_drake.station.config import Dynamic, Kinematic, Mover, Reflex, StationConfig
+from mobee_drake.station.data_log import AddDataLog, DataLogger
 from mobee_drake.station.parts import ClientPorts, StationParts
 from mobee_drake.station.safety import SafetyMonitor
 from mobee_drake.station.viewer import AddViewer
@@ -91,6 +92,8 @@ class Station:
     client: LeafSystem | None = None
     meshcat: Meshcat | None = None
     visualizer: MeshcatVisualizer | None = None
+    # The run's data log (None: the scenario turned it off).
+    data_log: DataLogger | None = None
 
 
 def _AddMobee(
@@ -357,6 +360,7 @@ def MakeMobeeStation(
             plant=plant,
             scene_graph=scene_graph,
             mobee=mobee,
+            world=world,
             attractor=attractor,
             marker_forces=marker_forces,
         )
@@ -364,6 +368,21 @@ def MakeMobeeStation(
     event_ledger = builder.AddNamedSystem(
         "world_event_ledger", WorldEventLedger(num_request_ports=len(request_ports))
     )
+    scripted_events = sorted(config.world_events, key=lambda e: e.time)
+    data_log = None
+    if config.data_log.enabled:
+        data_log = AddDataLog(
+            builder,
+            config=config.data_log,
+            time_step=config.time_step,
+            mobee=mobee,
+            robot_state=robot_state,
+            attractor=attractor,
+            event_counts=event_ledger.GetOutputPort("counts"),
+            scripted_events=scripted_events,
+            request_ports=request_ports,
+            client=client.system if client is not None else None,
+        )
 
     builder.ExportOutput(robot_state, "robot_state")
     builder.ExportOutput(attractor, "attractor")
@@ -383,10 +402,11 @@ def MakeMobeeStation(
         monitor=monitor,
         robot_state=diagram.GetOutputPort("robot_state"),
         attractor=diagram.GetOutputPort("attractor"),
-        scripted_events=sorted(config.world_events, key=lambda e: e.time),
+        scripted_events=scripted_events,
         request_ports=request_ports,
         event_ledger=event_ledger,
         client=client.system if client is not None else None,
         meshcat=meshcat,
         visualizer=visualizer,
+        data_log=data_log,
     )

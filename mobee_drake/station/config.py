@@ -102,6 +102,25 @@ class Visualization:
     trail_marker: str = "r_palm"
     # Draw the attractor as a translucent second robot.
     show_attractor: bool = True
+    # Frames per second of the viewer and of a recording, and the most frames a recording keeps
+    # (a longer run is recorded at a lower rate), which bounds its size.
+    frame_rate: float = 30.0
+    max_recorded_frames: int = 3600
+    # The default camera (world, m): in front of the iCub (which faces -x), a little to its
+    # right and above, looking at its hands' workspace.
+    camera_position: list[float] = dc.field(default_factory=lambda: [-1.4, -0.7, 0.5])
+    camera_target: list[float] = dc.field(default_factory=lambda: [-0.2, 0.0, 0.0])
+
+
+@dc.dataclass
+class DataLog:
+    """What the run's data log keeps (see :mod:`mobee_drake.station.data_log`)."""
+
+    enabled: bool = True
+    # Seconds between rows (0: every control period).
+    period: float = 0.0
+    # Each force term of eq. 5.7 per joint (True), or only its norm (False).
+    full_forces: bool = False
 
 
 @dc.dataclass
@@ -121,6 +140,7 @@ class StationConfig:
     # Scripted changes of the world.
     world_events: list[WorldEvent] = dc.field(default_factory=list)
     visualization: Visualization = dc.field(default_factory=Visualization)
+    data_log: DataLog = dc.field(default_factory=DataLog)
     # Seeds every generator of a run: random attractors, exploring agents, companions.
     random_seed: int = 0
 
@@ -146,6 +166,20 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
         errors.append("reflex: speed_deg and tolerance_deg must be finite and > 0, history >= 2")
     if not (math.isfinite(config.time_step) and 0 < config.time_step <= MAX_TIME_STEP):
         errors.append(f"time_step must be > 0 and <= {MAX_TIME_STEP} s, got {config.time_step}")
+    shown, log = config.visualization, config.data_log
+    if not (math.isfinite(shown.frame_rate) and shown.frame_rate > 0):
+        errors.append(f"visualization frame_rate must be > 0, got {shown.frame_rate}")
+    if not (
+        len(shown.camera_position) == len(shown.camera_target) == 3
+        and _Finite(shown.camera_position + shown.camera_target)
+    ):
+        errors.append("visualization camera_position and camera_target need three finite numbers")
+    if shown.max_recorded_frames < 1:
+        errors.append(
+            f"visualization max_recorded_frames must be >= 1, got {shown.max_recorded_frames}"
+        )
+    if not (math.isfinite(log.period) and log.period >= 0):
+        errors.append(f"data_log period must be >= 0 s (0: every control period), got {log.period}")
     names = set()
     for obj in config.objects:
         if not obj.name or obj.name in names:

@@ -67,6 +67,7 @@ class StateActionExecutor(LeafSystem):
         output_ports:
         - attractor
         - marker_forces
+        - data_log
 
     ``robot_state`` is (q, v) of MoBeE's n joints, ``marker_positions`` MoBeE's output of the same
     name (3m), ``field_pairs`` MoBeE's :class:`FieldPairs`; ``attractor`` is q* (n),
@@ -134,6 +135,21 @@ class StateActionExecutor(LeafSystem):
                 self._markers_port.ticket(),
             },
         )
+
+        # What the station's data log keeps (see DataLogColumns).
+        self.DeclareVectorOutputPort(
+            "data_log",
+            2,
+            lambda context, output: output.SetFromVector(
+                self._Vector(context)[[self._PHASE, self._FINISHED]]
+            ),
+            prerequisites_of_calc={self.discrete_state_ticket(self._state)},
+        )
+
+    def DataLogColumns(self) -> list[tuple[str, str]]:
+        """The phase of the action in flight (a :class:`Phase`) and the actions finished (see
+        :mod:`mobee_drake.station.data_log`)."""
+        return [("executor.phase", "Phase"), ("executor.finished_actions", "count")]
 
     def _Vector(self, context) -> np.ndarray:
         return context.get_discrete_state(self._state).value()

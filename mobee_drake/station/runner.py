@@ -24,6 +24,7 @@ class RunSummary:
     wall_time: float
     safety: SafetyReport
     recording: str | None = None
+    data_log: str | None = None
     # Where a resumed run started (s), and, for a run its checkpoint had finished, where it was.
     resumed_at: float | None = None
     finished_before: float | None = None
@@ -63,6 +64,8 @@ class RunSummary:
             lines += [f"  {line}" for line in _Lines(figures)]
         if self.recording:
             lines.append(f"recording: {self.recording}")
+        if self.data_log:
+            lines.append(f"data log: {self.data_log}")
         return "\n".join(lines)
 
 
@@ -132,6 +135,14 @@ def CompletedActions(counters: list, context) -> int:
     return sum(c.CompletedActions(c.GetMyContextFromRoot(context)) for c in counters)
 
 
+def _StartRecording(station: Station, duration: float) -> None:
+    """Records at the viewer's frame rate, or at the lower one that keeps ``duration`` within
+    the most frames a recording may keep (frames between two recorded ones are dropped)."""
+    shown = station.config.visualization
+    rate = min(shown.frame_rate, shown.max_recorded_frames / max(duration, 1e-9))
+    station.meshcat.StartRecording(frames_per_second=rate, set_visualizations_while_recording=True)
+
+
 def RunStation(
     station: Station,
     duration: float,
@@ -142,10 +153,14 @@ def RunStation(
     progress: bool = False,
     checkpoint: str | None = None,
     configuration: str = "",
+    data_log: str | None = None,
 ) -> RunSummary:
     """Runs ``station`` until ``duration`` with Drake's ``simulator_config`` (``realtime_rate``,
     if given, overrides its target real-time rate); with ``record`` saves its Meshcat recording
-    (HTML; the station must have been built with Meshcat).
+    (HTML; the station must have been built with Meshcat) at the viewer's frame rate, or at the
+    lower rate that keeps it within ``max_recorded_frames``; with ``data_log`` (a Parquet file)
+    writes the station's data log (see :mod:`mobee_drake.station.data_log`; a resumed run keeps
+    the file's rows from before it resumed).
 
     With ``checkpoint`` (a folder: new, empty or one of our checkpoints, and held by this run
     alone; see :mod:`mobee_drake.owned_folders`), a run resumes from the checkpoint there if
@@ -163,15 +178,13 @@ def RunStation(
         resumed = None
         if checkpoint and HasCheckpoint(checkpoint):
             LoadCheckpoint(station, context, checkpoint, configuration)
-            simulator.Initialize(InitializeParams(suppress_initialization_events=True))
             resumed = context.get_time()
-        else:
-            simulator.Initialize()
-        report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
         if resumed is not None and resumed >= duration:
+            report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
             return RunSummary(0.0, 0.0, report, finished_before=resumed)
-        if record:
-            station.visualizer.StartRecording()
+        if record:  # (Before the initialization's drawing, which the recording keeps.)
+            _StartRecording(station, duration - (resumed or 0.0))
+        simulator.Initialize(InitializeParams(suppress_initialization_events=resumed is not None))
         counters = ActionCounters(station)
         saved = [CompletedActions(counters, context)]
 
@@ -191,17 +204,22 @@ def RunStation(
         wall = time.perf_counter() - start
         recording = None
         if record:
-            station.visualizer.StopRecording()
-            station.visualizer.PublishRecording()
+            station.meshcat.StopRecording()
+            station.meshcat.PublishRecording()
             path = pathlib.Path(record)
             WriteTextAtomically(path, station.meshcat.StaticHtml())
             recording = str(path.resolve())
+        written_log = None
+        if data_log and station.data_log is not None:
+            station.data_log.Write(data_log, context, resumed_at=resumed)
+            written_log = str(pathlib.Path(data_log).resolve())
         report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
         return RunSummary(
             simulated_time=context.get_time() - (resumed or 0.0),
             wall_time=wall,
             safety=report,
             recording=recording,
+            data_log=written_log,
             resumed_at=resumed,
             outcome=RunOutcome(station, context),
         )

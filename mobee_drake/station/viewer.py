@@ -5,8 +5,10 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.geometry import (
     Meshcat,
+    MeshcatParams,
     MeshcatVisualizer,
     MeshcatVisualizerParams,
+    QueryObject,
     Rgba,
     Role,
     SceneGraph,
@@ -22,6 +24,7 @@ from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.assembly import FreezeJoints, JointStateSelector
 from mobee_drake.robots.scenario_robot import RobotModelText
 from mobee_drake.station.config import StationConfig
+from mobee_drake.world.live_world import ROLE_COLORS, LiveWorld
 
 ATTRACTOR_ALPHA = 0.25
 TRAIL_COLOR = Rgba(0.9, 0.2, 0.2, 1.0)
@@ -30,6 +33,12 @@ MARKER_FORCE_COLOR = Rgba(0.85, 0.0, 0.85, 1.0)
 MARKER_ARROW_LENGTH_PER_FORCE = 0.01
 # Length of a drawn contact force per metre of field penetration (a full 3 cm field: 15 cm).
 ARROW_LENGTH_PER_PENETRATION = 5.0
+
+
+def RecordingMeshcat() -> Meshcat:
+    """A Meshcat only to record in: Drake's Meshcat records through its server, so it listens,
+    but on this machine's loopback only (and, at the default logging level, says nothing)."""
+    return Meshcat(MeshcatParams(host="localhost"))
 
 
 class ForceDrawer(LeafSystem):
@@ -131,6 +140,52 @@ class TrailDrawer(LeafSystem):
         self._meshcat.SetLine(self._path, points.T, 3.0, TRAIL_COLOR)
 
 
+class WorldDrawer(LeafSystem):
+    """Draws the world's objects in Meshcat, under ``/drake/world``: each state an object is seen in
+    (its role, shape and pose) at a path of its own, shown while the object is in that state.
+
+    So a recording shows every world event at its time: a ball made a ghost at 6 s is solid
+    until 6 s, then translucent (Drake's illustration visualizer replaces a changed geometry, so
+    its recording shows the last state all along; the objects carry their role in perception
+    properties, which it does not draw). Which paths exist and which is shown is Meshcat's
+    bookkeeping, kept here as MeshcatVisualizer keeps its own: drawing changes nothing in the
+    simulation.
+    """
+
+    def __init__(self, *, meshcat: Meshcat, world: LiveWorld, period: float):
+        super().__init__()
+        self._meshcat, self._world = meshcat, world
+        self._query_port = self.DeclareAbstractInputPort(
+            "geometry_query", AbstractValue.Make(QueryObject())
+        )
+        self._paths: dict[tuple, str] = {}  # (name, role, shape, pose) -> its path
+        self._shown: dict[str, bool] = {}  # path -> whether it is shown
+        self.DeclareInitializationPublishEvent(self._Draw)
+        self.DeclarePeriodicPublishEvent(period_sec=period, offset_sec=0.0, publish=self._Draw)
+        self.DeclareForcedPublishEvent(self._Draw)
+
+    def _Draw(self, context) -> None:
+        objects = self._world.ObjectsSeenBy(self._query_port.Eval(context).inspector())
+        now, time = set(), context.get_time()
+        for name, (_, role, shape, X_WO) in objects.items():
+            key = (name, role, repr(shape), X_WO.GetAsMatrix34().tobytes())
+            path = self._paths.get(key)
+            if path is None:
+                path = f"world/{name}/{sum(k[0] == name for k in self._paths)}"
+                self._paths[key] = path
+                self._meshcat.SetObject(path, shape, Rgba(*ROLE_COLORS[role]))
+                self._meshcat.SetTransform(path, X_WO)
+                # Hidden in a recording until now (a recording without a frame at its start
+                # would show its first keyframe's value all along).
+                self._meshcat.SetProperty(path, "visible", False, 0.0)
+                self._shown[path] = False
+            now.add(path)
+        for path, shown in self._shown.items():
+            if (path in now) != shown:
+                self._meshcat.SetProperty(path, "visible", path in now, time)
+                self._shown[path] = path in now
+
+
 def _AddAttractorRobot(
     builder: DiagramBuilder,
     config: StationConfig,
@@ -169,6 +224,7 @@ def AddViewer(
     plant: MultibodyPlant,
     scene_graph: SceneGraph,
     mobee: Mobee,
+    world: LiveWorld,
     attractor: OutputPort,
     marker_forces: OutputPort | str | None = None,
 ) -> MeshcatVisualizer:
@@ -180,18 +236,27 @@ def AddViewer(
     settings = config.visualization
     if settings.show_attractor:
         _AddAttractorRobot(builder, config, scene_graph, mobee, attractor)
+    period = 1.0 / settings.frame_rate
     visualizer = MeshcatVisualizer.AddToBuilder(
         builder,
         scene_graph,
         meshcat,
-        MeshcatVisualizerParams(role=Role.kIllustration, prefix="illustration"),
+        MeshcatVisualizerParams(
+            publish_period=period, role=Role.kIllustration, prefix="illustration"
+        ),
     )
+    world_drawer = builder.AddNamedSystem(
+        "world_drawer", WorldDrawer(meshcat=meshcat, world=world, period=period)
+    )
+    builder.Connect(scene_graph.get_query_output_port(), world_drawer.get_input_port())
+    meshcat.SetCameraPose(settings.camera_position, settings.camera_target)
     # MoBeE's primitives, hidden by default (toggle "collision" in Meshcat's controls).
     MeshcatVisualizer.AddToBuilder(
         builder,
         scene_graph,
         meshcat,
         MeshcatVisualizerParams(
+            publish_period=period,
             role=Role.kProximity,
             prefix="collision",
             default_color=Rgba(0.2, 0.5, 0.9, 0.4),

@@ -28,12 +28,17 @@ class WorldEventLedger(LeafSystem):
 
         name: WorldEventLedger
 
-    It has no ports and no events: :func:`ApplyWorldEvents` keeps its state.
+        output_ports:
+        - counts
+
+    It has no events: :func:`ApplyWorldEvents` keeps its state; ``counts`` is that state (the
+    data log reads when each event was applied from it).
     """
 
     def __init__(self, *, num_request_ports: int):
         super().__init__()
         self._counts = self.DeclareDiscreteState(BasicVector(np.zeros(1 + num_request_ports)))
+        self.DeclareStateOutputPort("counts", self._counts)
 
     def Counts(self, context) -> np.ndarray:
         """(scripted events applied, requests applied per port), in this system's ``context``."""

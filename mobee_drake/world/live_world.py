@@ -16,8 +16,13 @@ removed and reshaped and its roles assigned and removed. We use exactly that:
 - its *role* decides what the rest of the system sees: an **obstacle** has the proximity role
   (MoBeE repels the robot from it and the dynamic robot collides with it) and is drawn solid; a
   **target** and a **ghost** have no proximity role (MoBeE ignores them, the palm may touch a
-  target), the target drawn green, the ghost translucent. The role is also written into the
-  object's illustration properties (group ``mobee_world``), so that it can be read back;
+  target), the target drawn green, the ghost translucent. The role and its colour are written
+  into the object's *perception* properties (group ``mobee_world``), so that they can be read
+  back. Perception, not illustration: no renderer is registered, and the station's viewer draws
+  the objects itself, each world it has seen at its own path (see
+  :class:`~mobee_drake.station.viewer.WorldDrawer`), so that a recording shows every world event
+  at its time (Drake's illustration visualizer replaces a changed geometry for the whole
+  recording);
 - :class:`LiveWorld` holds no state: names, ids, roles, shapes and poses are read from the
   Context's SceneGraph inspector, so two contexts of one diagram hold two worlds, a cloned Context
   clones its world, and a checkpoint saves :meth:`LiveWorld.Snapshot`.
@@ -34,11 +39,10 @@ from pydrake.geometry import (
     Cylinder,
     GeometryId,
     GeometryInstance,
-    IllustrationProperties,
-    MakePhongIllustrationProperties,
+    PerceptionProperties,
     ProximityProperties,
+    Rgba,
     Role,
-    RoleAssign,
     SceneGraph,
     Shape,
     Sphere,
@@ -54,7 +58,7 @@ ROLE_COLORS = {
     "target": np.array([0.20, 0.75, 0.30, 0.9]),
     "ghost": np.array([0.60, 0.60, 0.90, 0.25]),
 }
-# The illustration property that names a world object's role.
+# The perception property that names a world object's role.
 _ROLE_GROUP, _ROLE_PROPERTY = "mobee_world", "role"
 
 
@@ -93,8 +97,9 @@ def _ProximityProperties() -> ProximityProperties:
     return properties
 
 
-def _IllustrationProperties(role: str) -> IllustrationProperties:
-    properties = MakePhongIllustrationProperties(ROLE_COLORS[role])
+def _RoleProperties(role: str) -> PerceptionProperties:
+    properties = PerceptionProperties()
+    properties.AddProperty("phong", "diffuse", Rgba(*ROLE_COLORS[role]))
     properties.AddProperty(_ROLE_GROUP, _ROLE_PROPERTY, role)
     return properties
 
@@ -130,7 +135,7 @@ class LiveWorld:
         instance = GeometryInstance(
             ObjectPose(obj.position, obj.rpy_deg), MakeShape(obj.shape), obj.name
         )
-        instance.set_illustration_properties(_IllustrationProperties(obj.role))
+        instance.set_perception_properties(_RoleProperties(obj.role))
         geometry_id = self._plant.RegisterVisualGeometry(self._holder, instance)
         # The same geometry carries the proximity role while it is an obstacle.
         if obj.role == "obstacle":
@@ -147,8 +152,8 @@ class LiveWorld:
         """The world objects among the geometries ``inspector`` sees (they carry their role)."""
         return [
             g
-            for g in inspector.GetGeometries(self._FrameId(), Role.kIllustration)
-            if inspector.GetIllustrationProperties(g).HasProperty(_ROLE_GROUP, _ROLE_PROPERTY)
+            for g in inspector.GetGeometries(self._FrameId(), Role.kPerception)
+            if inspector.GetPerceptionProperties(g).HasProperty(_ROLE_GROUP, _ROLE_PROPERTY)
         ]
 
     def _FrameId(self):
@@ -163,11 +168,14 @@ class LiveWorld:
 
     def Objects(self, root_context) -> dict[str, tuple[GeometryId, str, Shape, RigidTransform]]:
         """Name -> (geometry id, role, shape, X_WO) of every object in ``root_context``."""
-        inspector = self._Inspector(root_context)
+        return self.ObjectsSeenBy(self._Inspector(root_context))
+
+    def ObjectsSeenBy(self, inspector) -> dict[str, tuple[GeometryId, str, Shape, RigidTransform]]:
+        """The same, in the world of a SceneGraph ``inspector`` (a query object's)."""
         return {
             inspector.GetName(g): (
                 g,
-                inspector.GetIllustrationProperties(g).GetProperty(_ROLE_GROUP, _ROLE_PROPERTY),
+                inspector.GetPerceptionProperties(g).GetProperty(_ROLE_GROUP, _ROLE_PROPERTY),
                 inspector.GetShape(g).Clone(),  # (outlives a removal)
                 inspector.GetPoseInFrame(g),  # The frame is the world's.
             )
@@ -212,7 +220,7 @@ class LiveWorld:
                 "the scenario's objects, as a ghost if it should appear later"
             )
         instance = GeometryInstance(X_WO, shape, name)
-        instance.set_illustration_properties(_IllustrationProperties(role))
+        instance.set_perception_properties(_RoleProperties(role))
         if role == "obstacle":
             instance.set_proximity_properties(_ProximityProperties())
         self._scene_graph.RegisterGeometry(
@@ -255,13 +263,9 @@ class LiveWorld:
             self._scene_graph.AssignRole(
                 context, self._source_id, geometry_id, _ProximityProperties()
             )
-        self._scene_graph.AssignRole(
-            context,
-            self._source_id,
-            geometry_id,
-            _IllustrationProperties(role),
-            RoleAssign.kReplace,
-        )
+        # (SceneGraph replaces no perception properties in place: removed, then assigned.)
+        self._scene_graph.RemoveRole(context, self._source_id, geometry_id, Role.kPerception)
+        self._scene_graph.AssignRole(context, self._source_id, geometry_id, _RoleProperties(role))
 
     def Apply(self, root_context, event: schema.WorldEvent) -> None:
         """Applies a world event."""
