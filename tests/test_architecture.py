@@ -14,6 +14,8 @@ import zipfile
 
 import grimp
 
+from mobee_drake import cli
+
 PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "mobee_drake"
 ROOT = PACKAGE.parent
 
@@ -108,14 +110,26 @@ class TestReadme(unittest.TestCase):
         self.assertIn("mobee-drake run", commands[0])
         self.assertIn("pytest", commands[1])
 
-    def test_the_client_example_runs(self):
+    @staticmethod
+    def _Example(containing: str) -> str:
+        """The README's Python example that contains ``containing`` (unindented)."""
         text = (ROOT / "README.md").read_text()
-        code = text.split("```python\n", 1)[1].split("```", 1)[0]
-        code = "\n".join(line[2:] if line.startswith("  ") else line for line in code.splitlines())
+        blocks = [block.split("```", 1)[0] for block in text.split("```python\n")[1:]]
+        (code,) = [block for block in blocks if containing in block]
+        return "\n".join(line[2:] if line.startswith("  ") else line for line in code.splitlines())
+
+    def test_the_client_example_runs(self):
         printed = io.StringIO()
         with contextlib.redirect_stdout(printed):
-            exec(compile(code, "README.md", "exec"), {})
+            exec(compile(self._Example("class BendElbow"), "README.md", "exec"), {})
         self.assertIn("[", printed.getvalue())  # the robot's state
+
+    def test_the_data_log_example_plots_the_main_job(self):
+        folder = pathlib.Path(tempfile.mkdtemp())
+        with contextlib.chdir(folder), contextlib.redirect_stdout(io.StringIO()):
+            cli.main(["run", "reach_around_ball", "--no-record"])
+            exec(compile(self._Example("read_parquet"), "README.md", "exec"), {})
+        self.assertGreater((folder / "results" / "palm_to_ball.png").stat().st_size, 10_000)
 
 
 class TestRelease(unittest.TestCase):

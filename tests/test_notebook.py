@@ -1,0 +1,33 @@
+"""The example notebook runs from start to end (so it cannot rot)."""
+
+import os
+import pathlib
+import unittest
+from unittest import mock
+
+import nbclient
+import nbformat
+
+NOTEBOOK = pathlib.Path(__file__).parents[1] / "examples" / "first_steps.ipynb"
+
+
+class TestNotebook(unittest.TestCase):
+    def test_first_steps_runs_and_plots(self):
+        notebook = nbformat.read(NOTEBOOK, as_version=4)
+        # The kernel draws inline, as in Jupyter (the suite's MPLBACKEND=Agg would hide plots).
+        with mock.patch.dict(os.environ):
+            os.environ.pop("MPLBACKEND", None)
+            nbclient.NotebookClient(notebook, timeout=300, kernel_name="python3").execute(
+                cwd=str(NOTEBOOK.parent)
+            )
+        outputs = [o for cell in notebook.cells for o in cell.get("outputs", [])]
+        self.assertFalse([o for o in outputs if o.output_type == "error"])
+        text = "".join(o.get("text", "") for o in outputs if o.output_type == "stream")
+        self.assertIn("closest approach:", text)
+        self.assertIn("rows: 601", text)  # 6 s at 10 ms, both ends
+        images = [o for o in outputs if "image/png" in o.get("data", {})]
+        self.assertEqual(len(images), 1)  # the plot
+
+
+if __name__ == "__main__":
+    unittest.main()

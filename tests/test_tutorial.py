@@ -1,0 +1,30 @@
+"""The tutorial's Python examples run as written, in order, after its first command."""
+
+import contextlib
+import io
+import pathlib
+import tempfile
+import unittest
+
+from mobee_drake import cli
+
+TUTORIAL = pathlib.Path(__file__).parents[1] / "docs" / "tutorial.md"
+
+
+class TestTutorial(unittest.TestCase):
+    def test_the_examples_run(self):
+        text = TUTORIAL.read_text()
+        blocks = [block.split("```", 1)[0] for block in text.split("```python\n")[1:]]
+        self.assertEqual(len(blocks), 3)
+        printed = io.StringIO()
+        with contextlib.chdir(tempfile.mkdtemp()), contextlib.redirect_stdout(printed):
+            cli.main(["run", "reach_around_ball", "--no-record"])
+            for block in blocks:
+                exec(compile(block, str(TUTORIAL), "exec"), {})
+        text = printed.getvalue()
+        self.assertIn("closest 4.7 cm", text)  # the palm marker's centre, as section 2 says
+        self.assertIn("right_arm", text)  # the agent with the strategy of section 5
+
+
+if __name__ == "__main__":
+    unittest.main()
