@@ -4,9 +4,11 @@
 import contextlib
 import io
 import logging
+import pathlib
 import re
 import subprocess
 import sys
+import tempfile
 import unittest
 
 from mobee_drake import cli
@@ -105,6 +107,26 @@ class TestProgressInLogs(unittest.TestCase):
         self.assertNotIn("\r", done.stderr)
         self.assertNotIn("\x1b", done.stderr)
         self.assertIn("simulated: 2/2 s", done.stderr)
+
+
+class TestHeadlessRun(unittest.TestCase):
+    def test_a_recorded_run_says_nothing_of_meshcat_and_leaves_its_three_files(self):
+        folder = pathlib.Path(tempfile.mkdtemp())
+        done = subprocess.run(
+            [sys.executable, "-m", "mobee_drake.cli", "run", "reach_around_ball",
+             "--duration", "0.5"],
+            capture_output=True,
+            text=True,
+            check=True,
+            cwd=folder,
+        )  # fmt: skip
+        for stream in (done.stdout, done.stderr):
+            self.assertNotIn("Meshcat", stream)
+            self.assertNotIn("http", stream)
+        for name in ("reach_around_ball.html", "reach_around_ball.log.parquet"):
+            self.assertIn(name, done.stdout)
+            self.assertGreater((folder / "results" / name).stat().st_size, 0)
+        self.assertTrue((folder / "results" / "reach_around_ball.summary.json").exists())
 
 
 if __name__ == "__main__":

@@ -1,6 +1,8 @@
 """Meshcat: the robot and its world, the attractor as a translucent robot, the trail of a marker,
 and MoBeE's workspace forces: field forces at witness points, client forces at markers."""
 
+import logging
+
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.geometry import (
@@ -37,8 +39,14 @@ ARROW_LENGTH_PER_PENETRATION = 5.0
 
 def RecordingMeshcat() -> Meshcat:
     """A Meshcat only to record in: Drake's Meshcat records through its server, so it listens,
-    but on this machine's loopback only (and, at the default logging level, says nothing)."""
-    return Meshcat(MeshcatParams(host="localhost"))
+    but on this machine's loopback only, and says nothing of it (no one is to connect)."""
+    drake_logger = logging.getLogger("drake")
+    level = drake_logger.level
+    drake_logger.setLevel(logging.WARNING)
+    try:
+        return Meshcat(MeshcatParams(host="localhost"))
+    finally:
+        drake_logger.setLevel(level)
 
 
 class ForceDrawer(LeafSystem):
