@@ -56,7 +56,7 @@ from mobee_drake.experiments.exploration import (
     Misses,
     StartExploration,
 )
-from mobee_drake.experiments.plots import StackedBars, plt
+from mobee_drake.experiments.plots import Figure, Legend, SaveFigure, StackedBars, plt
 from mobee_drake.mobee.constraints import ClauseSet
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
 from mobee_drake.planning.planner import GreedyPlan
@@ -496,20 +496,163 @@ def _ConstraintClearances(centres: np.ndarray) -> np.ndarray:
     )
 
 
-def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
+COVERAGE_STATE_ACTIONS = 1296  # 7.2: 81 states x 16 nearest neighbours
+TRIES = "tries [count]"
+VALUE = "value V(s, a) [nats]"  # expected discounted KL reward (Alg. 6)
+STATE_ACTION = "state-action [index]"
 
+
+def HypercubeFigure(results: list[dict]) -> Figure:
+    """Fig. 7.2-7.3 on the hypercube: tries and values per state-action after 320 actions, one
+    column per gamma, the runs stacked."""
+    gammas = sorted({r["gamma"] for r in results})
+    figure, axes = plt.subplots(2, len(gammas), figsize=(6 * len(gammas), 6.5), squeeze=False)
+    for column, gamma in enumerate(gammas):
+        mine = [r for r in results if r["gamma"] == gamma]
+        for row, (key, unit) in enumerate((("tries", TRIES), ("values", VALUE))):
+            axis = axes[row, column]
+            StackedBars(
+                axis,
+                np.array([r["snapshots"]["320"][key] for r in mine]),
+                [f"run {r['run']}" for r in mine],
+            )
+            axis.set(
+                xlabel=STATE_ACTION,
+                ylabel=f"{unit}, runs stacked",
+                title=f"gamma {gamma}: {key} after 320 actions, {len(mine)} runs",
+            )
+    figure.suptitle("7.1, the right arm's hypercube (cf. Fig. 7.2-7.3)")
+    return figure
+
+
+def CoverageFigure(results: list[dict]) -> Figure:
+    """Fig. 7.5: state-actions tried against transitions, one line per run."""
+    figure, axis = plt.subplots(figsize=(8, 4))
+    for strategy, colour in zip(
+        ("curious", "random", "least_tried"), ("tab:green", "tab:red", "tab:blue")
+    ):
+        for r in [r for r in results if r["strategy"] == strategy]:
+            coverage = np.array(r["coverage"])
+            axis.plot(
+                coverage[:, 0],
+                coverage[:, 1],
+                color=colour,
+                label=strategy if r["run"] == 0 else None,
+            )
+    axis.axhline(COVERAGE_STATE_ACTIONS, color="0.5", linestyle=":", label="all state-actions")
+    runs = len({r["run"] for r in results})
+    axis.set(
+        xlabel="transitions [count]",
+        ylabel=f"state-actions tried [count, of {COVERAGE_STATE_ACTIONS}]",
+        title=f"7.2, coverage of the rank-3 lattice (16 nearest neighbours), {runs} runs "
+        "per strategy (cf. Fig. 7.5)",
+    )
+    Legend(axis, title="strategy (one line per run)")
+    return figure
+
+
+def Rank4Figure(r: dict, space: Lattice, never: np.ndarray) -> Figure:
+    """Fig. 7.8-7.9 on a rank-4 lattice: tries and values per state-action, coloured by their
+    outcomes, and the actions taken from each state, the states never entered shaded."""
+    tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
+    outcomes = {
+        "several outcomes (>= 3 tries)": ("tab:red", (misses > 0) & (misses < 1) & (tries >= 3)),
+        "never reaches its goal (>= 3 tries)": ("tab:orange", (misses == 1) & (tries >= 3)),
+    }
+    colours = np.full(len(tries), "tab:blue", dtype=object)
+    for colour, chosen in outcomes.values():
+        colours[chosen] = colour
+    legend = {label: colour for label, (colour, _) in outcomes.items()}
+    legend["reaches its goal, or tried < 3 times"] = "tab:blue"
+    figure, axes = plt.subplots(3, 1, figsize=(13, 9))
+    caption = f"{r['lattice']} % lattice after {r['actions'][0]} actions"
+    for axis, heights, unit, what in (
+        (axes[0], tries, TRIES, "tries"),
+        (axes[1], r["values"][0], VALUE, "value"),
+    ):
+        axis.bar(np.arange(len(tries)), heights, width=1.0, color=colours)
+        axis.set(xlabel=STATE_ACTION, ylabel=unit, title=f"{caption}: {what} per state-action")
+        Legend(axis, legend)
+    visits = np.bincount(space.action_state, weights=tries, minlength=space.num_states)
+    axes[2].bar(np.arange(space.num_states), visits, width=1.0, label="actions from the state")
+    for state in never:
+        axes[2].axvspan(state - 0.5, state + 0.5, color="grey", alpha=0.4)
+    axes[2].set(
+        xlabel="state [index]",
+        ylabel="actions taken [count]",
+        title=f"{caption}: actions taken from each state",
+    )
+    Legend(axes[2], {"never entered": ("grey", 0.4)})
+    return figure
+
+
+def InitializationFigure(results: list[dict], initialization: str) -> Figure:
+    """Fig. 7.6-7.7: tries and values per state-action after every state-action was tried 5
+    times, one pair of rows per gamma, the runs stacked."""
+    mine = [r for r in results if r["initialization"] == initialization]
+    gammas = sorted({r["gamma"] for r in mine})
+    figure, axes = plt.subplots(2 * len(gammas), 1, figsize=(13, 5.2 * len(gammas)), squeeze=False)
+    for row, gamma in enumerate(gammas):
+        runs = [r for r in mine if r["gamma"] == gamma]
+        for offset, (key, unit) in enumerate((("tries", TRIES), ("values", VALUE))):
+            axis = axes[2 * row + offset, 0]
+            StackedBars(
+                axis, np.array([r[key][0] for r in runs]), [f"run {r['run']}" for r in runs]
+            )
+            axis.set(
+                xlabel=STATE_ACTION,
+                ylabel=f"{unit}, runs stacked",
+                title=f"{initialization} initialisation, gamma {gamma}: {key} per state-action "
+                f"once each was tried 5 times, {len(runs)} runs",
+            )
+    return figure
+
+
+def MovingBoxFigure(results: dict) -> Figure:
+    """Ch. 7.4.1: the share of tries reaching the goal per state-action, learned among the
+    moving box and without it, the state-actions found unreliable shaded."""
+    figure, axis = plt.subplots(figsize=(13, 4))
+    for offset, (trained, label) in enumerate(
+        (("moving_box", "learned among the moving box"), ("no_box", "learned without it"))
+    ):
+        reliability = results[trained]["reliability"]
+        axis.bar(np.arange(len(reliability)) + 0.4 * offset, reliability, width=0.4, label=label)
+    for sa in results["unreliable"]:
+        axis.axvspan(sa - 0.3, sa + 0.7, color="red", alpha=0.15)
+    axis.set(
+        xlabel=STATE_ACTION,
+        ylabel="tries reaching the goal [fraction]",
+        title="7.4.1, the right arm's hypercube: reliability of each state-action "
+        "(1 when tried < 5 times)",
+    )
+    Legend(axis, {f"unreliable (< {UNRELIABLE:.0%} among the box)": ("red", 0.15)})
+    return figure
+
+
+def ThreeAgentsFigure(results: dict) -> Figure:
+    """Fig. 7.10-7.12: each agent's tries per state-action, exploring together by a table."""
+    figure, axes = plt.subplots(3, 1, figsize=(13, 9))
+    for axis, name, tries, actions in zip(
+        axes, results["agents"], results["tries"], results["actions"]
+    ):
+        axis.bar(np.arange(len(tries)), tries, label=f"{name}, {actions} actions")
+        axis.set(
+            xlabel=STATE_ACTION,
+            ylabel=TRIES,
+            title=f"7.4, three agents by a table ({sum(results['actions'])} transitions in "
+            f"all): {name}'s tries per state-action",
+        )
+        Legend(axis)
+    return figure
+
+
+def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
+    """Writes ``experiment``'s figures into ``output``; returns its report's lines."""
     lines = []
     if experiment == "7.1":
-        gammas = sorted({r["gamma"] for r in results})
-        figure, axes = plt.subplots(2, len(gammas), figsize=(5 * len(gammas), 6), squeeze=False)
-        for column, gamma in enumerate(gammas):
+        SaveFigure(HypercubeFigure(results), output / "7.1_hypercube.png")
+        for gamma in sorted({r["gamma"] for r in results}):
             mine = [r for r in results if r["gamma"] == gamma]
-            for row, key in enumerate(("tries", "values")):
-                StackedBars(
-                    axes[row, column],
-                    np.array([r["snapshots"]["320"][key] for r in mine]),
-                    title=f"gamma {gamma}: {key} after 320 actions",
-                )
             tries = np.array([r["snapshots"]["320"]["tries"] for r in mine])
             values = np.array([r["snapshots"]["320"]["values"] for r in mine])
             lines.append(
@@ -517,8 +660,6 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
                 f"{tries.std(axis=1).mean():.2f} | {values.mean():.4f} | "
                 f"{np.mean([r['wall_seconds'] for r in mine]):.1f} |"
             )
-        figure.tight_layout()
-        figure.savefig(output / "7.1_hypercube.png", dpi=80)
         header = [
             "| gamma | runs | mean tries per state-action after 320 actions | "
             "spread of tries (std over state-actions, mean over runs) | mean V(s, a) | "
@@ -527,28 +668,15 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
         ]
         return header + lines
     if experiment == "7.2":
-        figure, axis = plt.subplots(figsize=(7, 4))
-        for strategy, colour in zip(
-            ("curious", "random", "least_tried"), ("tab:green", "tab:red", "tab:blue")
-        ):
+        SaveFigure(CoverageFigure(results), output / "7.2_coverage.png")
+        for strategy in ("curious", "random", "least_tried"):
             for r in [r for r in results if r["strategy"] == strategy]:
                 coverage = np.array(r["coverage"])
-                axis.plot(
-                    coverage[:, 0],
-                    coverage[:, 1],
-                    color=colour,
-                    label=strategy if r["run"] == 0 else None,
-                )
-                full = coverage[coverage[:, 1] >= 1296, 0]
+                full = coverage[coverage[:, 1] >= COVERAGE_STATE_ACTIONS, 0]
                 lines.append(
                     f"| {strategy} | {r['run']} | {coverage[-1, 0]} | "
                     f"{coverage[-1, 1]} | {full[0] if len(full) else '-'} |"
                 )
-        axis.set_xlabel("transitions")
-        axis.set_ylabel("state-actions tried (of 1296)")
-        axis.legend()
-        figure.tight_layout()
-        figure.savefig(output / "7.2_coverage.png", dpi=80)
         return [
             "| strategy | run | transitions | state-actions tried | transitions to try all |",
             "|---|---:|---:|---:|---:|",
@@ -577,51 +705,24 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
                 f"{space.action_state[top]}->{space.action_goal[top]}: {tries[top]}, "
                 f"{100 * (1 - misses[top]):.0f} % |"
             )
-            # Like Fig. 7.8-7.9: tries, values and visits; state-actions that sometimes miss
-            # their goal in red, the states never entered shaded.
-            figure, axes = plt.subplots(3, 1, figsize=(12, 7))
-            colours = np.where((misses > 0) & (tries >= 3), "tab:red", "tab:blue")
-            axes[0].bar(np.arange(len(tries)), tries, width=1.0, color=colours)
-            axes[0].set_title(
-                f"{r['lattice']} lattice, {r['actions'][0]} actions: tries per "
-                "state-action (red: sometimes ends elsewhere)"
-            )
-            axes[1].bar(np.arange(len(tries)), r["values"][0], width=1.0, color=colours)
-            axes[1].set_title("value V(s, a)")
-            visits = np.bincount(space.action_state, weights=tries, minlength=space.num_states)
-            axes[2].bar(np.arange(space.num_states), visits, width=1.0)
-            for state in never:
-                axes[2].axvspan(state - 0.5, state + 0.5, color="grey", alpha=0.4)
-            axes[2].set_title("actions taken from each state (grey: never entered)")
-            figure.tight_layout()
-            figure.savefig(output / f"7.3_{r['lattice']}.png", dpi=80)
+            SaveFigure(Rank4Figure(r, space, never), output / f"7.3_{r['lattice']}.png")
         return header + lines
     if experiment == "7.2i":
         space = Lattice([0.25, 0.5, 0.75], 4)
-        gammas = sorted({r["gamma"] for r in results})
         header = [
             "| initialisation | gamma | run | actions | state-actions missing their goal "
             "in more than 10 % of >= 3 tries (state -> goal: misses/tries) |",
             "|---|---:|---:|---:|---|",
         ]
         for initialization in ("50-50", "60-40"):
-            figure, axes = plt.subplots(
-                2 * len(gammas), 1, figsize=(12, 3 * len(gammas)), squeeze=False
+            SaveFigure(
+                InitializationFigure(results, initialization),
+                output / f"7.2i_{initialization}.png",
             )
-            for row, gamma in enumerate(gammas):
-                mine = [
-                    r
-                    for r in results
-                    if r["initialization"] == initialization and r["gamma"] == gamma
-                ]
-                for offset, key in enumerate(("tries", "values")):
-                    StackedBars(
-                        axes[2 * row + offset, 0],
-                        np.array([r[key][0] for r in mine]),
-                        title=f"{initialization}, gamma {gamma}: {key} per state-action, "
-                        f"{len(mine)} runs stacked",
-                    )
-                for r in mine:
+            for gamma in sorted({r["gamma"] for r in results}):
+                for r in results:
+                    if r["initialization"] != initialization or r["gamma"] != gamma:
+                        continue
                     tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
                     unreliable = np.flatnonzero((misses > 0.1) & (tries >= 3))
                     listed = ", ".join(
@@ -633,13 +734,11 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
                         f"| {initialization} | {gamma} | {r['run']} | "
                         f"{r['actions'][0]} | {listed or '-'} |"
                     )
-            figure.tight_layout()
-            figure.savefig(output / f"7.2i_{initialization}.png", dpi=80)
         return header + lines
     if experiment == "7.4.1":
+        SaveFigure(MovingBoxFigure(results), output / "7.4.1_moving_box.png")
         unreliable = np.array(results["unreliable"], dtype=int)
         risky = {(results["action_state"][sa], results["action_goal"][sa]) for sa in unreliable}
-        figure, axis = plt.subplots(figsize=(12, 4))
         header = [
             f"- unreliable state-actions learned among the moving box (reached their goal "
             f"in < {UNRELIABLE:.0%} of >= 5 tries), state -> goal: "
@@ -651,14 +750,8 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
             "state-action | penetrating control periods |",
             "|---|---:|---:|---:|---:|---:|---:|",
         ]
-        for offset, trained in enumerate(("moving_box", "no_box")):
+        for trained in ("moving_box", "no_box"):
             r = results[trained]
-            axis.bar(
-                np.arange(len(r["reliability"])) + 0.4 * offset,
-                r["reliability"],
-                width=0.4,
-                label=f"trained: {trained}",
-            )
             crossing = sum(
                 any(step in risky for step in zip(path, path[1:])) for path in r["plans"]
             )
@@ -670,20 +763,8 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
                 f"{np.mean([bool(set(e['tried']) & set(unreliable)) for e in episodes]):.0%} | "
                 f"{r.get('penetrating_steps', 0)} |"
             )
-        for sa in unreliable:
-            axis.axvspan(sa - 0.3, sa + 0.7, color="red", alpha=0.15)
-        axis.set_xlabel("state-action (unreliable ones shaded)")
-        axis.set_ylabel("share of tries reaching the goal")
-        axis.legend()
-        figure.tight_layout()
-        figure.savefig(output / "7.4.1_moving_box.png", dpi=80)
         return header + lines
-    figure, axes = plt.subplots(3, 1, figsize=(12, 8))
-    for axis, name, tries in zip(axes, results["agents"], results["tries"]):
-        axis.bar(np.arange(len(tries)), tries)
-        axis.set_title(f"{name}: tries per state-action")
-    figure.tight_layout()
-    figure.savefig(output / "7.4_three_agents.png", dpi=80)
+    SaveFigure(ThreeAgentsFigure(results), output / "7.4_three_agents.png")
     right, left = (np.array(t, dtype=float) for t in results["tries"][:2])
     correlation = float(np.corrcoef(right, left)[0, 1])
     lines = [

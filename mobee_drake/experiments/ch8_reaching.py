@@ -58,7 +58,7 @@ from mobee_drake.experiments.battery import (
     StopRequested,
 )
 from mobee_drake.experiments.exploration import ExplorationScenario, Explore
-from mobee_drake.experiments.plots import StackedBars, plt
+from mobee_drake.experiments.plots import Figure, SaveFigure, StackedBars, plt
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig, LoadAgentModel
 from mobee_drake.planning.state_space import Lattice
@@ -315,6 +315,133 @@ def _Cumulative(evaluation: list[dict]) -> float:
     return sum(r["reward"] or 0.0 for r in evaluation)
 
 
+def _Log(run: dict) -> np.ndarray:
+    """A run's log of actions, one row per action (columns: LOG_COLUMNS)."""
+    return np.array(run["log"]).reshape(-1, len(LOG_COLUMNS))
+
+
+def _Cumulatives(runs: list[dict], stages: list[int]) -> np.ndarray:
+    """The cumulative reward of every evaluation: runs x stages x evaluations."""
+    return np.array(
+        [[[_Cumulative(e) for e in r["evaluations"][str(stage)]] for stage in stages] for r in runs]
+    )
+
+
+def _Seeds(runs: list[dict], repeat: int = 1) -> list[str]:
+    """Legend labels of the runs' seeds, each ``repeat`` times (one per stacked row)."""
+    return [f"seed {r['settings']['seed']}" for r in runs for _ in range(repeat)]
+
+
+def CumulativeRewardFigure(by_strategy: dict[str, list[dict]], stages: list[int]) -> Figure:
+    """Fig. 8.2: the cumulative reward of every evaluation, stacked per stage, one colour per
+    seed (its evaluations split by white edges)."""
+    figure, axes = plt.subplots(
+        1, len(by_strategy), figsize=(6.5 * len(by_strategy), 4.5), squeeze=False, sharey=True
+    )
+    for axis, (strategy, runs) in zip(axes[0], by_strategy.items()):
+        table = _Cumulatives(runs, stages)
+        evaluations = table.shape[2]
+        StackedBars(
+            axis,
+            table.transpose(0, 2, 1).reshape(-1, len(stages)),
+            _Seeds(runs, evaluations),
+            x=np.arange(len(stages)),
+            width=0.6,
+        )
+        axis.set_xticks(np.arange(len(stages)), [str(s) for s in stages])
+        axis.set(
+            xlabel="exploratory problem-tries [count]",
+            ylabel="cumulative reward [sum of eq. 8.4\nover the problems], evaluations stacked",
+            title=f"{strategy}: {len(runs)} seeds x {evaluations} evaluations per stage",
+        )
+        axis.yaxis.set_tick_params(labelleft=True)
+    figure.suptitle(
+        "Fig. 8.2 on the kinematic iCub: cumulative reward of the exploitation evaluations"
+    )
+    return figure
+
+
+def ReachesFigure(strategy: str, runs: list[dict], stages: list[int], k: int, m: int) -> Figure:
+    """Fig. 8.4-8.6: the reaching state-actions chosen in evaluations, per stage, seeds
+    stacked (``k`` transitions, ``m`` states)."""
+    figure, axes = plt.subplots(len(stages), 1, figsize=(12, 2.6 * len(stages)), squeeze=False)
+    for axis, stage in zip(axes[:, 0], stages):
+        counts = np.array(
+            [
+                np.bincount(
+                    [
+                        t["reach"] - k
+                        for e in r["evaluations"][str(stage)]
+                        for t in e
+                        if t["reach"] >= 0
+                    ],
+                    minlength=m,
+                )
+                for r in runs
+            ]
+        )
+        StackedBars(axis, counts, _Seeds(runs))
+        axis.set(
+            xlabel=f"reaching state-action - {k} = the state it reaches from [index]",
+            ylabel="reaches [count]",
+            title=f"{strategy}, after {stage} problem-tries: reaches chosen in the "
+            "evaluations, seeds stacked",
+        )
+    return figure
+
+
+def ProblemTriesFigure(
+    by_strategy: dict[str, list[dict]], stages: list[int], k: int, m: int
+) -> Figure:
+    """Fig. 8.7: exploratory tries per problem (row) and state-action (column) before each
+    stage, mean over seeds, one column of images per strategy."""
+    figure, axes = plt.subplots(
+        len(stages),
+        len(by_strategy),
+        figsize=(6.5 * len(by_strategy), 2.6 * len(stages)),
+        squeeze=False,
+    )
+    num_problems = len(next(iter(by_strategy.values()))[0]["evaluations"][str(stages[0])][0])
+    for column, (strategy, runs) in enumerate(by_strategy.items()):
+        for row, stage in enumerate(stages):
+            image = np.zeros((num_problems, k + m))
+            for r in runs:
+                log = _Log(r)
+                log = log[log[:, 0] < stage]
+                np.add.at(image, (log[:, 1].astype(int), log[:, 2].astype(int)), 1.0)
+            axis = axes[row, column]
+            shown = axis.imshow(
+                image / len(runs), aspect="auto", cmap="jet", interpolation="nearest"
+            )
+            figure.colorbar(shown, ax=axis, label=f"tries [count,\nmean of {len(runs)} seeds]")
+            axis.set(
+                xlabel=f"state-action [index; reaches from {k}]",
+                ylabel="problem [index]",
+                title=f"{strategy}: tries in the first {stage} problem-tries",
+            )
+    return figure
+
+
+def FailedTransitionsFigure(by_strategy: dict[str, list[dict]], k: int) -> Figure:
+    """Fig. 8.8: failed transitions (reward -10) per transition state-action, seeds stacked."""
+    figure, axes = plt.subplots(
+        len(by_strategy), 1, figsize=(12, 3.2 * len(by_strategy)), squeeze=False
+    )
+    for axis, (strategy, runs) in zip(axes[:, 0], by_strategy.items()):
+        counts = []
+        for r in runs:
+            log = _Log(r)
+            counts.append(np.bincount(log[log[:, 6] < 0, 2].astype(int), minlength=k)[:k])
+        StackedBars(axis, np.array(counts), _Seeds(runs))
+        axis.set(
+            xlabel="transition state-action [index]",
+            ylabel="failed transitions [count]",
+            title=f"{strategy}: failed transitions (reward -10) in "
+            f"{runs[0]['settings']['problem_tries']} problem-tries per seed, seeds stacked",
+        )
+    return figure
+
+
 def Report(output: pathlib.Path, results: list[dict]) -> str:
     """Plots like Fig. 8.2, 8.4-8.8 and a markdown report; returns the report."""
     strategies = [
@@ -323,6 +450,14 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
     by_strategy = {s: [r for r in results if r["settings"]["strategy"] == s] for s in strategies}
     stages = sorted({int(k) for r in results for k in r["evaluations"]})
     k, m = results[0]["num_transitions"], results[0]["num_states"]
+    SaveFigure(CumulativeRewardFigure(by_strategy, stages), output / "8.2_cumulative_reward.png")
+    for strategy in strategies:
+        SaveFigure(
+            ReachesFigure(strategy, by_strategy[strategy], stages, k, m),
+            output / f"8.4-8.6_reaches_{strategy}.png",
+        )
+    SaveFigure(ProblemTriesFigure(by_strategy, stages, k, m), output / "8.7_problem_tries.png")
+    SaveFigure(FailedTransitionsFigure(by_strategy, k), output / "8.8_failed_transitions.png")
     lines = [
         "## Cumulative reward of the exploitation evaluations (Fig. 8.2)",
         "",
@@ -334,16 +469,8 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
         "|---|" + "---:|" * len(stages),
     ]
     means = {}
-    figure, axes = plt.subplots(
-        1, len(strategies), figsize=(5 * len(strategies), 4), squeeze=False, sharey=True
-    )
-    for axis, strategy in zip(axes[0], strategies):
-        table = np.array(
-            [
-                [[_Cumulative(e) for e in r["evaluations"][str(stage)]] for stage in stages]
-                for r in by_strategy[strategy]
-            ]
-        )
+    for strategy in strategies:
+        table = _Cumulatives(by_strategy[strategy], stages)
         means[strategy] = table.mean(axis=(0, 2))
         lines.append(
             f"| {strategy} | "
@@ -352,80 +479,6 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
             )
             + " |"
         )
-        # One colour per evaluation (seed after seed), stacked per stage.
-        StackedBars(
-            axis,
-            table.transpose(0, 2, 1).reshape(-1, len(stages)),
-            x=np.arange(len(stages)),
-            width=0.6,
-        )
-        axis.set_xticks(np.arange(len(stages)), [str(s) for s in stages])
-        axis.set_xlabel("exploratory problem-tries")
-        axis.set_title(strategy)
-    axes[0, 0].set_ylabel("cumulative reward, evaluations stacked")
-    figure.tight_layout()
-    figure.savefig(output / "8.2_cumulative_reward.png", dpi=80)
-
-    # Fig. 8.4-8.6: the reaching state-actions chosen in evaluations, per stage, seeds stacked.
-    for strategy in strategies:
-        figure, axes = plt.subplots(
-            len(stages), 1, figsize=(10, 1.6 * len(stages)), squeeze=False, sharex=True
-        )
-        for axis, stage in zip(axes[:, 0], stages):
-            counts = np.array(
-                [
-                    np.bincount(
-                        [
-                            t["reach"] - k
-                            for e in r["evaluations"][str(stage)]
-                            for t in e
-                            if t["reach"] >= 0
-                        ],
-                        minlength=m,
-                    )
-                    for r in by_strategy[strategy]
-                ]
-            )
-            StackedBars(axis, counts)
-            axis.set_ylabel(str(stage), rotation=0, labelpad=20)
-        axes[-1, 0].set_xlabel(f"reaching state-action - {k} (its state)")
-        axes[0, 0].set_title(f"{strategy}: reaches chosen in evaluations, seeds stacked")
-        figure.tight_layout()
-        figure.savefig(output / f"8.4-8.6_reaches_{strategy}.png", dpi=80)
-
-    # Fig. 8.7: exploratory tries per problem (row) and state-action (column), mean over seeds.
-    figure, axes = plt.subplots(
-        len(stages),
-        len(strategies),
-        figsize=(5 * len(strategies), 1.4 * len(stages)),
-        squeeze=False,
-    )
-    num_problems = len(results[0]["evaluations"][str(stages[0])][0])
-    for column, strategy in enumerate(strategies):
-        for row, stage in enumerate(stages):
-            image = np.zeros((num_problems, k + m))
-            for r in by_strategy[strategy]:
-                log = np.array(r["log"]).reshape(-1, len(LOG_COLUMNS))
-                log = log[log[:, 0] < stage]
-                np.add.at(image, (log[:, 1].astype(int), log[:, 2].astype(int)), 1.0)
-            axes[row, column].imshow(
-                image / len(by_strategy[strategy]),
-                aspect="auto",
-                cmap="jet",
-                interpolation="nearest",
-            )
-            axes[row, column].set_xticks([])
-            axes[row, column].set_yticks([])
-            if column == 0:
-                axes[row, column].set_ylabel(str(stage))
-        axes[-1, column].set_xlabel(strategy)
-    figure.tight_layout()
-    figure.savefig(output / "8.7_problem_tries.png", dpi=80)
-
-    # Fig. 8.8: failed transitions (reward -10) per state-action, seeds stacked.
-    figure, axes = plt.subplots(
-        len(strategies), 1, figsize=(10, 2.2 * len(strategies)), squeeze=False, sharex=True
-    )
     lines += [
         "",
         "## Robot time, failed transitions and reaches",
@@ -436,19 +489,15 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     hours = {}
-    for axis, strategy in zip(axes[:, 0], strategies):
-        counts, actions, failed, timeouts, tries = [], 0, 0, 0, 0
+    for strategy in strategies:
+        actions, failed, timeouts, tries = 0, 0, 0, 0
         for r in by_strategy[strategy]:
-            log = np.array(r["log"]).reshape(-1, len(LOG_COLUMNS))
-            negative = log[log[:, 6] < 0]
-            counts.append(np.bincount(negative[:, 2].astype(int), minlength=k)[:k])
+            log = _Log(r)
             actions += len(log)
-            failed += len(negative)
+            failed += int(np.sum(log[:, 6] < 0))
             tries += r["settings"]["problem_tries"]
             reaches = log[log[:, 2] >= k]
             timeouts += r["settings"]["problem_tries"] - len(reaches)
-        StackedBars(axis, np.array(counts))
-        axis.set_title(f"{strategy}: failed transitions per state-action, seeds stacked")
         hours[strategy] = sum(r["simulated_seconds"] for r in by_strategy[strategy]) / 3600
         lines.append(
             f"| {strategy} | {len(by_strategy[strategy])} | {hours[strategy]:.1f} | "
@@ -456,9 +505,6 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
             f"{timeouts} | {sum(r['wall_seconds'] for r in by_strategy[strategy]) / 3600:.2f} | "
             f"{sum(r['penetrating_steps'] for r in by_strategy[strategy])} |"
         )
-    axes[-1, 0].set_xlabel("transition state-action")
-    figure.tight_layout()
-    figure.savefig(output / "8.8_failed_transitions.png", dpi=80)
 
     if all("mdp" in r for r in results):
         lines += [

@@ -35,7 +35,7 @@ from mobee_drake.experiments.battery import (
     RunBattery,
     RunFolder,
 )
-from mobee_drake.experiments.plots import plt
+from mobee_drake.experiments.plots import Figure, SaveFigure, plt
 from mobee_drake.goal_babbling.baselines import ActuatorRandom, ActuatorRiac, SaggRandom
 from mobee_drake.goal_babbling.config import ConfigToDict, Experiment1Config, Experiment2Config
 from mobee_drake.goal_babbling.evaluation import MakeEvaluator
@@ -216,18 +216,18 @@ def WriteCurves(runs: list[dict], path: pathlib.Path) -> None:
                 )
 
 
-def PlotCurves(runs: list[dict], methods: list[str], experiment: int, path: pathlib.Path) -> None:
+def CurvesFigure(runs: list[dict], methods: list[str], experiment: int) -> Figure:
     """Mean and standard deviation over seeds of both errors against time steps (Fig. 4-5)."""
-    figure, axes = plt.subplots(1, 2, figsize=(11, 4))
+    figure, axes = plt.subplots(1, 2, figsize=(12, 4.5))
     for offset, method in enumerate(methods):
         method_runs = [run for run in runs if run["spec"]["method"] == method]
         if not method_runs:
             continue
-        steps = np.array([point["time_step"] for point in method_runs[0]["curve"]])
+        steps = np.array([point["time_step"] for point in method_runs[0]["curve"]]) / 1000
         for axis, measure in zip(axes, MEASURES, strict=True):
             values = np.array([[point[measure] for point in run["curve"]] for run in method_runs])
             mean, spread = values.mean(axis=0), values.std(axis=0)
-            (line,) = axis.plot(steps, mean, label=f"{method} (n={len(method_runs)})")
+            (line,) = axis.plot(steps, mean, label=f"{method} ({len(method_runs)} seeds)")
             # Error bars shifted per method for readability, as in the paper's figures.
             shift = (offset - 1.5) * 0.01 * steps[-1]
             axis.errorbar(
@@ -239,18 +239,27 @@ def PlotCurves(runs: list[dict], methods: list[str], experiment: int, path: path
                 capsize=2,
                 alpha=0.7,
             )
-    for axis, measure in zip(axes, MEASURES, strict=True):
-        axis.set_xlabel("time steps (micro-actions)")
-        axis.set_ylabel(f"mean {measure.replace('_', ' ')} (units)")
+    for axis, measure, title in zip(
+        axes,
+        MEASURES,
+        ("inverse model: reaching error on the test goals", "forward model: prediction error"),
+        strict=True,
+    ):
+        axis.set(
+            xlabel="time steps [thousands of micro-actions]",
+            ylabel=f"mean {measure.replace('_', ' ')} [units; arm length 50]",
+            title=title,
+        )
         axis.grid(alpha=0.3)
-    axes[0].legend(fontsize=8)
-    figure.suptitle(f"Experiment {experiment}: mean +- std over seeds")
-    figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+        axis.legend(fontsize=8, title="method (mean ± std)", title_fontsize=8)
+    figure.suptitle(
+        f"Experiment {experiment}: errors of the learned models, mean ± std over seeds "
+        "(cf. the paper's Fig. 4-5)"
+    )
+    return figure
 
 
-def PlotGoalHistograms(run: dict, path: pathlib.Path) -> None:
+def GoalsFigure(run: dict) -> Figure:
     """Histograms of the self-generated goals (subgoals excluded) in four windows, with regions
     (Fig. 3).
     """
@@ -260,7 +269,7 @@ def PlotGoalHistograms(run: dict, path: pathlib.Path) -> None:
     log = np.array(run["goal_log"]).reshape(-1, 7)
     goals = log[log[:, 4] > 0]
     figure, axes = plt.subplots(
-        1, NUM_HISTOGRAM_WINDOWS + 1, figsize=(4 * (NUM_HISTOGRAM_WINDOWS + 1), 4.4)
+        1, NUM_HISTOGRAM_WINDOWS + 1, figsize=(4.2 * (NUM_HISTOGRAM_WINDOWS + 1), 5.5)
     )
     panels = [
         (snapshot["first_goal"], snapshot["end_goal"], snapshot["regions"])
@@ -269,28 +278,44 @@ def PlotGoalHistograms(run: dict, path: pathlib.Path) -> None:
     panels.append((0, len(goals), run["region_snapshots"][-1]["regions"]))
     angles = np.linspace(-np.pi / 2, np.pi / 2, 100)
     for axis, (begin, end, regions) in zip(axes, panels, strict=True):
-        axis.hist2d(
+        *_, shown = axis.hist2d(
             goals[begin:end, 1],
             goals[begin:end, 2],
             bins=30,
             range=[[low[0], high[0]], [low[1], high[1]]],
             cmap="viridis",
         )
-        for x0, y0, x1, y1 in regions:
-            axis.plot([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], color="white", linewidth=0.6)
-        axis.plot(length * np.cos(angles), length * np.sin(angles), color="black", linewidth=1.5)
-        axis.set_title(f"goals {begin + 1}-{end}", fontsize=9)
-        axis.set_xlim(low[0], high[0])
-        axis.set_ylim(low[1], high[1])
-        axis.set_aspect("equal")
+        figure.colorbar(shown, ax=axis, label="goals per bin [count]", shrink=0.8)
+        for i, (x0, y0, x1, y1) in enumerate(regions):
+            axis.plot(
+                [x0, x1, x1, x0, x0],
+                [y0, y0, y1, y1, y0],
+                color="white",
+                linewidth=0.6,
+                label=None if i else "regions (at the window's end)",
+            )
+        axis.plot(
+            length * np.cos(angles),
+            length * np.sin(angles),
+            color="black",
+            linewidth=1.5,
+            label=f"reachable half-disc (radius {length:g})",
+        )
+        axis.set(
+            xlabel="goal x [units]",
+            ylabel="goal y [units]",
+            title=f"goals {begin + 1}-{end}",
+            xlim=(low[0], high[0]),
+            ylim=(low[1], high[1]),
+            aspect="equal",
+        )
+    axes[-1].legend(loc="lower right", fontsize=7, facecolor="0.85")
     spec = run["spec"]
     figure.suptitle(
-        f"SAGG-RIAC goals and regions, experiment {spec['experiment']}, seed {spec['seed']}, "
-        f"{spec['budget']} time steps"
+        f"SAGG-RIAC's goals (30 x 30 bins) and regions, experiment {spec['experiment']}, "
+        f"seed {spec['seed']}, {spec['budget']} time steps (cf. the paper's Fig. 3)"
     )
-    figure.tight_layout()
-    figure.savefig(path, dpi=100)
-    plt.close(figure)
+    return figure
 
 
 def _Format(values: np.ndarray) -> str:
@@ -392,10 +417,16 @@ def Analyse(specs: list[RunSpec], output: pathlib.Path, methods: list[str], comm
         if not runs:
             continue
         WriteCurves(runs, output / f"exp{experiment}_curves.csv")
-        PlotCurves(runs, methods, experiment, output / f"exp{experiment}_curves.png")
+        SaveFigure(
+            CurvesFigure(runs, methods, experiment),
+            output / f"exp{experiment}_curves.png",
+            dpi=110,
+        )
         sagg_riac_runs = [run for run in runs if run["spec"]["method"] == SaggRiac.name]
         if sagg_riac_runs:
-            PlotGoalHistograms(sagg_riac_runs[0], output / f"exp{experiment}_goals.png")
+            SaveFigure(
+                GoalsFigure(sagg_riac_runs[0]), output / f"exp{experiment}_goals.png", dpi=100
+            )
     WriteTextAtomically(
         output / "statistics.json",
         # A test that could not be computed (NaN) is written null.

@@ -15,7 +15,7 @@ import pathlib
 import numpy as np
 
 from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
-from mobee_drake.experiments.plots import plt
+from mobee_drake.experiments.plots import Figure, SaveFigure, plt
 from mobee_drake.station.viewer import RecordingMeshcat
 from mobee_drake.trm.display import MarkerCloud, PathMotion, RecordMotion, ShowRoadmap
 from mobee_drake.trm.examples import EXAMPLES, OpenBox, TrmExample
@@ -43,29 +43,33 @@ def FarthestPair(roadmap: TaskRelevantRoadmap) -> tuple[int, int]:
     return int(a), int(b)
 
 
-def Plot(
-    points: np.ndarray, roadmap: TaskRelevantRoadmap, title: str, path: pathlib.Path, boxes: bool
-) -> None:
-
-    figure = plt.figure(figsize=(6, 5))
+def RoadmapFigure(
+    points: np.ndarray, roadmap: TaskRelevantRoadmap, title: str, boxes: bool
+) -> Figure:
+    """The palm's positions over the roadmap's vertices with its edges (as Fig. 3.1-3.3, 3.8),
+    and with ``boxes`` the open box's walls and floor as wireframes."""
+    figure = plt.figure(figsize=(7, 5.5))
     axes = figure.add_subplot(projection="3d")
-    for a, b in roadmap.edges:
-        axes.plot(*points[[a, b]].T, color="0.75", linewidth=0.4)
-    axes.scatter(*points.T, s=6, color="tab:blue")
-    if boxes:  # the open box's walls and floor as wireframes
+    for i, (a, b) in enumerate(roadmap.edges):
+        axes.plot(
+            *points[[a, b]].T,
+            color="0.75",
+            linewidth=0.4,
+            label=None if i else f"edge ({len(roadmap.edges)})",
+        )
+    axes.scatter(*points.T, s=6, color="tab:blue", label=f"palm at a vertex ({len(points)})")
+    if boxes:
         signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).T.reshape(-1, 3)
+        label = "the open box's walls and floor"
         for obj in OpenBox():
             corners = np.array(obj.position) + signs * np.array(obj.shape.size) / 2
             for i, j in zip(*np.triu_indices(8, 1)):
                 if np.sum(signs[i] != signs[j]) == 1:
-                    axes.plot(*corners[[i, j]].T, color="tab:brown", linewidth=0.6)
-    axes.set_xlabel("x (m, back)")
-    axes.set_ylabel("y (m, right)")
-    axes.set_zlabel("z (m, up)")
-    axes.set_title(title)
-    figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+                    axes.plot(*corners[[i, j]].T, color="tab:brown", linewidth=0.6, label=label)
+                    label = None
+    axes.set(xlabel="x [m] (back)", ylabel="y [m] (right)", zlabel="z [m] (up)", title=title)
+    axes.legend(loc="upper left", fontsize="small")
+    return figure
 
 
 def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) -> str:
@@ -76,12 +80,16 @@ def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) ->
     )
     roadmap.Save(output / name)
     points = MarkerCloud(example.model, roadmap, example.marker)
-    Plot(
-        points,
-        roadmap,
-        f"{name}: {roadmap.num_vertices} vertices",
+    SaveFigure(
+        RoadmapFigure(
+            points,
+            roadmap,
+            f"{name}: the right palm over a task-relevant roadmap of {roadmap.num_vertices} "
+            f"vertices\n(spacing d = {config.spacing} m, seed {seed}; cf. Fig. 3.1-3.3, 3.8)",
+            boxes=name == "reach_into",
+        ),
         output / f"{name}.png",
-        boxes=name == "reach_into",
+        dpi=120,
     )
     start, goal = FarthestPair(roadmap)
     path = roadmap.Path(start, goal)

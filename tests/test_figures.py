@@ -1,0 +1,214 @@
+"""Every figure the experiments draw reads alone: on small synthetic results, each axes of each
+figure has x and y labels, a title, and a legend or a colour bar, and every colour of its bars
+and spans is named in its legend."""
+
+import pathlib
+import tempfile
+import types
+import unittest
+
+from matplotlib.colors import to_rgba
+import numpy as np
+
+from mobee_drake.experiments import (
+    bench_forces,
+    ch7_model_learning,
+    ch8_reaching,
+    saggriac,
+    trm_roadmaps,
+)
+from mobee_drake.experiments.plots import SaveFigure
+from mobee_drake.planning.state_space import Lattice
+from mobee_drake.reaching.learner import LOG_COLUMNS
+
+RNG = np.random.default_rng(0)
+
+
+def _IsColorbar(axis) -> bool:
+    return getattr(axis, "_colorbar", None) is not None
+
+
+def _HasColorbar(axis) -> bool:
+    return any(m.colorbar is not None for m in [*axis.images, *axis.collections])
+
+
+def _LegendColours(legend) -> set:
+    colours = set()
+    for handle in legend.legend_handles:
+        colour = handle.get_facecolor() if hasattr(handle, "get_facecolor") else None
+        colours.add(to_rgba(colour if colour is not None else handle.get_color()))
+    return colours
+
+
+class FigureTest(unittest.TestCase):
+    def assertReadable(self, figure, name: str):
+        """Checks every axes of ``figure``, then draws and saves it (small)."""
+        axes = [axis for axis in figure.axes if not _IsColorbar(axis)]
+        self.assertTrue(axes, name)
+        for i, axis in enumerate(axes):
+            where = f"{name}, axes {i} ({axis.get_title()!r})"
+            self.assertTrue(axis.get_xlabel(), where)
+            self.assertTrue(axis.get_ylabel(), where)
+            self.assertTrue(axis.get_title(), where)
+            if hasattr(axis, "get_zlabel"):
+                self.assertTrue(axis.get_zlabel(), where)
+            legend = axis.get_legend()
+            self.assertTrue(legend is not None or _HasColorbar(axis), where)
+            if legend is None:
+                continue
+            self.assertTrue(all(t.get_text() for t in legend.get_texts()), where)
+            # Every colour of a bar or a shaded span has a legend entry.
+            named = _LegendColours(legend)
+            for patch in axis.patches:
+                self.assertIn(to_rgba(patch.get_facecolor()), named, where)
+        with tempfile.TemporaryDirectory() as folder:
+            SaveFigure(figure, pathlib.Path(folder) / f"{name}.png", dpi=20)
+
+
+class TestCh7Figures(FigureTest):
+    def test_hypercube_and_initializations(self):
+        runs = [
+            dict(
+                gamma=gamma,
+                run=run,
+                initialization=initialization,
+                snapshots={"320": dict(tries=RNG.integers(4, 7, 16), values=RNG.random(16))},
+                tries=[RNG.integers(4, 9, 40)],
+                values=[RNG.random(40)],
+            )
+            for initialization in ("50-50", "60-40")
+            for gamma in (0.5, 0.9)
+            for run in range(3)
+        ]
+        self.assertReadable(ch7_model_learning.HypercubeFigure(runs), "7.1")
+        self.assertReadable(ch7_model_learning.InitializationFigure(runs, "60-40"), "7.2i")
+
+    def test_coverage(self):
+        runs = [
+            dict(strategy=strategy, run=run, coverage=[[0, 0], [50, 40], [100, 70]])
+            for strategy in ("curious", "random", "least_tried")
+            for run in range(2)
+        ]
+        self.assertReadable(ch7_model_learning.CoverageFigure(runs), "7.2")
+
+    def test_rank_4(self):
+        space = Lattice([0.2, 0.8], 4)
+        n = space.num_state_actions
+        misses = np.zeros(n)
+        misses[[1, 2]], misses[[3, 4]] = 0.5, 1.0  # several outcomes; never the goal
+        run = dict(
+            lattice="20-80",
+            actions=[200],
+            tries=[RNG.integers(3, 9, n)],
+            misses=[misses],
+            values=[RNG.random(n)],
+        )
+        figure = ch7_model_learning.Rank4Figure(run, space, np.array([5, 6]))
+        self.assertReadable(figure, "7.3")
+
+    def test_moving_box_and_three_agents(self):
+        moving = dict(
+            moving_box=dict(reliability=RNG.random(64)),
+            no_box=dict(reliability=np.ones(64)),
+            unreliable=[3, 9],
+        )
+        self.assertReadable(ch7_model_learning.MovingBoxFigure(moving), "7.4.1")
+        agents = dict(
+            agents=["right_arm", "left_arm", "torso"],
+            tries=[RNG.integers(0, 9, 30) for _ in range(3)],
+            actions=[10, 11, 12],
+        )
+        self.assertReadable(ch7_model_learning.ThreeAgentsFigure(agents), "7.4")
+
+
+class TestCh8Figures(FigureTest):
+    K, M, PROBLEMS, STAGES = 12, 4, 5, [0, 10]
+
+    def Run(self, strategy: str, seed: int) -> dict:
+        """A run of 10 problem-tries, each a transition (some failing) then a reach."""
+        log = []
+        for attempt in range(10):
+            state = int(RNG.integers(self.M))
+            transition = [attempt, attempt % self.PROBLEMS, RNG.integers(self.K), state, 0, 0]
+            reach = [attempt, attempt % self.PROBLEMS, self.K + state, state, 0, 0]
+            log += [transition + [-10.0 * (attempt % 3 == 0), 0, 0, 0], reach + [0.9, 0, 0, 0]]
+        self.assertEqual(len(log[0]), len(LOG_COLUMNS))
+        evaluations = {
+            str(stage): [
+                [
+                    dict(problem=p, reach=self.K + int(RNG.integers(self.M)), reward=RNG.random())
+                    for p in range(self.PROBLEMS)
+                ]
+                for _ in range(2)
+            ]
+            for stage in self.STAGES
+        }
+        return dict(
+            settings=dict(strategy=strategy, seed=seed, problem_tries=10),
+            log=log,
+            evaluations=evaluations,
+        )
+
+    def test_figures(self):
+        by_strategy = {s: [self.Run(s, seed) for seed in range(2)] for s in ("random", "intrinsic")}
+        self.assertReadable(ch8_reaching.CumulativeRewardFigure(by_strategy, self.STAGES), "8.2")
+        self.assertReadable(
+            ch8_reaching.ReachesFigure(
+                "random", by_strategy["random"], self.STAGES, self.K, self.M
+            ),
+            "8.4-8.6",
+        )
+        self.assertReadable(
+            ch8_reaching.ProblemTriesFigure(by_strategy, self.STAGES, self.K, self.M), "8.7"
+        )
+        self.assertReadable(ch8_reaching.FailedTransitionsFigure(by_strategy, self.K), "8.8")
+
+    def test_each_seed_of_a_stacked_bar_has_its_colour(self):
+        by_strategy = {"greedy": [self.Run("greedy", seed) for seed in range(3)]}
+        figure = ch8_reaching.CumulativeRewardFigure(by_strategy, self.STAGES)
+        legend = figure.axes[0].get_legend()
+        self.assertEqual([t.get_text() for t in legend.get_texts()], ["seed 0", "seed 1", "seed 2"])
+        self.assertEqual(len(_LegendColours(legend)), 3)
+        SaveFigure(figure, pathlib.Path(tempfile.mkdtemp()) / "8.2.png", dpi=20)
+
+
+class TestOtherFigures(FigureTest):
+    def test_saggriac(self):
+        curve = [
+            dict(time_step=t, reaching_error=10 / (1 + t), prediction_error=5 / (1 + t))
+            for t in (0, 100, 200)
+        ]
+        runs = [
+            dict(spec=dict(method=method, seed=seed), curve=curve)
+            for method in ("SAGG-RIAC", "ACTUATOR-Random")
+            for seed in range(2)
+        ]
+        figure = saggriac.CurvesFigure(runs, ["SAGG-RIAC", "ACTUATOR-Random"], 1)
+        self.assertReadable(figure, "saggriac curves")
+        goals = np.zeros((40, 7))
+        goals[:, 1:3] = RNG.uniform([0, -100], [100, 100], (40, 2))
+        goals[:, 4] = 1  # a goal, not a subgoal
+        run = dict(
+            config=dict(
+                goal_space_low=[0, -100], goal_space_high=[100, 100], arm=dict(total_length=50)
+            ),
+            goal_log=goals.tolist(),
+            region_snapshots=[
+                dict(first_goal=10 * i, end_goal=10 * i + 10, regions=[[0, -100, 50, 100]])
+                for i in range(4)
+            ],
+            spec=dict(experiment=2, seed=0, budget=1000),
+        )
+        self.assertReadable(saggriac.GoalsFigure(run), "saggriac goals")
+
+    def test_roadmap_and_scalability(self):
+        points = RNG.uniform(-0.3, 0.0, (6, 3))
+        roadmap = types.SimpleNamespace(edges=[(0, 1), (1, 2), (3, 4)])
+        figure = trm_roadmaps.RoadmapFigure(points, roadmap, "reach_into", boxes=True)
+        self.assertReadable(figure, "trm")
+        curves = {"katana": [(0, 2e4, 1.9e4), (10, 3e3, 2e3)], "icub": [(0, 7e3, 6e3)]}
+        self.assertReadable(bench_forces.ScalabilityFigure(curves, churn=True), "2.4")
+
+
+if __name__ == "__main__":
+    unittest.main()
