@@ -21,6 +21,12 @@ import shutil
 import tempfile
 
 
+def _Umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 def WriteFileAtomically(path: str | pathlib.Path, write) -> None:
     """Writes ``path`` through a staging file in the same folder: ``write(staging)`` writes the
     staging file (a path), which then replaces ``path``."""
@@ -30,6 +36,7 @@ def WriteFileAtomically(path: str | pathlib.Path, write) -> None:
     os.close(handle)
     try:
         write(staging)
+        os.chmod(staging, 0o666 & ~_Umask())  # As open() would have made it (mkstemp: 0o600).
         os.replace(staging, path)
     except BaseException:
         pathlib.Path(staging).unlink(missing_ok=True)

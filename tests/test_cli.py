@@ -25,6 +25,7 @@ COMMANDS = [
     ["bench", "simulation"],
     ["bench", "ik"],
     ["bench", "babbling"],
+    ["bench", "safety"],
 ]
 
 

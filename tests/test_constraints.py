@@ -79,6 +79,15 @@ class TestClauses(unittest.TestCase):
         active = ClauseSet(clauses, JOINTS).ActiveClauses(np.radians([40, 9, 4]), DELTA)
         np.testing.assert_array_equal(active, [False, True])
 
+    def test_a_literal_in_two_clauses_pushes_once(self):
+        """Eq. 5.17 sums each constraint once: the forearm rule's shape, (a OR b) AND (a OR c),
+        with every literal inside its band pushes a by one spring, not two."""
+        clauses = [Clause("ab", [L1, L2]), Clause("ac", [_Literal("a", 0), L3])]
+        np.testing.assert_allclose(_Force(clauses, [2, 3, 4]), [_Spring(2), _Spring(3), _Spring(4)])
+        # With only the first clause on (c clear), a still pushes once.
+        np.testing.assert_allclose(_Force(clauses, [2, 3, 40]), [_Spring(2), _Spring(3), 0])
+        self.assertEqual(len(ClauseSet(clauses, JOINTS).Clearances(np.zeros(3))), 3)
+
     def test_frozen_joints_become_constants(self):
         frozen = {"z": np.radians(30.0)}
         # z >= 0 holds forever with z frozen at 30 deg: the clause can never switch on.

@@ -5,7 +5,7 @@ import unittest
 from arm_diagram import ArmDiagram
 import numpy as np
 
-from mobee_drake.mobee.params import MobeeParams, SquashParams
+from mobee_drake.mobee.params import JointParams, MobeeParams, SquashParams
 from mobee_drake.mobee.squash import Squash
 from mobee_drake.mobee.system import FORCE_TERMS
 
@@ -65,6 +65,38 @@ class TestConfigurationSpaceTerms(unittest.TestCase):
         delta = params.constraint_delta
         magnitude = params.constraint_force * (delta - g) / delta
         np.testing.assert_allclose(arm.Out("f_cst"), magnitude * np.array([0, -1, -1]) / np.sqrt(2))
+
+
+class TestPerJointConstants(unittest.TestCase):
+    def test_squash_and_limits_per_joint(self):
+        """Eq. 5.8's m_i, k_i and eq. 5.12's delta_i, f_max,i per joint; the others keep the
+        robot-wide values, and a joint's own mass alone keeps the robot-wide damping."""
+        own = JointParams(
+            mass=2.0, spring_squash=SquashParams(5.0, 2.0), limit_delta=0.2, limit_force=10.0
+        )
+        params = MobeeParams(damping=7.0, joint_overrides={"joint2": own})
+        values = params.PerJoint(["joint1", "joint2", "joint3"])
+        np.testing.assert_array_equal(values.mass, [1.0, 2.0, 1.0])
+        np.testing.assert_array_equal(values.damping, [7.0, 7.0, 7.0])
+        arm = ArmDiagram(params=params)
+        arm.dut.GetInputPort("attractor").FixValue(arm.context, np.zeros(3))
+        q = np.array([0.5, 3.0 - 0.05, 0.5])  # joint2 0.05 rad from its upper limit of 3 rad
+        arm.Set(q)
+        stretch = 50.0 * q
+        np.testing.assert_allclose(
+            arm.Out("spring"),
+            -np.array(
+                [Squash(stretch[0], 20, 1), Squash(stretch[1], 5, 2), Squash(stretch[2], 20, 1)]
+            ),
+        )
+        np.testing.assert_allclose(arm.Out("f_lim"), [0.0, -10.0 * (0.2 - 0.05) / 0.2, 0.0])
+
+    def test_a_joints_bad_value_is_named(self):
+        params = MobeeParams(joint_overrides={"joint2": JointParams(limit_force=-1.0)})
+        with self.assertRaisesRegex(
+            ValueError, r"joint_overrides\[joint2\]\.limit_force must be > 0"
+        ):
+            params.Validate(["joint1", "joint2", "joint3"])
 
 
 class TestWorkspaceForces(unittest.TestCase):

@@ -9,11 +9,18 @@ and inserted while the robot moves: before every evaluation one box is removed a
 inserted (our single-threaded stand-in for the source's sensory thread flooding the model).
 One process, one core.
 
+Beside MoBeE's time each row prints Drake's own cost of the same work on the same poses, the
+*floor*: ``SetPositions`` and SceneGraph's signed-distance query up to the largest field margin
+(with ``--churn``, the same box replacements too), timed in alternate sweeps with MoBeE's so
+that both see the machine at the same speed; their ratio; and the process's peak resident
+memory after the row.
+
 Run: ``mobee-drake bench forces [--robot katana] [--churn] [--plot FILE.png]`` (or
 ``python -m mobee_drake.experiments.bench_forces``).
 """
 
 import dataclasses as dc
+import resource
 import time
 
 import numpy as np
@@ -46,6 +53,14 @@ class ForceBenchmarkResult:
     best_per_second: float
     median_per_second: float
     mean_pairs_in_fields: float
+    # Drake's floor for the same poses (best sweep, us per pose), and MoBeE's best over it.
+    floor_us: float = 0.0
+    # Peak resident memory of the process after the row (MiB).
+    peak_rss_mib: float = 0.0
+
+    @property
+    def ratio(self) -> float:
+        return 1e6 / self.best_per_second / self.floor_us
 
 
 def _RandomBox(name: str, robot: str, rng: np.random.Generator) -> SceneObject:
@@ -69,7 +84,7 @@ def _BuildRobotAmongBoxes(robot: str, num_boxes: int, rng: np.random.Generator):
         builder, plant=plant, scene_graph=scene_graph, robot=overlay, joints=joints
     )
     diagram = builder.Build()
-    return diagram, plant, mobee, world
+    return diagram, plant, mobee, world, max(overlay.field_margins.values())
 
 
 def _OscillatorPoses(
@@ -102,7 +117,7 @@ def MeasureForceEvaluations(
     """Times ``repeats`` sweeps of ``num_poses`` total-force evaluations among boxes; with
     ``churn``, each evaluation follows the removal of one box and the insertion of another."""
     rng = np.random.default_rng(seed)
-    diagram, plant, mobee, world = _BuildRobotAmongBoxes(robot, num_obstacles, rng)
+    diagram, plant, mobee, world, max_margin = _BuildRobotAmongBoxes(robot, num_obstacles, rng)
     context = diagram.CreateDefaultContext()
     plant_context = plant.GetMyMutableContextFromRoot(context)
     mobee_context = mobee.GetMyContextFromRoot(context)
@@ -112,12 +127,14 @@ def MeasureForceEvaluations(
         for k in range(num_poses * repeats if churn and boxes else 0)
     ]
     total, contacts = mobee.GetOutputPort("total"), mobee.GetOutputPort("field_contacts")
+    query = mobee.GetInputPort("geometry_query")
     # The plant's positions are the controlled joints, possibly in another order.
     order = [plant.GetJointByName(j).position_start() for j in mobee.joints]
     poses = _OscillatorPoses(mobee, num_poses, rng, amplitude)
     x = plant.GetPositions(plant_context)
-    rates = []
-    for repeat in range(repeats):
+
+    def Sweep(repeat: int, evaluate) -> float:
+        """Seconds for one sweep of the poses, each after its box replacement (with churn)."""
         start = time.perf_counter()
         for k, q in enumerate(poses):
             if replacements:
@@ -127,15 +144,32 @@ def MeasureForceEvaluations(
                 boxes[k % len(boxes)] = new.name
             x[order] = q
             plant.SetPositions(plant_context, x)
-            total.Eval(mobee_context)
-        rates.append(num_poses / (time.perf_counter() - start))
+            evaluate()
+        return time.perf_counter() - start
+
+    def Floor() -> None:
+        query.Eval(mobee_context).ComputeSignedDistancePairwiseClosestPoints(max_margin)
+
+    rates, floors = [], []
+    for repeat in range(repeats):
+        floors.append(Sweep(repeat, Floor) / num_poses)
+        if replacements:  # The churn's boxes are used once each: draw the sweep's anew.
+            replacements[repeat * num_poses : (repeat + 1) * num_poses] = [
+                _RandomBox(f"floor{repeat}_{k}", robot, rng) for k in range(num_poses)
+            ]
+        rates.append(num_poses / Sweep(repeat, lambda: total.Eval(mobee_context)))
     pairs = 0
     for q in poses[::10]:  # Untimed: how busy the field term was.
         x[order] = q
         plant.SetPositions(plant_context, x)
         pairs += len(contacts.Eval(mobee_context))
     return ForceBenchmarkResult(
-        num_obstacles, max(rates), float(np.median(rates)), pairs / len(poses[::10])
+        num_obstacles,
+        max(rates),
+        float(np.median(rates)),
+        pairs / len(poses[::10]),
+        floor_us=1e6 * min(floors),
+        peak_rss_mib=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
     )
 
 
@@ -194,9 +228,9 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     print(
         "| robot | boxes | evaluations/s (best) | evaluations/s (median) | us/evaluation (best) "
-        "| pairs inside fields (mean) |"
+        "| floor us (best) | ratio | pairs inside fields (mean) | peak RSS (MiB) |"
     )
-    print("|---|---:|---:|---:|---:|---:|")
+    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
     curves = {}
     for robot in args.robot:
         for n in args.obstacles:
@@ -212,7 +246,8 @@ def main(argv=None) -> None:
             curves.setdefault(robot, []).append((n, r.best_per_second, r.median_per_second))
             print(
                 f"| {robot} | {n} | {r.best_per_second:,.0f} | {r.median_per_second:,.0f} | "
-                f"{1e6 / r.best_per_second:.0f} | {r.mean_pairs_in_fields:.2f} |",
+                f"{1e6 / r.best_per_second:.0f} | {r.floor_us:.0f} | {r.ratio:.2f} | "
+                f"{r.mean_pairs_in_fields:.2f} | {r.peak_rss_mib:.0f} |",
                 flush=True,
             )
     if args.plot:

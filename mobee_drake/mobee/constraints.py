@@ -15,8 +15,10 @@ Eq. 5.16-5.17 group literals into clauses. We read the literal ``f_cst,i <-> 0``
 clear of its band" (``g_i >= delta``). A *clause* is a disjunction: it is safe while any of its
 literals is clear. **A clause's forces switch on exactly when none of its literals is clear, that
 is when every one of its literals is inside its band (or violated); then the forces of all its
-literals act together.** The constraint set is the conjunction of its clauses, so the total
-constraint force is the sum over the clauses that are switched on. A single-literal clause is an
+literals act together.** The constraint set is the conjunction of its clauses, and the total
+constraint force (eq. 5.17) sums **each distinct literal once** over the clauses that are switched
+on: a literal written in two clauses (the forearm rule writes the elbow's in both) is one
+constraint, which pushes once however many of its clauses are on. A single-literal clause is an
 ordinary constraint; the iCub's forearm clause "elbow below 90 deg OR pronation within 45 deg"
 stays silent while either holds with margin, and pushes both joints once both are near or beyond
 their bounds.
@@ -57,6 +59,7 @@ class ClauseSet:
         column = {name: i for i, name in enumerate(joints)}
         frozen = {name: np.degrees(angle) for name, angle in (frozen_joints or {}).items()}
         rows, offsets, membership, self.names = [], [], [], []
+        index: dict[tuple, int] = {}  # (a, b) of each distinct literal -> its row
         for clause in clauses:
             literals = []  # (a over the controlled joints, b in degrees)
             for literal in clause.literals:
@@ -82,9 +85,12 @@ class ClauseSet:
                 )
             members = []
             for a, b in literals:
-                members.append(len(rows))
-                rows.append(a)
-                offsets.append(np.radians(b))
+                key = (tuple(a), b)  # A literal already seen in another clause is the same one.
+                if key not in index:
+                    index[key] = len(rows)
+                    rows.append(a)
+                    offsets.append(np.radians(b))
+                members.append(index[key])
             membership.append(members)
             self.names.append(clause.name)
         n_literals = len(rows)
@@ -102,7 +108,8 @@ class ClauseSet:
         return self._C.shape[0]
 
     def Clearances(self, q: np.ndarray) -> np.ndarray:
-        """The clearance ``g`` of every literal, in radians (clause by clause, in order)."""
+        """The clearance ``g`` of every distinct literal, in radians (in the order the clauses
+        first name them)."""
         return self._normals @ q + self._offsets
 
     def ActiveClauses(self, q: np.ndarray, delta: float) -> np.ndarray:
@@ -131,6 +138,6 @@ class ClauseSet:
         inside = g < delta
         if not inside.any():  # The common case: every literal clear, no clause can switch on.
             return np.zeros_like(q)
-        # How many switched-on clauses each literal belongs to.
-        weight = self._Active(inside).astype(float) @ self._C
-        return self._normals.T @ (f_max * (delta - g) / delta * weight)
+        # Each literal of a switched-on clause, once (eq. 5.17).
+        on = (self._Active(inside).astype(float) @ self._C) > 0
+        return self._normals.T @ (f_max * (delta - g) / delta * on)

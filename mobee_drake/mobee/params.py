@@ -16,6 +16,10 @@ constraint forces (limits, constraints and collisions: 40).
 import dataclasses as dc
 import math
 
+import numpy as np
+
+from mobee_drake.mobee.barrier import BarrierParams
+
 
 @dc.dataclass
 class SquashParams:
@@ -26,12 +30,39 @@ class SquashParams:
 
 
 @dc.dataclass
-class JointDynamics:
-    """Per-joint overrides of the mass, damping and spring constants of eq. 5.7."""
+class JointParams:
+    """One joint's own values of MoBeE's per-joint constants; None keeps the robot-wide value.
 
-    mass: float = 1.0
-    damping: float = 50.0
-    stiffness: float = 50.0
+    Eq. 5.7's M, C, K, eq. 5.8's maximum ``m_i`` and slope ``k_i`` of each sigmoid, and eq.
+    5.12's spring length ``delta_i`` and force ``f_max,i`` of the joint's limits are all per
+    dimension in the text.
+    """
+
+    mass: float | None = None
+    damping: float | None = None
+    stiffness: float | None = None
+    spring_squash: SquashParams | None = None
+    config_squash: SquashParams | None = None
+    work_squash: SquashParams | None = None
+    collision_squash: SquashParams | None = None
+    limit_delta: float | None = None
+    limit_force: float | None = None
+
+
+SQUASHES = ("spring", "config", "work", "collision")
+
+
+@dc.dataclass(frozen=True)
+class PerJointValues:
+    """Every per-joint constant as an array over the controlled joints (in their order)."""
+
+    mass: np.ndarray
+    damping: np.ndarray
+    stiffness: np.ndarray
+    limit_delta: np.ndarray
+    limit_force: np.ndarray
+    # The sigmoids of eq. 5.8 by name (SQUASHES): (m, k), each an array.
+    squash: dict[str, tuple[np.ndarray, np.ndarray]]
 
 
 @dc.dataclass
@@ -42,8 +73,8 @@ class MobeeParams:
     mass: float = 1.0
     damping: float = 50.0
     stiffness: float = 50.0
-    # ... unless overridden here, by joint name.
-    joint_overrides: dict[str, JointDynamics] = dc.field(default_factory=dict)
+    # ... and every other per-joint constant below, unless a joint has its own value here.
+    joint_overrides: dict[str, JointParams] = dc.field(default_factory=dict)
 
     # L of the attractor spring -L(K(q - q*)) (eq. 5.7).
     spring_squash: SquashParams = dc.field(default_factory=lambda: SquashParams(20.0, 1.0))
@@ -62,43 +93,74 @@ class MobeeParams:
     # Linear constraints (eq. 5.15): spring length delta (rad of joint space) and f_max.
     constraint_delta: float = math.radians(10.0)
     constraint_force: float = 40.0
+    # The safety barrier (ours): no force, a client's or MoBeE's, closes a gap between solids
+    # faster than this (see mobee_drake/mobee/barrier.py).
+    barrier: BarrierParams = dc.field(default_factory=BarrierParams)
+
+    def _Values(self, override: JointParams | None = None) -> dict[str, float]:
+        """Every per-joint constant by name (``spring_squash.m``, ...), robot-wide or, where
+        ``override`` gives one, the joint's own."""
+        override = override or JointParams()
+        values = {}
+        for name in ("mass", "damping", "stiffness", "limit_delta", "limit_force"):
+            own = getattr(override, name)
+            values[name] = getattr(self, name) if own is None else own
+        for squash in SQUASHES:
+            own = getattr(override, f"{squash}_squash")
+            chosen = getattr(self, f"{squash}_squash") if own is None else own
+            values[f"{squash}_squash.m"], values[f"{squash}_squash.k"] = chosen.m, chosen.k
+        return values
 
     def Validate(self, joints: list[str]) -> None:
         """Raises ValueError naming the parameter (and joint) whose value is out of range."""
-        positive = {
-            "mass": self.mass,
-            "stiffness": self.stiffness,
-            "collision_gain": self.collision_gain,
-            "limit_delta": self.limit_delta,
-            "limit_force": self.limit_force,
-            "constraint_delta": self.constraint_delta,
-            "constraint_force": self.constraint_force,
-        }
-        for name in ("spring", "config", "work", "collision"):
-            squash = getattr(self, f"{name}_squash")
-            positive[f"{name}_squash.m"] = squash.m
-            positive[f"{name}_squash.k"] = squash.k
-        for name, override in self.joint_overrides.items():
+        for name in self.joint_overrides:
             if name not in joints:
                 raise ValueError(
                     f"MoBeE parameters: joint_overrides names unknown joint '{name}'; "
                     "controlled joints are: " + ", ".join(joints)
                 )
-            positive[f"joint_overrides[{name}].mass"] = override.mass
-            positive[f"joint_overrides[{name}].stiffness"] = override.stiffness
-            if not (math.isfinite(override.damping) and override.damping >= 0):
+        robot_wide = {
+            "collision_gain": self.collision_gain,
+            "constraint_delta": self.constraint_delta,
+            "constraint_force": self.constraint_force,
+        }
+        scopes = [("", {**self._Values(), **robot_wide})] + [
+            (f"joint_overrides[{joint}].", self._Values(override))
+            for joint, override in self.joint_overrides.items()
+        ]
+        for prefix, values in scopes:
+            for name, value in values.items():
+                low_ok = value >= 0 if name == "damping" else value > 0
+                if not (math.isfinite(value) and low_ok):
+                    bound = ">= 0" if name == "damping" else "> 0"
+                    raise ValueError(
+                        f"MoBeE parameters: {prefix}{name} must be {bound}, got {value}"
+                    )
+            # The barrier's condition: bounded speeds (docs/mobee.md, "The safety guarantee").
+            if self.barrier.enabled and values["damping"] <= 0:
                 raise ValueError(
-                    f"MoBeE parameters: joint_overrides[{name}].damping must be >= 0, "
-                    f"got {override.damping}"
+                    f"MoBeE parameters: {prefix}damping must be > 0 while the safety barrier is "
+                    "on (without damping speeds are unbounded and a solid may cross its field "
+                    f"in one period), got {values['damping']}"
                 )
-        for name, value in positive.items():
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"MoBeE parameters: {name} must be > 0, got {value}")
-        if not (math.isfinite(self.damping) and self.damping >= 0):
-            raise ValueError(f"MoBeE parameters: damping must be >= 0, got {self.damping}")
+        for error in self.barrier.Errors():
+            raise ValueError(f"MoBeE parameters: {error}")
 
-    def PerJoint(self, joints: list[str]) -> tuple[list[float], list[float], list[float]]:
-        """The mass, damping and stiffness of each joint, in the order of ``joints``."""
-        default = JointDynamics(self.mass, self.damping, self.stiffness)
-        rows = [self.joint_overrides.get(name, default) for name in joints]
-        return ([r.mass for r in rows], [r.damping for r in rows], [r.stiffness for r in rows])
+    def PerJoint(self, joints: list[str]) -> PerJointValues:
+        """Every per-joint constant for ``joints``, in their order."""
+        rows = [self._Values(self.joint_overrides.get(joint)) for joint in joints]
+
+        def Column(name: str) -> np.ndarray:
+            return np.array([row[name] for row in rows], dtype=float)
+
+        return PerJointValues(
+            mass=Column("mass"),
+            damping=Column("damping"),
+            stiffness=Column("stiffness"),
+            limit_delta=Column("limit_delta"),
+            limit_force=Column("limit_force"),
+            squash={
+                squash: (Column(f"{squash}_squash.m"), Column(f"{squash}_squash.k"))
+                for squash in SQUASHES
+            },
+        )

@@ -8,6 +8,7 @@ from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem, ValueProducer
 from pydrake.systems.primitives import MatrixGain
 
+from mobee_drake.mobee.barrier import BarrierForce, StepModel
 from mobee_drake.mobee.constraints import ClauseSet
 from mobee_drake.mobee.fields import (
     NO_FIELD_PAIRS,
@@ -22,8 +23,18 @@ from mobee_drake.mobee.squash import Squash
 from mobee_drake.robots.controlled_robot import ControlledRobot
 from mobee_drake.robots.overlay import MarkerStates, RobotOverlay
 
-# The force terms of eq. 5.7, in the order of the rows of the force cache; "total" is their sum.
-FORCE_TERMS = ("spring", "damping", "f_lim", "f_cst", "f_coll", "f_config", "f_work")
+# The force terms of eq. 5.7 and the safety barrier (ours; :mod:`mobee_drake.mobee.barrier`), in
+# the order of the rows of the force cache; "total" is their sum.
+FORCE_TERMS = (
+    "spring",
+    "damping",
+    "f_lim",
+    "f_cst",
+    "f_coll",
+    "f_config",
+    "f_work",
+    "f_barrier",
+)
 
 
 def _WithTotal(terms: np.ndarray) -> np.ndarray:
@@ -73,8 +84,10 @@ class Mobee(LeafSystem):
     ``M q'' = total``):
 
     - ``spring`` = -L(K(q - q*)), ``damping`` = -C q', ``f_lim``, ``f_cst``, ``f_coll``,
-      ``f_config``, ``f_work``, and ``total``, their sum; ``forces`` (8n) all eight, in that
-      order, for loggers.
+      ``f_config``, ``f_work``, the safety barrier ``f_barrier`` (ours: zero unless the others
+      would close a gap between solids too fast in the next period; needs ``step``, see
+      :mod:`mobee_drake.mobee.barrier`), and ``total``, their sum; ``forces`` (9n) all nine,
+      in that order, for loggers.
     - ``marker_positions`` (3m) and ``marker_directions`` (3m): in world, marker after marker.
     - ``marker_jacobians`` (3mn): the translational Jacobians dp_WM/dq, marker after marker, each
       3 x n in row-major order (reshape with ``(m, 3, n)``).
@@ -84,7 +97,8 @@ class Mobee(LeafSystem):
       witness points in their geometries' frames): cheaper, for monitors that run every step.
 
     The robot's kinematics are evaluated in a plant context held in a cache entry; the system
-    keeps no state of its own.
+    keeps no state of its own. ``step`` says how the next period integrates ``total`` (the
+    station gives it); without it there is no barrier.
     """
 
     def __init__(
@@ -94,9 +108,11 @@ class Mobee(LeafSystem):
         *,
         joints: list[str],
         params: MobeeParams | None = None,
+        step: StepModel | None = None,
     ):
         super().__init__()
         self._plant = plant
+        self._step = step
         self._params = params = params or MobeeParams()
         self._joints = list(joints)
         n = len(self._joints)
@@ -104,9 +120,16 @@ class Mobee(LeafSystem):
         self._robot = controlled = ControlledRobot.Of(plant, robot, self._joints, "MoBeE")
         self._q_index, self._v_index = controlled.q_index, controlled.v_index
         self._q_min, self._q_max = controlled.lower, controlled.upper
-        mass, damping, stiffness = (np.array(x) for x in params.PerJoint(self._joints))
-        self._mass, self._damping, self._stiffness = mass, damping, stiffness
-        self._limits = JointLimits(self._q_min, self._q_max, params.limit_delta, params.limit_force)
+        per_joint = params.PerJoint(self._joints)
+        mass, damping = per_joint.mass, per_joint.damping
+        self._mass, self._damping, self._stiffness = mass, damping, per_joint.stiffness
+        self._squash = per_joint.squash  # eq. 5.8's (m_i, k_i) of each sigmoid
+        self._barrier = params.barrier.enabled and step is not None
+        if self._barrier:
+            self._step_gain = step.Gain(mass, damping)
+        self._limits = JointLimits(
+            self._q_min, self._q_max, per_joint.limit_delta, per_joint.limit_force
+        )
         self._clauses = ClauseSet(
             robot.overlay.clauses, self._joints, robot.frozen_joints, source="MoBeE"
         )
@@ -244,6 +267,7 @@ class Mobee(LeafSystem):
         robot: RobotOverlay,
         joints: list[str],
         params: MobeeParams | None = None,
+        step: StepModel | None = None,
         name: str = "mobee",
     ) -> "Mobee":
         """Adds MoBeE to ``builder`` and connects its state and geometry query.
@@ -251,7 +275,9 @@ class Mobee(LeafSystem):
         The state comes from ``plant``'s state output through a selector of ``joints``; the
         attractor and the client's forces are left for the caller to connect or fix.
         """
-        mobee = builder.AddNamedSystem(name, Mobee(plant, robot, joints=joints, params=params))
+        mobee = builder.AddNamedSystem(
+            name, Mobee(plant, robot, joints=joints, params=params, step=step)
+        )
         joint_indices = [plant.GetJointByName(j, robot.instance).index() for j in joints]
         selector = builder.AddNamedSystem(
             f"{name}_state_selector", MatrixGain(plant.MakeStateSelectorMatrix(joint_indices))
@@ -357,23 +383,23 @@ class Mobee(LeafSystem):
             )
         )
 
-    def _CollisionForce(self, plant_context, pairs: FieldPairs) -> np.ndarray:
-        """The unsquashed sum of eq. 5.11 over the controlled joints: for each pair, the force
-        gain x field penetration along the separating direction at the witness point of the
-        robot geometry, and its opposite at the other witness point when that is the robot's too.
-        """
-        f_W = (self._params.collision_gain * (pairs.margin - pairs.distance))[
-            :, None
-        ] * pairs.nhat_BA_W
+    def _FieldNormals(self, plant_context, pairs: FieldPairs) -> np.ndarray:
+        """(k, n): each pair's generalized normal over the controlled joints, the gradient of
+        its signed distance (``d' = n . v``): the separating direction at the robot geometry's
+        witness point, projected by its Jacobian, less the same at the other witness point when
+        that is the robot's too (a self-collision)."""
         project, frames = self._project, self._geometry_frames
-        generalized = np.zeros(self._plant.num_velocities())
-        for g, p_GC, f in zip(pairs.geometry_A, pairs.p_ACa, f_W):
-            generalized += project(plant_context, frames[g], p_GC, f)
-        for i in np.flatnonzero(pairs.b_is_robot):  # A self-collision pushes both bodies apart.
-            generalized -= project(
-                plant_context, frames[pairs.geometry_B[i]], pairs.p_BCb[i], f_W[i]
+        normals = np.array(
+            [
+                project(plant_context, frames[g], p_GC, nhat)
+                for g, p_GC, nhat in zip(pairs.geometry_A, pairs.p_ACa, pairs.nhat_BA_W)
+            ]
+        )
+        for i in np.flatnonzero(pairs.b_is_robot):
+            normals[i] -= project(
+                plant_context, frames[pairs.geometry_B[i]], pairs.p_BCb[i], pairs.nhat_BA_W[i]
             )
-        return generalized[self._v_index]
+        return normals[:, self._v_index]
 
     def _CalcForces(self, context, value) -> None:
         p = self._params
@@ -381,26 +407,25 @@ class Mobee(LeafSystem):
         q_star = self._attractor_entry.Eval(context)
         terms = value.get_mutable_value()
 
-        terms[0] = -Squash(self._stiffness * (q - q_star), p.spring_squash.m, p.spring_squash.k)
+        terms[0] = -Squash(self._stiffness * (q - q_star), *self._squash["spring"])
         terms[1] = -self._damping * v
         terms[2] = self._limits.Force(q)
         terms[3] = self._clauses.Force(q, p.constraint_delta, p.constraint_force)
 
         pairs = self._field_pairs_entry.Eval(context)
+        normals = None
         if len(pairs):
-            plant_context = self._plant_context_entry.Eval(context)
-            terms[4] = Squash(
-                self._CollisionForce(plant_context, pairs),
-                p.collision_squash.m,
-                p.collision_squash.k,
-            )
+            normals = self._FieldNormals(self._plant_context_entry.Eval(context), pairs)
+            # Eq. 5.11: the gain times the field penetration along each pair's normal, summed.
+            collision = (p.collision_gain * (pairs.margin - pairs.distance)) @ normals
+            terms[4] = Squash(collision, *self._squash["collision"])
         else:
             terms[4] = 0.0
 
         if self._config_force_port.HasValue(context):
             f_q = self._config_force_port.Eval(context)
             self._CheckFinite("config_force", f_q, self._joints)
-            terms[5] = Squash(f_q, p.config_squash.m, p.config_squash.k)
+            terms[5] = Squash(f_q, *self._squash["config"])
         else:
             terms[5] = 0.0
 
@@ -424,7 +449,20 @@ class Mobee(LeafSystem):
                     )
                     for i in loaded
                 )
-                terms[6] = Squash(generalized[self._v_index], p.work_squash.m, p.work_squash.k)
+                terms[6] = Squash(generalized[self._v_index], *self._squash["work"])
+
+        terms[7] = 0.0
+        if self._barrier and normals is not None:
+            terms[7] = BarrierForce(
+                normals,
+                pairs.distance,
+                v,
+                terms[:7].sum(axis=0),
+                self._mass,
+                self._step_gain,
+                self._step.period,
+                p.barrier,
+            )
 
     def _CalcMarkerPoses(self, context, value) -> None:
         MarkerStates(

@@ -23,8 +23,8 @@ What moves the robot (``StationConfig.mover``):
     ``time_step`` and held in between.
 
 The diagram exports ``robot_state`` ((q, v) of MoBeE's joints, whichever robot moves),
-``attractor`` (MoBeE's q*), MoBeE's ``marker_positions`` and ``field_pairs``, and takes
-``config_force`` and, unless the client sets them, ``attractor`` and ``marker_forces`` as inputs.
+``attractor`` (MoBeE's q*), MoBeE's ``marker_positions`` and ``field_pairs``, and takes,
+unless the client sets them, ``attractor``, ``config_force`` and ``marker_forces`` as inputs.
 """
 
 import dataclasses as dc
@@ -43,6 +43,7 @@ from pydrake.systems.primitives import (
 )
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
+from mobee_drake.mobee.barrier import StepModel
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.mobee.reflex import ReflexController
 from mobee_drake.mobee.system import Mobee
@@ -110,8 +111,14 @@ def _AddMobee(
     """One robot's MoBeE, what moves it (its virtual dynamics, eq. 5.7, or MoBeE 1.0's reflex
     controller, whose command input the caller connects) and the map of its state into the
     plant's; returns MoBeE, the mover, the selector matrix and its gain system."""
+    # How the next period integrates MoBeE's total, for its safety barrier (MoBeE 1.0's reflex
+    # moves the robot by itself, without MoBeE 2.0's total).
+    step = None
+    if not isinstance(mover_config, Reflex):
+        force_controlled = isinstance(mover_config, Dynamic) and mover_config.control == "force"
+        step = StepModel(period=time_step, implicit_damping=not force_controlled)
     mobee = builder.AddNamedSystem(
-        f"{prefix}mobee", Mobee(plant, robot, joints=joints, params=params)
+        f"{prefix}mobee", Mobee(plant, robot, joints=joints, params=params, step=step)
     )
     builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
     if isinstance(mover_config, Reflex):
@@ -126,12 +133,12 @@ def _AddMobee(
         )
         builder.Connect(mobee.GetOutputPort("field_pairs"), mover.GetInputPort("field_pairs"))
     else:
-        _, damping, _ = params.PerJoint(joints)
+        damping = params.PerJoint(joints).damping
         mover = builder.AddNamedSystem(
             f"{prefix}virtual_dynamics",
             VirtualDynamics(
                 mass=mobee.mass,
-                damping=np.array(damping),
+                damping=damping,
                 period=time_step,
                 initial_positions=mobee.home,
             ),
@@ -255,7 +262,7 @@ def _ConnectClient(
     builder: DiagramBuilder, client: ClientPorts | None, mobee: Mobee, mover, reflex: bool
 ) -> tuple[OutputPort, OutputPort | str]:
     """Wires the client's ports into MoBeE (and MoBeE 1.0's mover); without a client, the
-    attractor and the marker forces are inputs of the diagram. Returns the attractor's port and
+    attractor and the client's forces are inputs of the diagram. Returns the attractor's port and
     the marker forces' port or diagram input name."""
     if client is None:
         attractor_input = builder.AddNamedSystem("attractor_input", PassThrough(len(mobee.joints)))
@@ -266,6 +273,10 @@ def _ConnectClient(
     builder.Connect(attractor, mobee.GetInputPort("attractor"))
     if reflex:  # MoBeE 1.0: the attractor is the position move command.
         builder.Connect(attractor, mover.GetInputPort("command"))
+    if client is None or client.config_force is None:
+        builder.ExportInput(mobee.GetInputPort("config_force"), "config_force")
+    else:
+        builder.Connect(client.config_force, mobee.GetInputPort("config_force"))
     if client is None or client.marker_forces is None:
         builder.ExportInput(mobee.GetInputPort("marker_forces"), "marker_forces")
         return attractor, "marker_forces"
@@ -312,8 +323,7 @@ def MakeMobeeStation(
         builder, plant, scene_graph, robot, joints, config.mobee, config.time_step, mover_config
     )
     # The client's forces (eq. 5.9-5.10) are inputs of the diagram, for scripts and supervisors
-    # (unfixed, they are zero), unless the client sets the marker forces.
-    builder.ExportInput(mobee.GetInputPort("config_force"), "config_force")
+    # (unfixed, they are zero), unless the client sets them (see _ConnectClient).
     companion_positions = _AddCompanions(builder, plant, scene_graph, world, config, companions)
     if isinstance(mover_config, Dynamic):
         from_plant = builder.AddNamedSystem("from_plant_state", MatrixGain(selector.T))

@@ -15,7 +15,8 @@ column                    unit         what
 ``q_star.<joint>``        rad          the attractor q*
 ``force.<term>``          M rad/s^2    the norm of each force of eq. 5.7 (``spring``,
                                        ``damping``, ``f_lim``, ``f_cst``, ``f_coll``,
-                                       ``f_config``, ``f_work``) and of their ``total``;
+                                       ``f_config``, ``f_work``), of the safety barrier
+                                       (``f_barrier``) and of their ``total``;
                                        with ``full_forces``, ``force.<term>.<joint>``
 ``marker.<name>.<x|y|z>`` m            each marker's position in world
 ``field_pairs``           count        pairs of geometry inside their fields

@@ -43,11 +43,13 @@ class StationParts:
 @dc.dataclass
 class ClientPorts:
     """What a client offers the station: its system (a typed handle for scripts), the attractor
-    q* of MoBeE's joints, and optionally the forces on MoBeE's markers (eq. 5.10)."""
+    q* of MoBeE's joints, and optionally the forces on MoBeE's markers (eq. 5.10) and its
+    configuration-space force (eq. 5.9)."""
 
     system: LeafSystem
     attractor: OutputPort
     marker_forces: OutputPort | None = None
+    config_force: OutputPort | None = None
 
 
 class ClientConfig(Protocol):
