@@ -30,7 +30,7 @@ from mobee_drake.station.config import DataLog, StationConfig, StationConfigErro
 from mobee_drake.station.executor import StateActionAttractor
 from mobee_drake.station.runner import RunStation, RunSummary
 from mobee_drake.station.viewer import RecordingMeshcat
-from mobee_drake.yaml_io import LoadYamlFile, YamlFileError
+from mobee_drake.yaml_io import CheckYamlStructure, LoadYamlFile, YamlFileError
 
 # The longest run a scenario may ask for (s; our choice: about 116 simulated days, far beyond any
 # experiment of the sources, and short enough that a typo like 1e308 is caught, not simulated).
@@ -86,14 +86,24 @@ def LoadScenario(
     scenario = LoadYamlFile(schema=Scenario, filename=filename, child_name=scenario_name)
     ValidateScenario(scenario, str(filename))
     for text in [overrides] if isinstance(overrides, str) else overrides or []:
+        source = f"overrides '{_OneLine(text)}'"
         try:
+            CheckYamlStructure(text, source)  # (alias bombs, absurd nesting)
             scenario = yaml_load_typed(schema=Scenario, data=text, defaults=scenario)
+        except YamlFileError:
+            raise
         except yaml.YAMLError as e:
-            raise YamlFileError(f"overrides '{text}': invalid YAML: {e.problem}") from None
+            raise YamlFileError(f"{source}: invalid YAML: {e.problem}") from None
         except (RuntimeError, ValueError, TypeError) as e:
-            raise YamlFileError(f"overrides '{text}': {e}") from e
-        ValidateScenario(scenario, f"overrides '{text}'")
+            raise YamlFileError(f"{source}: {e}") from e
+        ValidateScenario(scenario, source)
     return scenario
+
+
+def _OneLine(text: str, limit: int = 80) -> str:
+    """``text`` on one line, cut short: for messages that quote it."""
+    text = text.strip().replace("\n", "\\n")
+    return text if len(text) <= limit else text[:limit] + "..."
 
 
 def ResumableConfiguration(scenario: Scenario) -> str:

@@ -5,6 +5,12 @@ schema", "could not convert string to float: 'x'") but not *where*. Every file t
 goes through :func:`LoadYamlFile`, which re-raises such errors as :class:`YamlFileError`
 carrying the file name and, when the offending key or value can be found in the text, its
 line number.
+
+Before Drake reads a file, :func:`CheckYamlStructure` walks its events (no recursion, no alias
+expanded) and refuses nesting deeper than :data:`MAX_YAML_DEPTH` (PyYAML's composer and Drake's
+reader recurse, so a deeper file would end in a ``RecursionError``) and aliases that repeat more
+than :data:`MAX_ALIAS_NODES` nodes in all (a "billion laughs" file: a few lines whose nested
+aliases expand to billions of nodes, which Drake's reader would walk for hours).
 """
 
 import pathlib
@@ -16,6 +22,49 @@ import yaml
 
 class YamlFileError(ValueError):
     """A YAML file that does not match its schema; the message names the file and line."""
+
+
+# Nesting deeper than this is refused (our schemas nest a few levels).
+MAX_YAML_DEPTH = 100
+# Aliases (``*name``) may repeat at most this many nodes in all.
+MAX_ALIAS_NODES = 10_000
+
+
+def CheckYamlStructure(text: str, source: str) -> None:
+    """Refuses nesting deeper than :data:`MAX_YAML_DEPTH` and aliases that repeat more than
+    :data:`MAX_ALIAS_NODES` nodes, reading the parser's events one at a time (linear time).
+
+    Raises:
+        YamlFileError: naming ``source`` and the line; yaml.MarkedYAMLError for invalid YAML.
+    """
+    sizes: dict[str, int] = {}  # an anchor's node count, its aliases expanded
+    open_nodes: list[list] = []  # [anchor, node count so far] of each open collection
+    repeated = 0
+    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        line = event.start_mark.line + 1
+        if isinstance(event, yaml.CollectionStartEvent):
+            if len(open_nodes) >= MAX_YAML_DEPTH:
+                raise YamlFileError(f"{source}:{line}: nested deeper than {MAX_YAML_DEPTH} levels")
+            open_nodes.append([event.anchor, 1])
+            continue
+        if isinstance(event, yaml.ScalarEvent):
+            anchor, size = event.anchor, 1
+        elif isinstance(event, yaml.AliasEvent):
+            anchor, size = None, sizes.get(event.anchor, 1)
+            repeated += size
+            if repeated > MAX_ALIAS_NODES:
+                raise YamlFileError(
+                    f"{source}:{line}: aliases repeat more than {MAX_ALIAS_NODES} nodes (here "
+                    f"*{event.anchor}); write the data out instead"
+                )
+        elif isinstance(event, yaml.CollectionEndEvent):
+            anchor, size = open_nodes.pop()
+        else:
+            continue
+        if anchor is not None:
+            sizes[anchor] = size
+        if open_nodes:
+            open_nodes[-1][1] += size
 
 
 def LineOf(text: str, names: list[str]) -> int | None:
@@ -65,10 +114,13 @@ def LoadYamlFile(*, schema, filename, child_name: str | None = None, defaults=No
     ):
         raise YamlFileError(f"{path}: empty (write {{}} for all the defaults)")
     try:
+        CheckYamlStructure(text, str(path))
         kwargs = dict(schema=schema, data=text, child_name=child_name)
         if defaults is not None:
             kwargs["defaults"] = defaults
         return yaml_load_typed(**kwargs)
+    except YamlFileError:
+        raise
     except yaml.MarkedYAMLError as e:
         mark = e.problem_mark
         raise YamlFileError(f"{path}:{mark.line + 1}: invalid YAML: {e.problem}") from e

@@ -1,14 +1,73 @@
-"""Tries, as a new user would, the bad inputs and misuses of issue 18 on the command line and
-prints what each ends in (exit code and the last line it printed), as a markdown table.
+"""Tries, as a new user would, the bad inputs and misuses of issue 18 on the command line, and
+the malformed robot (MoBeE XML), overlay and scenario files of issue 5, and prints what each ends
+in (exit code and the last line it printed), as a markdown table.
 
 Run: ``python scripts/try_bad_inputs.py [FOLDER]`` (FOLDER: where to make the trials' files; a
-temporary folder by default). About a minute: each trial starts the command afresh.
+temporary folder by default). About two minutes: each trial starts the command afresh.
 """
 
 import pathlib
 import subprocess
 import sys
 import tempfile
+
+
+def _Tree(body: str) -> str:
+    """A MoBeE XML robot file (bodypart 'arm') around ``body``."""
+    return (
+        '<?xml version="1.0"?>\n<ZeroPositionKinematicTree version="1.0" robotName="r">\n'
+        f'<bodypart name="arm">\n{body}\n</bodypart>\n</ZeroPositionKinematicTree>\n'
+    )
+
+
+def _Joint(attributes: str = "", inside: str = "") -> str:
+    return (
+        f'<motor minPos="0" maxPos="10"><joint z="1" minPos="0" maxPos="10" {attributes}>'
+        f"{inside}</joint></motor>"
+    )
+
+
+# A valid arm for the scenario 'katana' (which draws the trail of the marker 'wrist').
+ARM = '<link x="1" radius="0.05"><marker name="wrist"/>{}</link>'
+
+
+# Malformed robot files (issue 5, part 4): what each is, its content.
+ROBOT_FILES = {
+    'z="1 0"': _Tree('<link z="1 0"/>'),
+    'z="0_19"': _Tree('<link z="0_19"/>'),
+    "an unknown element in <constraint>": _Tree(
+        _Joint() + '<constraintList><constraint a="1" q="0" b="1"><foo/></constraint>'
+        "</constraintList>"
+    ),
+    "a <link> in a <box>": _Tree(
+        '<link z="1"><box width="1" height="1" depth="1"><link z="1"/></box></link>'
+    ),
+    "ISO-8859-1, undeclared": _Tree("<!-- caf\u00e9 -->").encode("latin-1"),
+    "no joints (valid XML)": _Tree('<link z="1" radius="0.05"/>'),
+    "ISO-8859-1, declared (valid)": _Tree("<!-- caf\u00e9 -->" + _Joint("", ARM.format("")))
+    .replace('<?xml version="1.0"?>', '<?xml version="1.0" encoding="ISO-8859-1"?>')
+    .encode("latin-1"),
+    "nesting 1000 deep": _Tree('<link z="1">' * 1000 + "</link>" * 1000),
+    'a joint named "a<b"': _Tree(_Joint('name="a&lt;b"')),
+    'a joint named "a::b"': _Tree(_Joint('name="a::b"')),
+    'a joint named ""': _Tree(_Joint('name=""')),
+    'a joint named "base"': _Tree(_Joint('name="base"')),
+    "an axis of 1e308": _Tree(_Joint().replace('z="1"', 'z="1e308"')),
+    "limits of +-1e308": _Tree(
+        _Joint().replace('minPos="0" maxPos="10" ', 'minPos="-1e308" maxPos="1e308" ', 1)
+    ),
+    'version="2.0"': _Tree("").replace('version="1.0" r', 'version="2.0" r'),
+    "20,000 markers (valid)": _Tree(
+        _Joint("", ARM.format("".join(f'<marker name="m{i}"/>' for i in range(20000))))
+    ),
+}
+
+
+def _Bomb(key: str) -> str:
+    """A 'billion laughs' YAML file (9^8 nodes) under ``key``."""
+    lines = ['_l0: &l0 ["x", "x", "x", "x", "x", "x", "x", "x", "x"]']
+    lines += [f"_l{i}: &l{i} [" + ", ".join([f"*l{i - 1}"] * 9) + "]" for i in range(1, 8)]
+    return "\n".join([*lines, f"{key}: [" + ", ".join(["*l7"] * 9) + "]"]) + "\n"
 
 
 def Trials(folder: pathlib.Path) -> list[tuple[str, list[str]]]:
@@ -22,8 +81,20 @@ def Trials(folder: pathlib.Path) -> list[tuple[str, list[str]]]:
         ("binary.yaml", b"\x00\x01"),
         ("latin1.yaml", b"\xff\xfe duration: 3"),
         ("empty.yaml", b""),
+        ("bomb_scenario.yaml", _Bomb("objects").encode()),
+        ("bomb_overlay.yaml", _Bomb("exclude").encode()),
+        ("deep_scenario.yaml", ("duration: " + "[" * 5000 + "]" * 5000).encode()),
     ):
         (folder / name).write_bytes(data)
+    robot_trials = []
+    for i, (what, data) in enumerate(ROBOT_FILES.items()):
+        path = folder / f"robot_{i}.xml"
+        path.write_bytes(data if isinstance(data, bytes) else data.encode())
+        robot_trials.append((
+            f"robot file: {what}",
+            ["run", "katana", "--duration", "0.1", "--no-meshcat", "--no-log",
+             "--set", f"{{robot: !ZeroPositionConfig {{file: {path}}}}}"],
+        ))  # fmt: skip
     run = ["run", "explore_hypercube", "--no-meshcat"]
     checkpoint = str(folder / "run")
     return [
@@ -64,6 +135,10 @@ def Trials(folder: pathlib.Path) -> list[tuple[str, list[str]]]:
         ("saggriac into a user's folder", ["experiment", "saggriac", "--smoke", "--experiments", "1", "--output", str(thesis_folder)]),
         ("saggriac smoke battery", ["experiment", "saggriac", "--smoke", "--experiments", "1", "--seeds", "1", "--output", str(folder / "sagg")]),
         ("the same battery, its runs with other settings", ["experiment", "saggriac", "--experiments", "1", "--seeds", "1", "--budget-exp1", "600", "--checkpoints", "3", "--output", str(folder / "sagg")]),
+        *robot_trials,
+        ("a 'billion laughs' scenario file", ["run", str(folder / "bomb_scenario.yaml")]),
+        ("a scenario file nested 5000 deep", ["run", str(folder / "deep_scenario.yaml")]),
+        ("a 'billion laughs' overlay file", ["run", "reach_around_ball", "--duration", "0.1", "--no-meshcat", "--no-log", "--set", f"{{robot: {{overlay: {folder / 'bomb_overlay.yaml'}}}}}"]),
     ]  # fmt: skip
 
 

@@ -20,7 +20,7 @@ JOINTS = ["joint1", "joint2", "joint3"]
 class ArmDiagram:
     """The arm, optional fixed boxes and MoBeE, with the plant's positions set by the test."""
 
-    def __init__(self, boxes=(), params=None):
+    def __init__(self, boxes=(), params=None, joints=JOINTS, couplings=()):
         builder = DiagramBuilder()
         self.plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
         self.robot = AddRobotWithOverlay(
@@ -28,7 +28,8 @@ class ArmDiagram:
             scene_graph,
             model_file=MODELS / "three_link_arm.urdf",
             overlay_file=MODELS / "three_link_arm_overlay.yaml",
-            controlled_joints=JOINTS,
+            controlled_joints=joints,
+            couplings=couplings,
         )
         world = LiveWorld(self.plant, scene_graph)
         for i, (size, center) in enumerate(boxes):
@@ -42,7 +43,7 @@ class ArmDiagram:
             plant=self.plant,
             scene_graph=scene_graph,
             robot=self.robot,
-            joints=JOINTS,
+            joints=list(joints),
             params=self.params,
         )
         self.diagram = builder.Build()

@@ -32,6 +32,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from mobee_drake.robots.couplings import JointCoupling
 from mobee_drake.robots.overlay import Clause
 
 
@@ -43,6 +44,8 @@ class ClauseSet:
         joints: names of the controlled joints, in the order of ``q``.
         frozen_joints: angles (rad) of joints welded in place; their terms become constants.
         source: what to name in error messages (the overlay file).
+        followers: joints that follow controlled ones (robots/couplings.py); a term on one
+            becomes a term on its leader (times the ratio) and a constant.
 
     A literal on frozen joints only is a constant: true (the clause can never switch on, so it is
     dropped) or false (it never stops the clause from switching on, so it is left out of it).
@@ -55,9 +58,11 @@ class ClauseSet:
         joints: Sequence[str],
         frozen_joints: Mapping[str, float] | None = None,
         source: str = "overlay",
+        followers: Sequence[JointCoupling] = (),
     ):
         column = {name: i for i, name in enumerate(joints)}
         frozen = {name: np.degrees(angle) for name, angle in (frozen_joints or {}).items()}
+        following = {c.follower: c for c in followers}
         rows, offsets, membership, self.names = [], [], [], []
         index: dict[tuple, int] = {}  # (a, b) of each distinct literal -> its row
         for clause in clauses:
@@ -66,7 +71,11 @@ class ClauseSet:
                 a, b = np.zeros(len(joints)), literal.offset
                 for name, coefficient in literal.coefficients.items():
                     if name in column:
-                        a[column[name]] = coefficient
+                        a[column[name]] += coefficient
+                    elif name in following:  # c q_f = c ratio q_leader + c offset (degrees)
+                        coupling = following[name]
+                        a[column[coupling.leader]] += coefficient * coupling.ratio
+                        b += coefficient * np.degrees(coupling.offset)
                     elif name in frozen:
                         b += coefficient * frozen[name]
                     else:

@@ -21,6 +21,7 @@ from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.mobee.projection import PointForceProjector
 from mobee_drake.mobee.squash import Squash
 from mobee_drake.robots.controlled_robot import ControlledRobot
+from mobee_drake.robots.couplings import JointCoupling
 from mobee_drake.robots.overlay import MarkerStates, RobotOverlay
 
 # The force terms of eq. 5.7 and the safety barrier (ours; :mod:`mobee_drake.mobee.barrier`), in
@@ -118,7 +119,9 @@ class Mobee(LeafSystem):
         n = len(self._joints)
         params.Validate(self._joints)
         self._robot = controlled = ControlledRobot.Of(plant, robot, self._joints, "MoBeE")
-        self._q_index, self._v_index = controlled.q_index, controlled.v_index
+        # Generalized forces over the plant's velocities onto the controlled joints (their
+        # followers' included: robots/couplings.py).
+        self._to_joints = controlled.velocity_map
         self._q_min, self._q_max = controlled.lower, controlled.upper
         per_joint = params.PerJoint(self._joints)
         mass, damping = per_joint.mass, per_joint.damping
@@ -131,7 +134,11 @@ class Mobee(LeafSystem):
             self._q_min, self._q_max, per_joint.limit_delta, per_joint.limit_force
         )
         self._clauses = ClauseSet(
-            robot.overlay.clauses, self._joints, robot.frozen_joints, source="MoBeE"
+            robot.overlay.clauses,
+            self._joints,
+            robot.frozen_joints,
+            source="MoBeE",
+            followers=controlled.followers,
         )
         self._default_positions = plant.GetPositions(plant.CreateDefaultContext())
         self._home = controlled.home
@@ -324,6 +331,16 @@ class Mobee(LeafSystem):
             )
 
     @property
+    def followers(self) -> tuple[JointCoupling, ...]:
+        """The joints that follow the controlled ones (a motor's other joints)."""
+        return self._robot.followers
+
+    def PlantStateMap(self) -> tuple[np.ndarray, np.ndarray]:
+        """(S, s0) with ``x_plant = S [q; v] + s0`` for this robot's entries of the plant's state
+        (its controlled joints and the joints that follow them)."""
+        return self._robot.PlantStateMap(self._plant.num_positions())
+
+    @property
     def position_limits(self) -> tuple[np.ndarray, np.ndarray]:
         return self._q_min.copy(), self._q_max.copy()
 
@@ -365,8 +382,7 @@ class Mobee(LeafSystem):
     def _CalcPlantContext(self, context, value) -> None:
         plant_context = value.get_mutable_value()
         q, _ = self._ReadState(context)
-        positions = self._default_positions.copy()
-        positions[self._q_index] = q
+        positions = self._robot.PlantPositions(q, self._default_positions.copy())
         self._plant.SetPositions(plant_context, positions)
 
     def _CalcFieldPairs(self, context, value) -> None:
@@ -399,7 +415,7 @@ class Mobee(LeafSystem):
             normals[i] -= project(
                 plant_context, frames[pairs.geometry_B[i]], pairs.p_BCb[i], pairs.nhat_BA_W[i]
             )
-        return normals[:, self._v_index]
+        return normals @ self._to_joints
 
     def _CalcForces(self, context, value) -> None:
         p = self._params
@@ -449,7 +465,7 @@ class Mobee(LeafSystem):
                     )
                     for i in loaded
                 )
-                terms[6] = Squash(generalized[self._v_index], *self._squash["work"])
+                terms[6] = Squash(generalized @ self._to_joints, *self._squash["work"])
 
         terms[7] = 0.0
         if self._barrier and normals is not None:
@@ -478,7 +494,8 @@ class Mobee(LeafSystem):
         blocks = [
             self._plant.CalcJacobianTranslationalVelocity(
                 plant_context, JacobianWrtVariable.kV, body.body_frame(), marker.p_BM, world, world
-            )[:, self._v_index]
+            )
+            @ self._to_joints
             for marker, body in zip(self._markers, self._marker_bodies)
         ]
         output.SetFromVector(np.concatenate([b.ravel() for b in blocks]) if blocks else np.zeros(0))

@@ -79,7 +79,10 @@ class KinematicModel:
         self.position_index = self.robot.q_index
         self.lower, self.upper, self.home = self.robot.lower, self.robot.upper, self.robot.home
         self.clauses = ClauseSet(
-            self._overlay.overlay.clauses, self.joints, self._overlay.frozen_joints
+            self._overlay.overlay.clauses,
+            self.joints,
+            self._overlay.frozen_joints,
+            followers=self.robot.followers,
         )
         self.markers, self._marker_bodies = self.robot.markers, self.robot.marker_bodies
         self.marker_names = self.robot.marker_names
@@ -98,8 +101,7 @@ class KinematicModel:
 
     def SetPose(self, q: np.ndarray) -> None:
         """Puts the model in pose ``q`` (the controlled joints, rad)."""
-        positions = self.plant.GetPositions(self._plant_context)
-        positions[self.position_index] = q
+        positions = self.robot.PlantPositions(q, self.plant.GetPositions(self._plant_context))
         self.plant.SetPositions(self._plant_context, positions)
 
     def Evaluate(self, q: np.ndarray) -> PoseEvaluation:

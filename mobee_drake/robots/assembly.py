@@ -1,6 +1,7 @@
 """Adds a robot for MoBeE to a plant: root welded, uncontrolled joints welded, overlay applied."""
 
 from collections.abc import Callable, Iterable, Mapping
+import dataclasses as dc
 import pathlib
 
 import numpy as np
@@ -11,6 +12,7 @@ from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex, RevoluteJoint
 
+from mobee_drake.robots.couplings import Followers, JointCoupling
 from mobee_drake.robots.overlay import (
     ApplyOverlay,
     LoadOverlay,
@@ -30,12 +32,14 @@ def AddRobotWithOverlay(
     home: Mapping[str, float] | None = None,
     X_WRoot: RigidTransform | None = None,
     model_name: str | None = None,
+    couplings: tuple[JointCoupling, ...] = (),
 ) -> RobotOverlay:
     """Adds the robot of ``model_file`` (URDF or SDFormat) with its MoBeE overlay to ``plant``.
 
     The overlay's ``reference_link`` is the robot's root: unless the model already fixes it, it is
     welded to the world at ``X_WRoot``. Joints not in ``controlled_joints`` are welded at their
-    ``home`` angle (radians, zero by default). Must be called before ``plant.Finalize()``.
+    ``home`` angle (radians, zero by default), but for those that follow a controlled joint by
+    ``couplings`` (one motor driving several joints). Must be called before ``plant.Finalize()``.
 
     Raises:
         ValueError: naming the file and the element, for unknown joints or links, home angles
@@ -52,6 +56,7 @@ def AddRobotWithOverlay(
         X_WRoot=X_WRoot,
         model_source=model_file,
         overlay_source=str(overlay_file),
+        couplings=couplings,
     )
 
 
@@ -66,9 +71,11 @@ def AddModelWithOverlay(
     X_WRoot: RigidTransform | None,
     model_source: str,
     overlay_source: str,
+    couplings: tuple[JointCoupling, ...] = (),
 ) -> RobotOverlay:
     """:func:`AddRobotWithOverlay` for a model that ``add_model(plant)`` adds (to the plant and to
-    the scratch plant that finds the links' poses at zero) and an overlay already loaded."""
+    the scratch plant that finds the links' poses at zero) and an overlay already loaded; the
+    joints that follow a controlled one by ``couplings`` move with it (they are not welded)."""
     instance = add_model(plant)
     if not plant.HasBodyNamed(overlay.reference_link, instance):
         raise ValueError(
@@ -82,10 +89,16 @@ def AddModelWithOverlay(
     ):
         plant.WeldFrames(plant.world_frame(), root.body_frame(), X_WRoot or RigidTransform())
     reference = ZeroConfigurationPoses(add_model, overlay.reference_link)
+    controlled_joints = list(controlled_joints)
+    followers = Followers(couplings, controlled_joints, model_source)
     frozen = FreezeJoints(
-        plant, instance, keep=controlled_joints, home=home or {}, source=model_source
+        plant,
+        instance,
+        keep=controlled_joints + [c.follower for c in followers],
+        home=home or {},
+        source=model_source,
     )
-    return ApplyOverlay(
+    robot = ApplyOverlay(
         plant,
         scene_graph,
         instance,
@@ -94,6 +107,7 @@ def AddModelWithOverlay(
         frozen_joints=frozen,
         source=overlay_source,
     )
+    return dc.replace(robot, couplings=tuple(followers))
 
 
 def FreezeJoints(

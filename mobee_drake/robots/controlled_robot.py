@@ -1,13 +1,19 @@
 """One robot of a plant as its controllers see it: the joints they control (where those sit in
 the plant's position and velocity vectors, their limits and home angles) and the robot's markers
 with their bodies. MoBeE (:class:`~mobee_drake.mobee.system.Mobee`) and the NGIK kinematic model
-(:class:`~mobee_drake.ngik.kinematic_model.KinematicModel`) both look the robot up through it."""
+(:class:`~mobee_drake.ngik.kinematic_model.KinematicModel`) both look the robot up through it.
+
+A joint that follows a controlled one (:mod:`mobee_drake.robots.couplings`) is not a degree of
+freedom of its own: the maps below carry the controlled joints' (q, v) into the plant's with the
+followers set, and the plant's generalized forces back onto the controlled joints (the chain
+rule: a follower's force acts on its leader times the ratio)."""
 
 import dataclasses as dc
 
 import numpy as np
 from pydrake.multibody.plant import MultibodyPlant
 
+from mobee_drake.robots.couplings import CoupledPositions, Followers, JointCoupling
 from mobee_drake.robots.overlay import BodyMarker, RobotOverlay
 
 
@@ -28,6 +34,12 @@ class ControlledRobot:
     marker_bodies: tuple
     # Who reports an error ("MoBeE", "kinematic model").
     source: str
+    # The joints that follow controlled ones, and where all of them sit in the plant's vectors.
+    followers: tuple[JointCoupling, ...]
+    coupled: CoupledPositions
+    # v_plant = velocity_map @ v (nv x n): each controlled joint's column is 1 at its own velocity
+    # and the ratio at its followers'; its transpose carries generalized forces onto the joints.
+    velocity_map: np.ndarray
 
     @staticmethod
     def Of(
@@ -52,6 +64,10 @@ class ControlledRobot:
                 )
             found.append(plant.GetJointByName(name, robot.instance))
         q_index = np.array([j.position_start() for j in found], dtype=int)
+        followers = Followers(robot.couplings, joints, source)
+        coupled = CoupledPositions.Of(plant, robot.instance, joints, followers)
+        velocity_map = np.zeros((plant.num_velocities(), len(joints)))
+        velocity_map[coupled.velocity_rows] = coupled.P
         return ControlledRobot(
             joints=tuple(joints),
             q_index=q_index,
@@ -64,7 +80,29 @@ class ControlledRobot:
                 plant.GetBodyByName(m.body_name, robot.instance) for m in robot.markers
             ),
             source=source,
+            followers=tuple(followers),
+            coupled=coupled,
+            velocity_map=velocity_map,
         )
+
+    def PlantPositions(self, q: np.ndarray, positions: np.ndarray) -> np.ndarray:
+        """``positions`` (the plant's, modified) with the controlled joints at ``q`` and their
+        followers where they follow."""
+        coupled = self.coupled
+        positions[coupled.rows] = coupled.P @ q + coupled.p0
+        return positions
+
+    def PlantStateMap(self, num_positions: int) -> tuple[np.ndarray, np.ndarray]:
+        """(S, s0) with ``x_plant = S [q; v] + s0`` for the robot's entries of the plant's
+        state (every other entry zero): the controlled joints and their followers."""
+        nv, n = self.velocity_map.shape
+        coupled = self.coupled
+        S = np.zeros((num_positions + nv, 2 * n))
+        S[coupled.rows, :n] = coupled.P
+        S[num_positions:, n:] = self.velocity_map
+        s0 = np.zeros(num_positions + nv)
+        s0[coupled.rows] = coupled.p0
+        return S, s0
 
     @property
     def marker_names(self) -> list[str]:

@@ -22,6 +22,7 @@ from collections.abc import Callable, Mapping
 import dataclasses as dc
 import math
 import pathlib
+import re
 
 import numpy as np
 from pydrake.geometry import (
@@ -45,6 +46,7 @@ from pydrake.math import RigidTransform, RollPitchYaw, RotationMatrix
 from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import FixedOffsetFrame, FrameIndex, ModelInstanceIndex
 
+from mobee_drake.robots.couplings import JointCoupling
 from mobee_drake.yaml_io import LineOf, LoadYamlFile
 
 
@@ -132,19 +134,43 @@ class OverlayError(ValueError):
     """An overlay that is inconsistent with itself or with its robot."""
 
 
-def _Vector(where: str, what: str, values, *, nonzero: bool = False) -> np.ndarray:
+# The largest magnitude of a length (m), an angle (deg) or a constraint's coefficient or offset;
+# anything beyond is a typing error (and 1e308 would overflow a norm to inf or a unit to zero).
+MAX_MAGNITUDE = 1e6
+# Names of primitives and markers (and of everything a MoBeE XML file names): letters, digits,
+# '_', '-', '.'; never a Drake scope separator '::', nothing to escape in a model's text.
+_NAME = re.compile(r"[A-Za-z0-9_.\-]+")
+
+
+def NameProblem(name: str) -> str | None:
+    """Why ``name`` cannot name a part of a model, or None when it can."""
+    if not _NAME.fullmatch(name):
+        return f"{name!r} is not a name: use letters, digits, '_', '-' and '.'"
+    if name.startswith("__") or name == "world":
+        return f"{name!r} is reserved (SDFormat keeps 'world' and names starting with '__')"
+    return None
+
+
+def _Vector(where: Callable[[], str], what: str, values, *, nonzero: bool = False) -> np.ndarray:
+    """Three finite numbers within +-MAX_MAGNITUDE; ``where()`` names them in an error."""
     v = np.asarray(values, dtype=float)
     if v.shape != (3,) or not np.all(np.isfinite(v)):
-        raise OverlayError(f"{where}: {what} must be three finite numbers, got {values}")
+        raise OverlayError(f"{where()}: {what} must be three finite numbers, got {values}")
+    if np.max(np.abs(v)) > MAX_MAGNITUDE:
+        raise OverlayError(f"{where()}: {what} must be within +-{MAX_MAGNITUDE:g}, got {values}")
     if nonzero and np.linalg.norm(v) < 1e-12:
-        raise OverlayError(f"{where}: {what} must not be zero, got {values}")
+        raise OverlayError(f"{where()}: {what} must not be zero, got {values}")
     return v
 
 
-def _Positive(where: str, what: str, value: float, *, allow_zero: bool = False) -> float:
+def _Positive(
+    where: Callable[[], str], what: str, value: float, *, allow_zero: bool = False
+) -> float:
     if not (math.isfinite(value) and (value > 0 or (allow_zero and value == 0))):
         bound = ">= 0" if allow_zero else "> 0"
-        raise OverlayError(f"{where}: {what} must be {bound}, got {value}")
+        raise OverlayError(f"{where()}: {what} must be {bound}, got {value}")
+    if value > MAX_MAGNITUDE:
+        raise OverlayError(f"{where()}: {what} must be <= {MAX_MAGNITUDE:g}, got {value}")
     return value
 
 
@@ -159,12 +185,18 @@ def ValidateOverlay(overlay: Overlay, source: str = "overlay", text: str | None 
         line = LineOf(text, [name]) if text else None
         return f"{source}:{line}: '{name}'" if line else f"{source}: '{name}'"
 
-    _Positive(source, "default_field", overlay.default_field, allow_zero=True)
+    def At(name: str):
+        """Where ``name`` is, found only when an error is raised (LineOf reads the whole text)."""
+        return lambda: where(name)
+
+    _Positive(lambda: source, "default_field", overlay.default_field, allow_zero=True)
     names = set()
     for p in overlay.primitives:
-        w = where(p.name or "<unnamed primitive>")
+        w = At(p.name or "<unnamed primitive>")
         if not p.name or p.name in names:
-            raise OverlayError(f"{w}: every primitive needs a unique name")
+            raise OverlayError(f"{w()}: every primitive needs a unique name")
+        if problem := NameProblem(p.name):
+            raise OverlayError(f"{w()}: {problem}")
         names.add(p.name)
         shape = p.shape
         if isinstance(shape, Sphere):
@@ -187,31 +219,41 @@ def ValidateOverlay(overlay: Overlay, source: str = "overlay", text: str | None 
                 raise OverlayError(f"{where(name)}: exclusion names an unknown primitive")
     marker_names = set()
     for m in overlay.markers:
-        w = where(m.name or "<unnamed marker>")
+        w = At(m.name or "<unnamed marker>")
         if not m.name or m.name in marker_names:
-            raise OverlayError(f"{w}: every marker needs a unique name")
+            raise OverlayError(f"{w()}: every marker needs a unique name")
+        if problem := NameProblem(m.name):
+            raise OverlayError(f"{w()}: {problem}")
         marker_names.add(m.name)
         _Vector(w, "position", m.position)
         _Vector(w, "direction", m.direction, nonzero=True)
     for clause in overlay.clauses:
-        w = where(clause.name or "<unnamed clause>")
+        w = At(clause.name or "<unnamed clause>")
         if not clause.literals:
-            raise OverlayError(f"{w}: a clause needs at least one literal")
+            raise OverlayError(f"{w()}: a clause needs at least one literal")
         for literal in clause.literals:
             a = np.array(list(literal.coefficients.values()), dtype=float)
-            if a.size == 0 or not np.all(np.isfinite(a)) or not np.any(a != 0):
+            if (
+                a.size == 0
+                or not np.all(np.isfinite(a))
+                or not np.any(a != 0)
+                or np.max(np.abs(a)) > MAX_MAGNITUDE
+            ):
                 raise OverlayError(
-                    f"{w}: a literal needs finite, not all zero coefficients, got "
-                    f"{literal.coefficients}"
+                    f"{w()}: a literal needs finite, not all zero coefficients within "
+                    f"+-{MAX_MAGNITUDE:g}, got {literal.coefficients}"
                 )
-            if not math.isfinite(literal.offset):
-                raise OverlayError(f"{w}: offset must be finite, got {literal.offset}")
+            if not (math.isfinite(literal.offset) and abs(literal.offset) <= MAX_MAGNITUDE):
+                raise OverlayError(
+                    f"{w()}: offset must be finite and within +-{MAX_MAGNITUDE:g}, "
+                    f"got {literal.offset}"
+                )
 
 
 def LoadOverlay(filename: str | pathlib.Path) -> Overlay:
     """Loads and validates an overlay file (see ``models/icub_overlay.yaml``)."""
     overlay = LoadYamlFile(schema=Overlay, filename=filename)
-    ValidateOverlay(overlay, str(filename), pathlib.Path(filename).read_text())
+    ValidateOverlay(overlay, str(filename), pathlib.Path(filename).read_text(encoding="utf-8"))
     return overlay
 
 
@@ -254,6 +296,8 @@ class RobotOverlay:
     markers: tuple[BodyMarker, ...]
     # The angle (rad) of each joint of the model that was welded instead of controlled.
     frozen_joints: Mapping[str, float] = dc.field(default_factory=dict)
+    # The joints that move with a controlled one (a motor's other joints: robots/couplings.py).
+    couplings: tuple[JointCoupling, ...] = ()
 
 
 def ZeroConfigurationPoses(

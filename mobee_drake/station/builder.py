@@ -48,6 +48,7 @@ from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.mobee.reflex import ReflexController
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.assembly import JointStateSelector
+from mobee_drake.robots.couplings import LinearMapSystem
 from mobee_drake.robots.overlay import RobotOverlay
 from mobee_drake.robots.scenario_robot import AddScenarioRobot
 from mobee_drake.station.config import Dynamic, Kinematic, Mover, Reflex, StationConfig
@@ -110,7 +111,8 @@ def _AddMobee(
 ):
     """One robot's MoBeE, what moves it (its virtual dynamics, eq. 5.7, or MoBeE 1.0's reflex
     controller, whose command input the caller connects) and the map of its state into the
-    plant's; returns MoBeE, the mover, the selector matrix and its gain system."""
+    plant's (``x_plant = S [q; v] + s0``, followers of coupled joints included); returns MoBeE,
+    the mover, S and the map's system."""
     # How the next period integrates MoBeE's total, for its safety barrier (MoBeE 1.0's reflex
     # moves the robot by itself, without MoBeE 2.0's total).
     step = None
@@ -145,17 +147,17 @@ def _AddMobee(
         )
         builder.Connect(mobee.GetOutputPort("total"), mover.GetInputPort("total"))
         builder.Connect(mobee.GetOutputPort("damping"), mover.GetInputPort("damping"))
-    selector = JointStateSelector(plant, mobee.joints, robot.instance)
-    to_plant = builder.AddNamedSystem(f"{prefix}to_plant_state", MatrixGain(selector))
+    S, s0 = mobee.PlantStateMap()
+    to_plant = builder.AddNamedSystem(f"{prefix}to_plant_state", LinearMapSystem(S, s0))
     builder.Connect(mover.GetOutputPort("state"), to_plant.get_input_port())
-    return mobee, mover, selector, to_plant
+    return mobee, mover, S, to_plant
 
 
 def _AddJointController(
     builder: DiagramBuilder,
     plant: MultibodyPlant,
     mobee: Mobee,
-    selector: np.ndarray,
+    state_map: np.ndarray,
     to_plant: LeafSystem,
     dynamic: Dynamic,
     time_step: float,
@@ -166,7 +168,7 @@ def _AddJointController(
         held = builder.AddNamedSystem("total_hold", ZeroOrderHold(time_step, len(mobee.joints)))
         builder.Connect(mobee.GetOutputPort("total"), held.get_input_port())
         # q'' = total / M in MoBeE's order, then to the plant's velocity order.
-        to_acceleration = selector[plant.num_positions() :, len(mobee.joints) :]
+        to_acceleration = state_map[plant.num_positions() :, len(mobee.joints) :]
         acceleration = builder.AddNamedSystem(
             "acceleration", MatrixGain(to_acceleration @ np.diag(1.0 / mobee.mass))
         )
@@ -319,18 +321,20 @@ def MakeMobeeStation(
         world.Register(obj)
     plant.Finalize()
 
-    mobee, mover, selector, to_plant = _AddMobee(
+    mobee, mover, state_map, to_plant = _AddMobee(
         builder, plant, scene_graph, robot, joints, config.mobee, config.time_step, mover_config
     )
     # The client's forces (eq. 5.9-5.10) are inputs of the diagram, for scripts and supervisors
     # (unfixed, they are zero), unless the client sets them (see _ConnectClient).
     companion_positions = _AddCompanions(builder, plant, scene_graph, world, config, companions)
     if isinstance(mover_config, Dynamic):
-        from_plant = builder.AddNamedSystem("from_plant_state", MatrixGain(selector.T))
+        # The controlled joints' (q, v), read from the plant (followers left out).
+        selector = JointStateSelector(plant, mobee.joints, robot.instance).T
+        from_plant = builder.AddNamedSystem("from_plant_state", MatrixGain(selector))
         builder.Connect(plant.get_state_output_port(), from_plant.get_input_port())
         robot_state = from_plant.get_output_port()
         _AddJointController(
-            builder, plant, mobee, selector, to_plant, mover_config, config.time_step
+            builder, plant, mobee, state_map, to_plant, mover_config, config.time_step
         )
     else:
         _PoseKinematicRobots(

@@ -19,11 +19,12 @@ from pydrake.math import RigidTransform
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem, OutputPort
-from pydrake.systems.primitives import MatrixGain, SharedPointerSystem
+from pydrake.systems.primitives import SharedPointerSystem
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
 from mobee_drake.mobee.system import Mobee
-from mobee_drake.robots.assembly import FreezeJoints, JointStateSelector
+from mobee_drake.robots.assembly import FreezeJoints
+from mobee_drake.robots.couplings import CoupledPositions, LinearMapSystem
 from mobee_drake.robots.scenario_robot import RobotModelText
 from mobee_drake.station.config import StationConfig
 from mobee_drake.world.live_world import ROLE_COLORS, LiveWorld
@@ -209,13 +210,15 @@ def _AddAttractorRobot(
     (instance,) = parser.AddModelsFromString(text, extension)
     ghost.RenameModelInstance(instance, "attractor")
     ghost.WeldFrames(ghost.world_frame(), ghost.GetFrameByName(root, instance), RigidTransform())
-    FreezeJoints(ghost, instance, keep=mobee.joints, home=home, source="attractor robot")
+    followers = list(mobee.followers)
+    moved = list(mobee.joints) + [c.follower for c in followers]
+    FreezeJoints(ghost, instance, keep=moved, home=home, source="attractor robot")
     ghost.Finalize()
     builder.AddNamedSystem("attractor_robot_owner", SharedPointerSystem(ghost))
-    positions = JointStateSelector(ghost, mobee.joints, instance)[
-        : ghost.num_positions(), : len(mobee.joints)
-    ]
-    to_ghost = builder.AddNamedSystem("attractor_to_robot", MatrixGain(positions))
+    coupled = CoupledPositions.Of(ghost, instance, list(mobee.joints), followers)
+    P, p0 = np.zeros((ghost.num_positions(), len(mobee.joints))), np.zeros(ghost.num_positions())
+    P[coupled.rows], p0[coupled.rows] = coupled.P, coupled.p0
+    to_ghost = builder.AddNamedSystem("attractor_to_robot", LinearMapSystem(P, p0))
     to_pose = builder.AddNamedSystem("attractor_pose", MultibodyPositionToGeometryPose(ghost))
     builder.Connect(attractor, to_ghost.get_input_port())
     builder.Connect(to_ghost.get_output_port(), to_pose.get_input_port())
