@@ -6,13 +6,64 @@ with the dynamic robot for each requested control modality, and prints the real-
 number of control periods in which solid geometry penetrated, the deepest penetration, and the
 closest approach to the table and of the robot to itself.
 
+For the kinematic robot it also prints the cost of one control period (MoBeE, virtual dynamics,
+safety monitor, data log, simulator: wall time over periods) beside Drake's floor for that
+period, ``SetPositions`` and the signed-distance query up to the largest field margin at the
+period's pose, replayed in the same process on the same scene; and their ratio.
+
 Run: ``mobee-drake bench simulation [--seconds 600] [--controls position velocity force]``.
 """
 
+import time
+
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
+from pydrake.systems.framework import DiagramBuilder
+
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat
-from mobee_drake.scenario import LoadScenario, RunScenario
+from mobee_drake.robots.scenario_robot import AddScenarioRobot
+from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario, Scenario
+from mobee_drake.station.world_events import MakeSimulator
+from mobee_drake.world.live_world import LiveWorld
 
 SCENARIO = "motor_babbling"
+
+
+def ControlPeriodAndFloor(scenario: Scenario) -> tuple[float, float]:
+    """(us per control period of the kinematic robot, us of Drake's floor per period) over the
+    scenario's duration (see the module)."""
+    station = BuildScenario(scenario)
+    simulator = MakeSimulator(station)
+    simulator.Initialize()
+    start = time.perf_counter()
+    simulator.AdvanceTo(scenario.duration)
+    periods = round(scenario.duration / scenario.time_step)
+    per_period = (time.perf_counter() - start) / periods
+    # The poses the run went through, from its log (or, without one, from a second run).
+    log = station.data_log.Table(simulator.get_context()).to_pandas()
+    poses = log[[f"q.{j}" for j in station.mobee.joints]].to_numpy()
+    # The floor: the same robot and objects, posed and queried.
+    builder = DiagramBuilder()
+    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
+    robot, joints = AddScenarioRobot(plant, scene_graph, scenario.robot)
+    world = LiveWorld(plant, scene_graph)
+    for obj in scenario.objects:
+        world.Register(obj)
+    plant.Finalize()
+    diagram = builder.Build()
+    context = diagram.CreateDefaultContext()
+    plant_context = plant.GetMyMutableContextFromRoot(context)
+    scene_graph_context = scene_graph.GetMyContextFromRoot(context)
+    query = scene_graph.get_query_output_port()
+    max_margin = max(robot.field_margins.values())
+    order = [plant.GetJointByName(j).position_start() for j in joints]
+    x = plant.GetPositions(plant_context)
+    start = time.perf_counter()
+    for q in poses:
+        x[order] = q
+        plant.SetPositions(plant_context, x)
+        query.Eval(scene_graph_context).ComputeSignedDistancePairwiseClosestPoints(max_margin)
+    floor = (time.perf_counter() - start) / len(poses)
+    return 1e6 * per_period, 1e6 * floor
 
 
 def main(argv=None) -> None:
@@ -33,6 +84,14 @@ def main(argv=None) -> None:
         "--scenario", default=str(SCENARIO), help="the scenario run (a file or a shipped name)"
     )
     args = parser.parse_args(argv)
+    kinematic = LoadScenario(args.scenario, f"{{mover: !Kinematic {{}}, duration: {args.seconds}}}")
+    period, floor = ControlPeriodAndFloor(kinematic)
+    print(
+        f"kinematic robot, one control period of {kinematic.time_step * 1000:g} ms: "
+        f"{period:.0f} us ({kinematic.time_step * 1e6 / period:.0f}x real time); Drake's floor "
+        f"(SetPositions + signed-distance query at the period's pose): {floor:.0f} us; "
+        f"ratio {period / floor:.2f}\n"
+    )
     runs = [("kinematic", "-")] + [("dynamic", control) for control in args.controls]
     print(f"{args.scenario}, {args.seconds:g} s simulated per run")
     print(

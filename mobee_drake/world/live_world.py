@@ -173,20 +173,37 @@ class LiveWorld:
     def ObjectsSeenBy(self, inspector) -> dict[str, tuple[GeometryId, str, Shape, RigidTransform]]:
         """The same, in the world of a SceneGraph ``inspector`` (a query object's)."""
         return {
-            inspector.GetName(g): (
-                g,
-                inspector.GetPerceptionProperties(g).GetProperty(_ROLE_GROUP, _ROLE_PROPERTY),
-                inspector.GetShape(g).Clone(),  # (outlives a removal)
-                inspector.GetPoseInFrame(g),  # The frame is the world's.
-            )
-            for g in self._ObjectIds(inspector)
+            inspector.GetName(g): self._Describe(inspector, g) for g in self._ObjectIds(inspector)
         }
 
+    @staticmethod
+    def _Describe(inspector, g: GeometryId) -> tuple[GeometryId, str, Shape, RigidTransform]:
+        return (
+            g,
+            inspector.GetPerceptionProperties(g).GetProperty(_ROLE_GROUP, _ROLE_PROPERTY),
+            inspector.GetShape(g).Clone(),  # (outlives a removal)
+            inspector.GetPoseInFrame(g),  # The frame is the world's.
+        )
+
+    def _Find(self, inspector, name: str) -> GeometryId | None:
+        """The object named ``name`` (SceneGraph's lookup by name: no scan of the world)."""
+        try:
+            g = inspector.GetGeometryIdByName(self._FrameId(), Role.kPerception, name)
+        except RuntimeError:  # No geometry of that name (or several: not one of our objects).
+            return None
+        properties = inspector.GetPerceptionProperties(g)
+        return g if properties.HasProperty(_ROLE_GROUP, _ROLE_PROPERTY) else None
+
     def _Get(self, root_context, name: str) -> tuple:
-        objects = self.Objects(root_context)
-        if name not in objects:
-            raise ValueError(f"unknown world object '{name}'; objects are: " + ", ".join(objects))
-        return objects[name]
+        inspector = self._Inspector(root_context)
+        return self._Describe(inspector, self._IdOf(inspector, name))
+
+    def _IdOf(self, inspector, name: str) -> GeometryId:
+        g = self._Find(inspector, name)
+        if g is None:
+            names = ", ".join(self.ObjectsSeenBy(inspector))
+            raise ValueError(f"unknown world object '{name}'; objects are: {names}")
+        return g
 
     def Names(self, root_context) -> list[str]:
         return list(self.Objects(root_context))
@@ -195,11 +212,11 @@ class LiveWorld:
         return self._Get(root_context, name)[1]
 
     def GeometryIdOf(self, root_context, name: str) -> GeometryId:
-        return self._Get(root_context, name)[0]
+        return self._IdOf(self._Inspector(root_context), name)
 
     def Add(self, root_context, obj: schema.SceneObject) -> None:
         """Adds an object while the simulation runs."""
-        if obj.name in self.Objects(root_context):
+        if self._Find(self._Inspector(root_context), obj.name) is not None:
             raise ValueError(f"world object '{obj.name}' exists already")
         _CheckRole(obj.name, obj.role)
         self._Register(
