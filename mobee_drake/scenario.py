@@ -122,7 +122,12 @@ def ResumableConfiguration(scenario: Scenario) -> str:
 
 def BuildScenario(scenario: Scenario, meshcat: Meshcat | None = None) -> Station:
     """The station of ``scenario`` with its client (``station.client``); with ``meshcat``, also
-    the viewer."""
+    the viewer. A run longer than its data log's ``max_rows`` periods is logged at the longer
+    period that keeps it within them (its memory bounded)."""
+    log = scenario.data_log
+    period = max(log.period or scenario.time_step, scenario.duration / log.max_rows)
+    if period != (log.period or scenario.time_step):
+        scenario = dc.replace(scenario, data_log=dc.replace(log, period=period))
     return MakeMobeeStation(scenario, meshcat, prebuild_callback=scenario.attractor.AddToBuilder)
 
 

@@ -137,6 +137,15 @@ class TestDataLog(unittest.TestCase):
             resumed["q.r_elbow"].to_numpy(), whole["q.r_elbow"].to_numpy(), atol=1e-12
         )
 
+    def test_a_long_run_keeps_at_most_its_rows(self):
+        """2 s at 10 ms periods with at most 50 rows: a row every 40 ms (memory bounded)."""
+        scenario = LoadScenario("reach_around_ball", "{duration: 2.0, data_log: {max_rows: 50}}")
+        path = _Folder() / "bounded.parquet"
+        RunScenario(scenario, data_log=str(path))
+        log = pd.read_parquet(path)
+        self.assertEqual(len(log), 51)
+        np.testing.assert_allclose(np.diff(log["time"]), 0.04, atol=1e-12)
+
     def test_a_run_without_a_log(self):
         station = BuildScenario(LoadScenario("reach_around_ball", "{data_log: {enabled: false}}"))
         self.assertIsNone(station.data_log)

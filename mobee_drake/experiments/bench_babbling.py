@@ -54,7 +54,9 @@ def CommandErrors(q: np.ndarray, q_star: np.ndarray) -> np.ndarray:
 def RunOne(run: RunFolder, controller: str, seed: int, minutes: float, scenario_file: str) -> dict:
     """The battery job of one controller's babbling with one seed."""
     mover = "!Reflex {}" if controller == "reflex" else "!Kinematic {}"
-    scenario = LoadScenario(scenario_file, f"{{mover: {mover}, random_seed: {seed}}}")
+    scenario = LoadScenario(
+        scenario_file, f"{{mover: {mover}, random_seed: {seed}, data_log: {{enabled: false}}}}"
+    )
     scenario.attractor.period = PERIOD
     logs = {}
 

@@ -101,7 +101,7 @@ def main(argv=None) -> None:
     print("|---|---|---:|---:|---:|---:|---:|")
     for robot_model, control in runs:
         mover = "!Kinematic {}" if control == "-" else f"!Dynamic {{control: {control}}}"
-        overrides = f"{{mover: {mover}, duration: {args.seconds}}}"
+        overrides = f"{{mover: {mover}, duration: {args.seconds}, data_log: {{enabled: false}}}}"
         summary = RunScenario(LoadScenario(args.scenario, overrides))
         safety = summary.safety
         closest = {

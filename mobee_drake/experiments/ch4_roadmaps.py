@@ -35,7 +35,7 @@ from mobee_drake.roadmaps.adaptive_roadmap import (
 )
 from mobee_drake.robots.icub import RIGHT_ARM_JOINTS, TORSO_JOINTS, IcubConfig
 from mobee_drake.scenario import BuildScenario, Scenario
-from mobee_drake.station.config import Reflex, Visualization
+from mobee_drake.station.config import DataLog, Reflex, Visualization
 from mobee_drake.station.executor import StateActionAttractor
 from mobee_drake.station.settling import ActionTiming
 from mobee_drake.world.objects import Box, SceneObject, Sphere
@@ -59,6 +59,7 @@ def _ReflexRobot(objects: list[SceneObject], seed: int, meshcat) -> ReflexRobot:
         time_step=0.02,
         random_seed=seed,
         visualization=Visualization(show_attractor=False),
+        data_log=DataLog(enabled=False),  # (The experiment keeps its own data.)
     )
     return ReflexRobot(BuildScenario(scenario, meshcat))
 

@@ -138,6 +138,7 @@ def ReachScenario(reach_force: float = ReachForcing().force) -> Scenario:
     scenario.attractor = StateActionAttractor()
     scenario.attractor.forcing.force = reach_force
     scenario.time_step = 0.02
+    scenario.data_log.enabled = False  # (The battery keeps its own data.)
     return scenario
 
 

@@ -28,6 +28,7 @@ def ExplorationScenario(
     scenario.attractor = ExploreAttractor(agents=agents)
     scenario.time_step = 0.02
     scenario.random_seed = random_seed
+    scenario.data_log.enabled = False  # (The experiments keep their own data.)
     return scenario
 
 

@@ -121,6 +121,10 @@ class DataLog:
     period: float = 0.0
     # Each force term of eq. 5.7 per joint (True), or only its norm (False).
     full_forces: bool = False
+    # The most rows a run's log keeps in memory (about 5 kB each for the iCub at the peak, with
+    # Drake's sink's spare capacity and the written table): a longer run is logged at a longer
+    # period (see mobee_drake.scenario.BuildScenario). 30,000: a 10-minute run at 20 ms.
+    max_rows: int = 30_000
 
 
 @dc.dataclass
@@ -178,6 +182,8 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
         errors.append(
             f"visualization max_recorded_frames must be >= 1, got {shown.max_recorded_frames}"
         )
+    if log.max_rows < 1:
+        errors.append(f"data_log max_rows must be >= 1, got {log.max_rows}")
     if not (math.isfinite(log.period) and log.period >= 0):
         errors.append(f"data_log period must be >= 0 s (0: every control period), got {log.period}")
     names = set()
