@@ -24,8 +24,8 @@ import resource
 import time
 
 import numpy as np
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-from pydrake.systems.framework import DiagramBuilder
+from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
+from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
 from mobee_drake.experiments.plots import Figure, SaveFigure, plt
@@ -72,19 +72,52 @@ def _RandomBox(name: str, robot: str, rng: np.random.Generator) -> SceneObject:
     )
 
 
-def _BuildRobotAmongBoxes(robot: str, num_boxes: int, rng: np.random.Generator):
+@dc.dataclass
+class PosedScene:
+    """A robot, its objects and MoBeE, posed by ``SetPositions`` on the plant (no simulator)."""
+
+    diagram: Diagram
+    plant: MultibodyPlant
+    mobee: Mobee
+    world: LiveWorld
+    max_margin: float  # the largest field margin: the floor's query distance
+
+    def Contexts(self):
+        """A fresh root context, the plant's and MoBeE's in it."""
+        context = self.diagram.CreateDefaultContext()
+        return (
+            context,
+            self.plant.GetMyMutableContextFromRoot(context),
+            self.mobee.GetMyContextFromRoot(context),
+        )
+
+    def PositionOrder(self) -> list[int]:
+        """Where MoBeE's joints are in the plant's positions."""
+        return [self.plant.GetJointByName(j).position_start() for j in self.mobee.joints]
+
+
+def BuildPosedScene(robot_config, objects) -> PosedScene:
+    """The robot of ``robot_config`` among ``objects`` (SceneObjects), with MoBeE."""
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
-    overlay, joints = AddScenarioRobot(plant, scene_graph, ROBOTS[robot]())
+    overlay, joints = AddScenarioRobot(plant, scene_graph, robot_config)
     world = LiveWorld(plant, scene_graph)
-    for i in range(num_boxes):
-        world.Register(_RandomBox(f"box{i}", robot, rng))
+    for obj in objects:
+        world.Register(obj)
     plant.Finalize()
     mobee = Mobee.AddToBuilder(
         builder, plant=plant, scene_graph=scene_graph, robot=overlay, joints=joints
     )
-    diagram = builder.Build()
-    return diagram, plant, mobee, world, max(overlay.field_margins.values())
+    return PosedScene(builder.Build(), plant, mobee, world, max(overlay.field_margins.values()))
+
+
+def FloorEvaluation(scene: PosedScene, mobee_context):
+    """Drake's floor for one pose already set: SceneGraph's signed-distance query up to the
+    largest field margin (the pose update included)."""
+    query = scene.mobee.GetInputPort("geometry_query")
+    return lambda: query.Eval(mobee_context).ComputeSignedDistancePairwiseClosestPoints(
+        scene.max_margin
+    )
 
 
 def _OscillatorPoses(
@@ -117,19 +150,18 @@ def MeasureForceEvaluations(
     """Times ``repeats`` sweeps of ``num_poses`` total-force evaluations among boxes; with
     ``churn``, each evaluation follows the removal of one box and the insertion of another."""
     rng = np.random.default_rng(seed)
-    diagram, plant, mobee, world, max_margin = _BuildRobotAmongBoxes(robot, num_obstacles, rng)
-    context = diagram.CreateDefaultContext()
-    plant_context = plant.GetMyMutableContextFromRoot(context)
-    mobee_context = mobee.GetMyContextFromRoot(context)
-    boxes = [f"box{i}" for i in range(num_obstacles)]
+    objects = [_RandomBox(f"box{i}", robot, rng) for i in range(num_obstacles)]
+    scene = BuildPosedScene(ROBOTS[robot](), objects)
+    plant, mobee, world = scene.plant, scene.mobee, scene.world
+    context, plant_context, mobee_context = scene.Contexts()
+    boxes = [obj.name for obj in objects]
     replacements = [
         _RandomBox(f"new{k}", robot, rng)
         for k in range(num_poses * repeats if churn and boxes else 0)
     ]
     total, contacts = mobee.GetOutputPort("total"), mobee.GetOutputPort("field_contacts")
-    query = mobee.GetInputPort("geometry_query")
     # The plant's positions are the controlled joints, possibly in another order.
-    order = [plant.GetJointByName(j).position_start() for j in mobee.joints]
+    order = scene.PositionOrder()
     poses = _OscillatorPoses(mobee, num_poses, rng, amplitude)
     x = plant.GetPositions(plant_context)
 
@@ -147,12 +179,10 @@ def MeasureForceEvaluations(
             evaluate()
         return time.perf_counter() - start
 
-    def Floor() -> None:
-        query.Eval(mobee_context).ComputeSignedDistancePairwiseClosestPoints(max_margin)
-
+    floor = FloorEvaluation(scene, mobee_context)
     rates, floors = [], []
     for repeat in range(repeats):
-        floors.append(Sweep(repeat, Floor) / num_poses)
+        floors.append(Sweep(repeat, floor) / num_poses)
         if replacements:  # The churn's boxes are used once each: draw the sweep's anew.
             replacements[repeat * num_poses : (repeat + 1) * num_poses] = [
                 _RandomBox(f"floor{repeat}_{k}", robot, rng) for k in range(num_poses)

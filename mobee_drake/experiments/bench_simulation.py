@@ -18,15 +18,11 @@ Run: ``mobee-drake bench simulation [--seconds 600] [--controls position velocit
 import dataclasses as dc
 import time
 
-from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
-from pydrake.systems.framework import DiagramBuilder
-
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat
-from mobee_drake.robots.scenario_robot import AddScenarioRobot
+from mobee_drake.experiments.bench_forces import BuildPosedScene, FloorEvaluation
 from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario, Scenario
 from mobee_drake.station.config import DataLog
 from mobee_drake.station.world_events import MakeSimulator
-from mobee_drake.world.live_world import LiveWorld
 
 SCENARIO = "motor_babbling"
 
@@ -54,26 +50,15 @@ def ControlPeriodAndFloor(scenario: Scenario) -> tuple[float, float]:
     log = logged.data_log.Table(simulator.get_context()).to_pandas()
     poses = log[[f"q.{j}" for j in logged.mobee.joints]].to_numpy()
     # The floor: the same robot and objects, posed and queried.
-    builder = DiagramBuilder()
-    plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
-    robot, joints = AddScenarioRobot(plant, scene_graph, scenario.robot)
-    world = LiveWorld(plant, scene_graph)
-    for obj in scenario.objects:
-        world.Register(obj)
-    plant.Finalize()
-    diagram = builder.Build()
-    context = diagram.CreateDefaultContext()
-    plant_context = plant.GetMyMutableContextFromRoot(context)
-    scene_graph_context = scene_graph.GetMyContextFromRoot(context)
-    query = scene_graph.get_query_output_port()
-    max_margin = max(robot.field_margins.values())
-    order = [plant.GetJointByName(j).position_start() for j in joints]
-    x = plant.GetPositions(plant_context)
+    scene = BuildPosedScene(scenario.robot, scenario.objects)
+    _, plant_context, mobee_context = scene.Contexts()
+    floor_evaluation, order = FloorEvaluation(scene, mobee_context), scene.PositionOrder()
+    x = scene.plant.GetPositions(plant_context)
     start = time.perf_counter()
     for q in poses:
         x[order] = q
-        plant.SetPositions(plant_context, x)
-        query.Eval(scene_graph_context).ComputeSignedDistancePairwiseClosestPoints(max_margin)
+        scene.plant.SetPositions(plant_context, x)
+        floor_evaluation()
     floor = (time.perf_counter() - start) / len(poses)
     return 1e6 * per_period, 1e6 * floor
 

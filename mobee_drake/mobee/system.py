@@ -350,6 +350,11 @@ class Mobee(LeafSystem):
         return self._mass.copy()
 
     @property
+    def damping(self) -> np.ndarray:
+        """The diagonal of C (eq. 5.7), for integrating the damping implicitly."""
+        return self._damping.copy()
+
+    @property
     def clauses(self) -> ClauseSet:
         return self._clauses
 

@@ -66,8 +66,7 @@ class ControlledRobot:
         q_index = np.array([j.position_start() for j in found], dtype=int)
         followers = Followers(robot.couplings, joints, source)
         coupled = CoupledPositions.Of(plant, robot.instance, joints, followers)
-        velocity_map = np.zeros((plant.num_velocities(), len(joints)))
-        velocity_map[coupled.velocity_rows] = coupled.P
+        velocity_map = coupled.VelocityMap(plant.num_velocities())
         return ControlledRobot(
             joints=tuple(joints),
             q_index=q_index,
@@ -96,13 +95,11 @@ class ControlledRobot:
         """(S, s0) with ``x_plant = S [q; v] + s0`` for the robot's entries of the plant's
         state (every other entry zero): the controlled joints and their followers."""
         nv, n = self.velocity_map.shape
-        coupled = self.coupled
+        P, p0 = self.coupled.PositionMap(num_positions)
         S = np.zeros((num_positions + nv, 2 * n))
-        S[coupled.rows, :n] = coupled.P
+        S[:num_positions, :n] = P
         S[num_positions:, n:] = self.velocity_map
-        s0 = np.zeros(num_positions + nv)
-        s0[coupled.rows] = coupled.p0
-        return S, s0
+        return S, np.concatenate([p0, np.zeros(nv)])
 
     @property
     def marker_names(self) -> list[str]:

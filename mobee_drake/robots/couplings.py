@@ -50,6 +50,19 @@ class CoupledPositions:
     P: np.ndarray
     p0: np.ndarray
 
+    def PositionMap(self, num_positions: int) -> tuple[np.ndarray, np.ndarray]:
+        """(P, p0) over all of the plant's positions: ``q_plant = P q + p0`` on this robot's
+        entries, zero elsewhere."""
+        P, p0 = np.zeros((num_positions, self.P.shape[1])), np.zeros(num_positions)
+        P[self.rows], p0[self.rows] = self.P, self.p0
+        return P, p0
+
+    def VelocityMap(self, num_velocities: int) -> np.ndarray:
+        """``v_plant = V v`` on this robot's entries, zero elsewhere."""
+        V = np.zeros((num_velocities, self.P.shape[1]))
+        V[self.velocity_rows] = self.P
+        return V
+
     @staticmethod
     def Of(
         plant: MultibodyPlant,

@@ -135,12 +135,11 @@ def _AddMobee(
         )
         builder.Connect(mobee.GetOutputPort("field_pairs"), mover.GetInputPort("field_pairs"))
     else:
-        damping = params.PerJoint(joints).damping
         mover = builder.AddNamedSystem(
             f"{prefix}virtual_dynamics",
             VirtualDynamics(
                 mass=mobee.mass,
-                damping=damping,
+                damping=mobee.damping,
                 period=time_step,
                 initial_positions=mobee.home,
             ),

@@ -216,8 +216,7 @@ def _AddAttractorRobot(
     ghost.Finalize()
     builder.AddNamedSystem("attractor_robot_owner", SharedPointerSystem(ghost))
     coupled = CoupledPositions.Of(ghost, instance, list(mobee.joints), followers)
-    P, p0 = np.zeros((ghost.num_positions(), len(mobee.joints))), np.zeros(ghost.num_positions())
-    P[coupled.rows], p0[coupled.rows] = coupled.P, coupled.p0
+    P, p0 = coupled.PositionMap(ghost.num_positions())
     to_ghost = builder.AddNamedSystem("attractor_to_robot", LinearMapSystem(P, p0))
     to_pose = builder.AddNamedSystem("attractor_pose", MultibodyPositionToGeometryPose(ghost))
     builder.Connect(attractor, to_ghost.get_input_port())
