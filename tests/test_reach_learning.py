@@ -41,12 +41,12 @@ class TestStateActionExecutor(unittest.TestCase):
         pairs = FieldPairs(
             [None] * k,
             [None] * k,
-            np.zeros(k),
-            np.full(k, 0.05),
-            np.zeros((k, 3)),
-            np.zeros((k, 3)),
-            np.zeros((k, 3)),
-            np.array(b_is_robot, dtype=bool),
+            distance=np.zeros(k),
+            margin=np.full(k, 0.05),
+            p_WCa=np.zeros((k, 3)),
+            nhat_BA_W=np.zeros((k, 3)),
+            row_A=np.zeros(k, dtype=int),
+            row_B=np.where(b_is_robot, 1, -1),
         )
         self.dut.GetInputPort("field_pairs").FixValue(self.context, AbstractValue.Make(pairs))
 

@@ -17,12 +17,12 @@ H = 0.02
 ONE_PAIR = FieldPairs(
     [None],
     [None],
-    np.zeros(1),
-    np.full(1, 0.05),
-    np.zeros((1, 3)),
-    np.zeros((1, 3)),
-    np.zeros((1, 3)),
-    np.ones(1, dtype=bool),
+    distance=np.zeros(1),
+    margin=np.full(1, 0.05),
+    p_WCa=np.zeros((1, 3)),
+    nhat_BA_W=np.zeros((1, 3)),
+    row_A=np.zeros(1, dtype=int),
+    row_B=np.ones(1, dtype=int),
 )
 
 

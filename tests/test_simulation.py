@@ -199,12 +199,12 @@ class TestSafetyMonitor(unittest.TestCase):
             pairs = FieldPairs(
                 [arm] * k,
                 list(ids),
-                np.array(distances),
-                np.full(k, 0.03),
-                np.zeros((k, 3)),
-                np.zeros((k, 3)),
-                np.zeros((k, 3)),
-                np.array([i == chest for i in ids]),
+                distance=np.array(distances),
+                margin=np.full(k, 0.03),
+                p_WCa=np.zeros((k, 3)),
+                nhat_BA_W=np.zeros((k, 3)),
+                row_A=np.zeros(k, dtype=int),
+                row_B=np.array([1 if i == chest else -1 for i in ids]),
             )
             dut.GetInputPort("field_pairs").FixValue(context, pairs)
             context.SetDiscreteState(dut.EvalUniquePeriodicDiscreteUpdate(context).value())

@@ -111,6 +111,10 @@ class ClauseSet:
         self._C = np.zeros((len(membership), n_literals))
         for c, members in enumerate(membership):
             self._C[c, members] = 1.0
+        # The same as booleans (a boolean matmul is an OR of ANDs), and the normals' transpose.
+        self._member = self._C > 0
+        self._member_T = self._member.T.copy()
+        self._normals_T = self._normals.T.copy()
 
     @property
     def num_clauses(self) -> int:
@@ -120,6 +124,11 @@ class ClauseSet:
         """The clearance ``g`` of every distinct literal, in radians (in the order the clauses
         first name them)."""
         return self._normals @ q + self._offsets
+
+    def Bands(self, delta: float) -> tuple[np.ndarray, np.ndarray]:
+        """(R, c): the depth ``R q + c = delta - g`` of every literal into its band of width
+        ``delta``, positive inside it: a clause can switch on only where one is."""
+        return -self._normals, delta - self._offsets
 
     def ActiveClauses(self, q: np.ndarray, delta: float) -> np.ndarray:
         """Which clauses have their forces switched on: all of their literals within ``delta``."""
@@ -139,14 +148,17 @@ class ClauseSet:
         return float(np.sum(per_clause[np.isfinite(per_clause)]))
 
     def _Active(self, inside: np.ndarray) -> np.ndarray:
-        return self._C @ (~inside) == 0
+        return ~(self._member @ ~inside)  # no literal of the clause is clear
 
     def Force(self, q: np.ndarray, delta: float, f_max: float) -> np.ndarray:
         """The total constraint force ``f_cst`` (eq. 5.15-5.17 as described in the module)."""
-        g = self.Clearances(q)
-        inside = g < delta
+        return self.ForceAtDepths(delta - self.Clearances(q), delta, f_max)
+
+    def ForceAtDepths(self, depths: np.ndarray, delta: float, f_max: float) -> np.ndarray:
+        """``f_cst`` from the literals' depths ``delta - g`` into their bands (:meth:`Bands`)."""
+        inside = depths > 0.0
         if not inside.any():  # The common case: every literal clear, no clause can switch on.
-            return np.zeros_like(q)
+            return np.zeros(self._normals.shape[1])
         # Each literal of a switched-on clause, once (eq. 5.17).
-        on = (self._Active(inside).astype(float) @ self._C) > 0
-        return self._normals.T @ (f_max * (delta - g) / delta * on)
+        on = self._member_T @ self._Active(inside)
+        return self._normals_T @ (f_max / delta * depths * on)

@@ -45,22 +45,31 @@ class FieldContact:
 class FieldPairs:
     """The k pairs inside their fields as arrays; A is always a robot geometry.
 
-    Witness points are kept in their own geometry's frame (``p_ACa`` in A's, ``p_BCb`` in B's), as
-    SceneGraph reports them: the forces need them on the robot's bodies, not in world.
+    ``row_A`` and ``row_B`` are the geometries' rows in the robot's :class:`RobotFields` (``row_B``
+    is -1 for an obstacle), for looking up what each robot geometry is fixed to.
     """
 
     geometry_A: list[GeometryId]
     geometry_B: list[GeometryId]
     distance: np.ndarray  # (k,)
     margin: np.ndarray  # (k,)
-    p_ACa: np.ndarray  # (k, 3)
-    p_BCb: np.ndarray  # (k, 3)
+    p_WCa: np.ndarray  # (k, 3) witness points on A, in world
     nhat_BA_W: np.ndarray  # (k, 3)
-    # Whether B is a robot geometry too (a self-collision, which pushes both bodies).
-    b_is_robot: np.ndarray  # (k,) bool
+    row_A: np.ndarray  # (k,) int
+    row_B: np.ndarray  # (k,) int, -1 when B is not the robot's
 
     def __len__(self) -> int:
         return len(self.geometry_A)
+
+    @property
+    def b_is_robot(self) -> np.ndarray:
+        """(k,) bool: whether B is a robot geometry too (a self-collision, which pushes both)."""
+        return self.row_B >= 0
+
+    @property
+    def p_WCb(self) -> np.ndarray:
+        """(k, 3) witness points on B, in world (SceneGraph's ``p_WCa - p_WCb = d nhat_BA_W``)."""
+        return self.p_WCa - self.distance[:, None] * self.nhat_BA_W
 
     def __deepcopy__(self, memo) -> "FieldPairs":
         # Never modified after construction (and GeometryId cannot be copied): copies share it.
@@ -75,71 +84,72 @@ NO_FIELD_PAIRS = FieldPairs(
     np.zeros(0),
     np.zeros((0, 3)),
     np.zeros((0, 3)),
-    np.zeros((0, 3)),
-    np.zeros(0, dtype=bool),
+    np.zeros(0, dtype=int),
+    np.zeros(0, dtype=int),
 )
 
 
-def FindFieldPairs(
-    query: QueryObject, margins: Mapping[GeometryId, float], max_margin: float
-) -> FieldPairs:
-    """Finds every pair with a robot geometry (a key of ``margins``) inside its field.
+class RobotFields:
+    """A robot's geometries that have a field: each one's row (their order in ``geometries``)
+    and margin (m)."""
 
-    ``max_margin`` is the largest of ``margins``: no pair farther apart can be inside its field.
-    """
-    if max_margin <= 0:
-        return NO_FIELD_PAIRS
-    rows = []
-    for pair in query.ComputeSignedDistancePairwiseClosestPoints(max_margin):
-        id_A, id_B = pair.id_A, pair.id_B
-        margin_A, margin_B = margins.get(id_A), margins.get(id_B)
-        if margin_A is None:
-            if margin_B is None:
-                continue  # Neither geometry is the robot's.
-            margin = margin_B
-        else:
-            margin = margin_A if margin_B is None or margin_A > margin_B else margin_B
-        distance = pair.distance
-        if distance >= margin:
-            continue
-        if margin_A is None:  # Make A the robot's geometry.
+    def __init__(self, margins: Mapping[GeometryId, float]):
+        self.geometries = list(margins)
+        self.max_margin = max(margins.values(), default=0.0)  # no pair farther can be inside
+        self._rows = {g: (row, margin) for row, (g, margin) in enumerate(margins.items())}
+
+    def FindPairs(self, query: QueryObject) -> FieldPairs:
+        """Every pair with a robot geometry inside its field, at the pose of ``query``."""
+        if self.max_margin <= 0:
+            return NO_FIELD_PAIRS
+        rows, lookup = [], self._rows.get
+        poses = {}  # X_WA of each robot geometry met (several pairs often share one)
+        for pair in query.ComputeSignedDistancePairwiseClosestPoints(self.max_margin):
+            id_A, id_B = pair.id_A, pair.id_B
+            a, b = lookup(id_A), lookup(id_B)
+            if a is None:
+                if b is None:
+                    continue  # Neither geometry is the robot's.
+                margin = b[1]
+            else:
+                margin = a[1] if b is None or a[1] > b[1] else b[1]
+            distance = pair.distance
+            if distance >= margin:
+                continue
+            if a is None:  # Make A the robot's geometry.
+                id_A, id_B, a, b = id_B, id_A, b, None
+                p_ACa, nhat = pair.p_BCb, -pair.nhat_BA_W
+            else:
+                p_ACa, nhat = pair.p_ACa, pair.nhat_BA_W
+            X_WA = poses.get(a[0])
+            if X_WA is None:
+                X_WA = poses[a[0]] = query.GetPoseInWorld(id_A).GetAsMatrix34()
             rows.append(
-                (id_B, id_A, distance, margin, pair.p_BCb, pair.p_ACa, -pair.nhat_BA_W, False)
+                (id_A, id_B, distance, margin, X_WA, p_ACa, nhat, a[0], -1 if b is None else b[0])
             )
-        else:
-            rows.append(
-                (
-                    id_A,
-                    id_B,
-                    distance,
-                    margin,
-                    pair.p_ACa,
-                    pair.p_BCb,
-                    pair.nhat_BA_W,
-                    margin_B is not None,
-                )
-            )
-    if not rows:
-        return NO_FIELD_PAIRS
-    ids_A, ids_B, distance, margin, p_ACa, p_BCb, nhat, both = zip(*rows)
-    return FieldPairs(
-        list(ids_A),
-        list(ids_B),
-        np.array(distance),
-        np.array(margin),
-        np.array(p_ACa),
-        np.array(p_BCb),
-        np.array(nhat),
-        np.array(both),
-    )
+        if not rows:
+            return NO_FIELD_PAIRS
+        ids_A, ids_B, distance, margin, X_WA, p_ACa, nhat, row_A, row_B = zip(*rows)
+        X_WA = np.array(X_WA)
+        return FieldPairs(
+            list(ids_A),
+            list(ids_B),
+            np.array(distance),
+            np.array(margin),
+            np.einsum("kij,kj->ki", X_WA[:, :, :3], np.array(p_ACa)) + X_WA[:, :, 3],
+            np.array(nhat),
+            np.array(row_A),
+            np.array(row_B),
+        )
 
 
 def ToFieldContacts(
     pairs: FieldPairs, query: QueryObject, names: Mapping[GeometryId, str]
 ) -> list[FieldContact]:
-    """The pairs as a list of :class:`FieldContact`, witness points in world."""
+    """The pairs as a list of :class:`FieldContact` (``names`` first, then SceneGraph's)."""
     inspector = query.inspector()
     contacts = []
+    p_WCb = pairs.p_WCb
     for i, (a, b) in enumerate(zip(pairs.geometry_A, pairs.geometry_B)):
         contacts.append(
             FieldContact(
@@ -149,8 +159,8 @@ def ToFieldContacts(
                 name_B=names.get(b) or inspector.GetName(b),
                 distance=float(pairs.distance[i]),
                 margin=float(pairs.margin[i]),
-                p_WCa=query.GetPoseInWorld(a).multiply(pairs.p_ACa[i]),
-                p_WCb=query.GetPoseInWorld(b).multiply(pairs.p_BCb[i]),
+                p_WCa=pairs.p_WCa[i].copy(),
+                p_WCb=p_WCb[i],
                 nhat_BA_W=pairs.nhat_BA_W[i].copy(),
             )
         )

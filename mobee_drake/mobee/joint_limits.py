@@ -20,11 +20,22 @@ class JointLimits:
         self._lower_edge, self._upper_edge = q_min + delta, q_max - delta
         self._slope = f_max / delta
 
+    def Bands(self) -> tuple[np.ndarray, np.ndarray]:
+        """(R, c): the depths ``R q + c`` of the joints into their lower bands (first n rows) and
+        their upper bands (last n rows), positive inside a band: where ``f_lim`` is not zero."""
+        n = len(self._lower_edge)
+        return np.vstack([-np.eye(n), np.eye(n)]), np.concatenate(
+            [self._lower_edge, -self._upper_edge]
+        )
+
     def Force(self, q: np.ndarray) -> np.ndarray:
         """The per-joint limit force ``f_lim(q)`` (eq. 5.12-5.13, typos corrected)."""
-        return self._slope * (
-            np.maximum(0.0, self._lower_edge - q) - np.maximum(0.0, q - self._upper_edge)
-        )
+        return self.ForceAtDepths(np.stack([self._lower_edge - q, q - self._upper_edge]))
+
+    def ForceAtDepths(self, depths: np.ndarray) -> np.ndarray:
+        """``f_lim`` from the depths of :meth:`Bands`, as two rows: lower bands, upper bands."""
+        inside = np.maximum(depths, 0.0)
+        return self._slope * (inside[0] - inside[1])
 
 
 def JointLimitForce(

@@ -4,21 +4,15 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.geometry import QueryObject
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.multibody.tree import JacobianWrtVariable
 from pydrake.systems.framework import LeafSystem, ValueProducer
 from pydrake.systems.primitives import MatrixGain
 
 from mobee_drake.mobee.barrier import BarrierForce, StepModel
 from mobee_drake.mobee.constraints import ClauseSet
-from mobee_drake.mobee.fields import (
-    NO_FIELD_PAIRS,
-    FieldPairs,
-    FindFieldPairs,
-    ToFieldContacts,
-)
+from mobee_drake.mobee.fields import NO_FIELD_PAIRS, FieldPairs, RobotFields, ToFieldContacts
 from mobee_drake.mobee.joint_limits import JointLimits
+from mobee_drake.mobee.joint_screws import JointScrews
 from mobee_drake.mobee.params import MobeeParams
-from mobee_drake.mobee.projection import PointForceProjector
 from mobee_drake.mobee.squash import Squash
 from mobee_drake.robots.controlled_robot import ControlledRobot
 from mobee_drake.robots.couplings import JointCoupling
@@ -36,11 +30,6 @@ FORCE_TERMS = (
     "f_work",
     "f_barrier",
 )
-
-
-def _WithTotal(terms: np.ndarray) -> np.ndarray:
-    """The force terms (one row each) and their total, as one vector."""
-    return np.concatenate([terms.ravel(), terms.sum(axis=0)])
 
 
 class Mobee(LeafSystem):
@@ -126,6 +115,7 @@ class Mobee(LeafSystem):
         per_joint = params.PerJoint(self._joints)
         mass, damping = per_joint.mass, per_joint.damping
         self._mass, self._damping, self._stiffness = mass, damping, per_joint.stiffness
+        self._negative_damping = -damping
         self._squash = per_joint.squash  # eq. 5.8's (m_i, k_i) of each sigmoid
         self._barrier = params.barrier.enabled and step is not None
         if self._barrier:
@@ -140,18 +130,33 @@ class Mobee(LeafSystem):
             source="MoBeE",
             followers=controlled.followers,
         )
+        # f_lim and f_cst push only inside a band (eq. 5.12, 5.15): one product gives the depth of
+        # every joint and literal into its band, and in most evaluations none is inside one.
+        bands = [self._limits.Bands(), self._clauses.Bands(params.constraint_delta)]
+        self._band_rows = np.vstack([R for R, _ in bands])
+        self._band_offsets = np.concatenate([c for _, c in bands])
         self._default_positions = plant.GetPositions(plant.CreateDefaultContext())
         self._home = controlled.home
         self._state_names = [f"{j} position" for j in self._joints] + [
             f"{j} velocity" for j in self._joints
         ]
 
-        self._margins = dict(robot.field_margins)
-        self._max_margin = max(self._margins.values(), default=0.0)
+        self._fields = RobotFields(robot.field_margins)
         self._geometry_names = dict(robot.geometry_names)
-        self._geometry_frames = {g: plant.get_frame(f) for g, f in robot.geometry_frames.items()}
-        self._project = PointForceProjector(plant)
+        # Every Jacobian below comes from the joints' screws, through the body of each point.
+        self._screws = JointScrews(plant, self._to_joints)
+        # Which velocities move each field geometry's body; a last row of zeros for obstacles
+        # (FieldPairs.row_B is -1).
+        field_bodies = [
+            int(plant.get_frame(robot.geometry_frames[g]).body().index())
+            for g in self._fields.geometries
+        ]
+        moves = self._screws.Moves(np.array(field_bodies, dtype=int))
+        self._field_moves = np.vstack([moves, np.zeros(moves.shape[1])])
         self._markers, self._marker_bodies = controlled.markers, controlled.marker_bodies
+        self._marker_body_rows = np.array([int(b.index()) for b in self._marker_bodies], dtype=int)
+        self._marker_moves = self._screws.Moves(self._marker_body_rows)
+        self._marker_force_names = [f"{m.name}[{axis}]" for m in self._markers for axis in "xyz"]
         num_markers = len(self._markers)
 
         self._state_port = self.DeclareVectorInputPort("state", 2 * n)
@@ -180,27 +185,23 @@ class Mobee(LeafSystem):
             prerequisites_of_calc={state_ticket},
         )
         plant_ticket = self._plant_context_entry.ticket()
+        self._screws_entry = self.DeclareCacheEntry(
+            description="the joints' screws at the input configuration",
+            value_producer=ValueProducer(
+                allocate=lambda: AbstractValue.Make(np.zeros(0)),
+                calc=lambda context, value: value.set_value(
+                    self._screws.Calc(self._plant_context_entry.Eval(context))
+                ),
+            ),
+            prerequisites_of_calc={plant_ticket},
+        )
+        screws_ticket = self._screws_entry.ticket()
         self._field_pairs_entry = self.DeclareCacheEntry(
             description="geometry pairs inside their fields",
             value_producer=ValueProducer(
                 allocate=lambda: AbstractValue.Make(NO_FIELD_PAIRS), calc=self._CalcFieldPairs
             ),
             prerequisites_of_calc={self._query_port.ticket()},
-        )
-        self._forces_entry = self.DeclareCacheEntry(
-            description="force terms of eq. 5.7",
-            value_producer=ValueProducer(
-                allocate=lambda: AbstractValue.Make(np.zeros((len(FORCE_TERMS), n))),
-                calc=self._CalcForces,
-            ),
-            prerequisites_of_calc={
-                state_ticket,
-                plant_ticket,
-                self._field_pairs_entry.ticket(),
-                self._attractor_entry.ticket(),
-                self._config_force_port.ticket(),
-                self._marker_forces_port.ticket(),
-            },
         )
         self._marker_pose_entry = self.DeclareCacheEntry(
             description="marker positions and directions",
@@ -211,6 +212,23 @@ class Mobee(LeafSystem):
             prerequisites_of_calc={plant_ticket},
         )
 
+        self._forces_entry = self.DeclareCacheEntry(
+            description="force terms of eq. 5.7",
+            value_producer=ValueProducer(
+                # One row per term, then their total.
+                allocate=lambda: AbstractValue.Make(np.zeros((len(FORCE_TERMS) + 1, n))),
+                calc=self._CalcForces,
+            ),
+            prerequisites_of_calc={
+                state_ticket,
+                screws_ticket,
+                self._marker_pose_entry.ticket(),
+                self._field_pairs_entry.ticket(),
+                self._attractor_entry.ticket(),
+                self._config_force_port.ticket(),
+                self._marker_forces_port.ticket(),
+            },
+        )
         for row, term in enumerate(FORCE_TERMS):
             self.DeclareVectorOutputPort(
                 term,
@@ -223,18 +241,14 @@ class Mobee(LeafSystem):
         self.DeclareVectorOutputPort(
             "total",
             n,
-            lambda context, output: output.SetFromVector(
-                self._forces_entry.Eval(context).sum(axis=0)
-            ),
+            lambda context, output: output.SetFromVector(self._forces_entry.Eval(context)[-1]),
             prerequisites_of_calc={self._forces_entry.ticket()},
         )
         # Every term and the total in one vector (term-major), for loggers: one read, not eight.
         self.DeclareVectorOutputPort(
             "forces",
             (len(FORCE_TERMS) + 1) * n,
-            lambda context, output: output.SetFromVector(
-                _WithTotal(self._forces_entry.Eval(context))
-            ),
+            lambda context, output: output.SetFromVector(self._forces_entry.Eval(context).ravel()),
             prerequisites_of_calc={self._forces_entry.ticket()},
         )
         for row, name in enumerate(("marker_positions", "marker_directions")):
@@ -250,7 +264,7 @@ class Mobee(LeafSystem):
             "marker_jacobians",
             3 * num_markers * n,
             self._CalcMarkerJacobians,
-            prerequisites_of_calc={plant_ticket},
+            prerequisites_of_calc={screws_ticket, self._marker_pose_entry.ticket()},
         )
         self.DeclareAbstractOutputPort(
             "field_contacts",
@@ -391,9 +405,7 @@ class Mobee(LeafSystem):
         self._plant.SetPositions(plant_context, positions)
 
     def _CalcFieldPairs(self, context, value) -> None:
-        value.set_value(
-            FindFieldPairs(self._query_port.Eval(context), self._margins, self._max_margin)
-        )
+        value.set_value(self._fields.FindPairs(self._query_port.Eval(context)))
 
     def _CalcFieldContacts(self, context, output) -> None:
         output.set_value(
@@ -404,23 +416,16 @@ class Mobee(LeafSystem):
             )
         )
 
-    def _FieldNormals(self, plant_context, pairs: FieldPairs) -> np.ndarray:
+    def _FieldNormals(self, context, pairs: FieldPairs) -> np.ndarray:
         """(k, n): each pair's generalized normal over the controlled joints, the gradient of
         its signed distance (``d' = n . v``): the separating direction at the robot geometry's
-        witness point, projected by its Jacobian, less the same at the other witness point when
-        that is the robot's too (a self-collision)."""
-        project, frames = self._project, self._geometry_frames
-        normals = np.array(
-            [
-                project(plant_context, frames[g], p_GC, nhat)
-                for g, p_GC, nhat in zip(pairs.geometry_A, pairs.p_ACa, pairs.nhat_BA_W)
-            ]
+        witness point projected onto the joints, less the same at the other witness point when
+        that is the robot's too (a self-collision). The two witness points lie on one line along
+        the direction, so both are one projection with the difference of the bodies' motions."""
+        moves = self._field_moves[pairs.row_A] - self._field_moves[pairs.row_B]
+        return self._screws.Project(
+            self._screws_entry.Eval(context), moves, pairs.p_WCa, pairs.nhat_BA_W
         )
-        for i in np.flatnonzero(pairs.b_is_robot):
-            normals[i] -= project(
-                plant_context, frames[pairs.geometry_B[i]], pairs.p_BCb[i], pairs.nhat_BA_W[i]
-            )
-        return normals @ self._to_joints
 
     def _CalcForces(self, context, value) -> None:
         p = self._params
@@ -428,51 +433,44 @@ class Mobee(LeafSystem):
         q_star = self._attractor_entry.Eval(context)
         terms = value.get_mutable_value()
 
-        terms[0] = -Squash(self._stiffness * (q - q_star), *self._squash["spring"])
-        terms[1] = -self._damping * v
-        terms[2] = self._limits.Force(q)
-        terms[3] = self._clauses.Force(q, p.constraint_delta, p.constraint_force)
+        # -L(K(q - q*)) as L(K(q* - q)): L is odd (the same numbers, one operation fewer).
+        terms[0] = Squash(self._stiffness * (q_star - q), *self._squash["spring"])
+        np.multiply(self._negative_damping, v, out=terms[1])
+        terms[2:] = 0.0
+        depths = self._band_rows @ q + self._band_offsets
+        if depths.max() > 0.0:
+            n = len(q)
+            terms[2] = self._limits.ForceAtDepths(depths[: 2 * n].reshape(2, n))
+            terms[3] = self._clauses.ForceAtDepths(
+                depths[2 * n :], p.constraint_delta, p.constraint_force
+            )
 
         pairs = self._field_pairs_entry.Eval(context)
         normals = None
         if len(pairs):
-            normals = self._FieldNormals(self._plant_context_entry.Eval(context), pairs)
+            normals = self._FieldNormals(context, pairs)
             # Eq. 5.11: the gain times the field penetration along each pair's normal, summed.
             collision = (p.collision_gain * (pairs.margin - pairs.distance)) @ normals
             terms[4] = Squash(collision, *self._squash["collision"])
-        else:
-            terms[4] = 0.0
 
         if self._config_force_port.HasValue(context):
             f_q = self._config_force_port.Eval(context)
             self._CheckFinite("config_force", f_q, self._joints)
             terms[5] = Squash(f_q, *self._squash["config"])
-        else:
-            terms[5] = 0.0
 
-        terms[6] = 0.0
         if self._markers and self._marker_forces_port.HasValue(context):
             f_m = self._marker_forces_port.Eval(context).reshape(-1, 3)
-            self._CheckFinite(
-                "marker_forces",
-                f_m.ravel(),
-                [f"{m.name}[{axis}]" for m in self._markers for axis in "xyz"],
-            )
+            self._CheckFinite("marker_forces", f_m.ravel(), self._marker_force_names)
             loaded = np.flatnonzero(np.any(f_m != 0.0, axis=1))
             if loaded.size:
-                plant_context = self._plant_context_entry.Eval(context)
-                generalized = sum(
-                    self._project(
-                        plant_context,
-                        self._marker_bodies[i].body_frame(),
-                        self._markers[i].p_BM,
-                        f_m[i],
-                    )
-                    for i in loaded
-                )
-                terms[6] = Squash(generalized @ self._to_joints, *self._squash["work"])
+                generalized = self._screws.Project(
+                    self._screws_entry.Eval(context),
+                    self._marker_moves[loaded],
+                    self._marker_pose_entry.Eval(context)[0][loaded],
+                    f_m[loaded],
+                ).sum(axis=0)
+                terms[6] = Squash(generalized, *self._squash["work"])
 
-        terms[7] = 0.0
         if self._barrier and normals is not None:
             terms[7] = BarrierForce(
                 normals,
@@ -484,6 +482,7 @@ class Mobee(LeafSystem):
                 self._step.period,
                 p.barrier,
             )
+        np.sum(terms[:-1], axis=0, out=terms[-1])
 
     def _CalcMarkerPoses(self, context, value) -> None:
         MarkerStates(
@@ -494,13 +493,9 @@ class Mobee(LeafSystem):
         )
 
     def _CalcMarkerJacobians(self, context, output) -> None:
-        plant_context = self._plant_context_entry.Eval(context)
-        world = self._plant.world_frame()
-        blocks = [
-            self._plant.CalcJacobianTranslationalVelocity(
-                plant_context, JacobianWrtVariable.kV, body.body_frame(), marker.p_BM, world, world
-            )
-            @ self._to_joints
-            for marker, body in zip(self._markers, self._marker_bodies)
-        ]
-        output.SetFromVector(np.concatenate([b.ravel() for b in blocks]) if blocks else np.zeros(0))
+        jacobians = self._screws.Jacobians(
+            self._screws_entry.Eval(context),
+            self._marker_body_rows,
+            self._marker_pose_entry.Eval(context)[0],
+        )
+        output.SetFromVector(jacobians.ravel())

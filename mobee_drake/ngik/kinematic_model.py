@@ -18,7 +18,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake.mobee.constraints import ClauseSet
-from mobee_drake.mobee.fields import FindFieldPairs
+from mobee_drake.mobee.fields import RobotFields
 from mobee_drake.robots.controlled_robot import ControlledRobot
 from mobee_drake.robots.overlay import MarkerStates
 from mobee_drake.robots.scenario_robot import AddScenarioRobot, RobotConfig
@@ -87,8 +87,7 @@ class KinematicModel:
         self.markers, self._marker_bodies = self.robot.markers, self.robot.marker_bodies
         self.marker_names = self.robot.marker_names
         self.clearance = clearance
-        self._field_margins = self._overlay.field_margins if inside_fields else None
-        self._max_margin = max(self._overlay.field_margins.values(), default=0.0)
+        self._fields = RobotFields(self._overlay.field_margins) if inside_fields else None
         inspector = scene_graph.model_inspector()
         self._names = {g: inspector.GetName(g) for g in inspector.GetAllGeometryIds()}
         self._names.update(self._overlay.geometry_names)
@@ -118,8 +117,8 @@ class KinematicModel:
 
     def _CollisionPairs(self) -> tuple[tuple[str, str], ...]:
         query = self.scene_graph.get_query_output_port().Eval(self._scene_graph_context)
-        if self._field_margins is not None:
-            fields = FindFieldPairs(query, self._field_margins, self._max_margin)
+        if self._fields is not None:
+            fields = self._fields.FindPairs(query)
             return tuple(
                 (self._names[a], self._names[b])
                 for a, b in zip(fields.geometry_A, fields.geometry_B)

@@ -145,7 +145,8 @@ def _AddMobee(
             ),
         )
         builder.Connect(mobee.GetOutputPort("total"), mover.GetInputPort("total"))
-        builder.Connect(mobee.GetOutputPort("damping"), mover.GetInputPort("damping"))
+        if isinstance(mover_config, Dynamic):  # MoBeE sees the plant's measured velocity.
+            builder.Connect(mobee.GetOutputPort("damping"), mover.GetInputPort("damping"))
     S, s0 = mobee.PlantStateMap()
     to_plant = builder.AddNamedSystem(f"{prefix}to_plant_state", LinearMapSystem(S, s0))
     builder.Connect(mover.GetOutputPort("state"), to_plant.get_input_port())

@@ -23,7 +23,9 @@ class VirtualDynamics(LeafSystem):
         v+ = (v + h (total - damping) / M) / (1 + h C / M),     q+ = q + h v+.
 
     The ``damping`` input carries ``-C v`` of whatever velocity MoBeE saw (the dynamic robot's
-    measured one), and is replaced by the implicit damping of this system's own velocity.
+    measured one), and is replaced by the implicit damping of this system's own velocity. Left
+    unconnected, MoBeE saw this system's own velocity (the kinematic robot, whose MoBeE reads this
+    state), and ``damping = -C v`` is computed here (the same numbers, one port read fewer).
     The state (q, v) is the output, in MoBeE's joint order.
     """
 
@@ -35,6 +37,7 @@ class VirtualDynamics(LeafSystem):
         mass, damping = np.asarray(mass, dtype=float), np.asarray(damping, dtype=float)
         self._period = period
         self._h_over_mass = period / mass
+        self._damping = damping
         self._damping_factor = 1.0 / (1.0 + period * damping / mass)
         self._total_port = self.DeclareVectorInputPort("total", n)
         self._damping_port = self.DeclareVectorInputPort("damping", n)
@@ -49,7 +52,10 @@ class VirtualDynamics(LeafSystem):
     def _Update(self, context, discrete_state) -> None:
         x = context.get_discrete_state_vector().value()
         n = len(self._h_over_mass)
-        undamped = self._total_port.Eval(context) - self._damping_port.Eval(context)
+        if self._damping_port.HasValue(context):
+            undamped = self._total_port.Eval(context) - self._damping_port.Eval(context)
+        else:  # total - (-C v)
+            undamped = self._total_port.Eval(context) + self._damping * x[n:]
         v_next = (x[n:] + self._h_over_mass * undamped) * self._damping_factor
         discrete_state.get_mutable_vector().SetFromVector(
             np.concatenate([x[:n] + self._period * v_next, v_next])
