@@ -117,8 +117,13 @@ class TestVirtualDynamics(unittest.TestCase):
     def test_one_step_is_semi_implicit_euler_with_implicit_damping(self):
         mass, damping, h = np.array([2.0, 1.0]), np.array([10.0, 0.0]), 0.02
         q0 = np.array([0.1, -0.2])
-        dut = VirtualDynamics(mass=mass, damping=damping, period=h, initial_positions=q0)
+        dut = VirtualDynamics(
+            mass=mass, damping=damping, period=h, initial_positions=q0, measured_damping=True
+        )
         context = dut.CreateDefaultContext()
+        np.testing.assert_array_equal(
+            context.get_discrete_state_vector().value(), [0.1, -0.2, 0, 0]
+        )
         v0 = np.array([0.5, 1.0])
         context.SetDiscreteState(np.concatenate([q0, v0]))
         total, damping_term = np.array([3.0, -4.0]), np.array([-1.0, 0.0])
@@ -126,6 +131,14 @@ class TestVirtualDynamics(unittest.TestCase):
         dut.GetInputPort("damping").FixValue(context, damping_term)
         state = dut.EvalUniquePeriodicDiscreteUpdate(context).get_vector().value()
         v1 = (v0 + h * (total - damping_term) / mass) / (1 + h * damping / mass)
+        np.testing.assert_allclose(state, np.concatenate([q0 + h * v1, v1]))
+        # Without the damping input it is the damping of this state, -C v0.
+        kinematic = VirtualDynamics(mass=mass, damping=damping, period=h, initial_positions=q0)
+        own = kinematic.CreateDefaultContext()
+        own.SetDiscreteState(np.concatenate([q0, v0]))
+        kinematic.GetInputPort("total").FixValue(own, total)
+        state = kinematic.EvalUniquePeriodicDiscreteUpdate(own).get_vector().value()
+        v1 = (v0 + h * (total + damping * v0) / mass) / (1 + h * damping / mass)
         np.testing.assert_allclose(state, np.concatenate([q0 + h * v1, v1]))
 
     def test_spring_and_damper_settle_at_the_attractor(self):
@@ -139,7 +152,6 @@ class TestVirtualDynamics(unittest.TestCase):
         for _ in range(1500):
             q, v = context.get_discrete_state_vector().value()
             dut.GetInputPort("total").FixValue(context, [-K * (q - 1.0) - C * v])
-            dut.GetInputPort("damping").FixValue(context, [-C * v])
             context.SetDiscreteState(dut.EvalUniquePeriodicDiscreteUpdate(context).value())
         np.testing.assert_allclose(
             context.get_discrete_state_vector().value(), [1.0, 0.0], atol=1e-6

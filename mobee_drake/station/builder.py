@@ -142,10 +142,12 @@ def _AddMobee(
                 damping=mobee.damping,
                 period=time_step,
                 initial_positions=mobee.home,
+                # The dynamic robot's MoBeE sees the plant's measured velocity.
+                measured_damping=isinstance(mover_config, Dynamic),
             ),
         )
         builder.Connect(mobee.GetOutputPort("total"), mover.GetInputPort("total"))
-        if isinstance(mover_config, Dynamic):  # MoBeE sees the plant's measured velocity.
+        if isinstance(mover_config, Dynamic):
             builder.Connect(mobee.GetOutputPort("damping"), mover.GetInputPort("damping"))
     S, s0 = mobee.PlantStateMap()
     to_plant = builder.AddNamedSystem(f"{prefix}to_plant_state", LinearMapSystem(S, s0))

@@ -1,10 +1,11 @@
 """MoBeE's virtual dynamics (eq. 5.7) integrated in discrete time: the kinematic robot's motion."""
 
 import numpy as np
-from pydrake.systems.framework import BasicVector, LeafSystem
+from pydrake.systems.framework import Diagram, DiagramBuilder
+from pydrake.systems.primitives import LinearSystem, Multiplexer
 
 
-class VirtualDynamics(LeafSystem):
+class VirtualDynamics(Diagram):
     """Integrates ``M q'' = total`` with period ``h`` from the forces of MoBeE.
 
     .. pydrake_system::
@@ -12,51 +13,54 @@ class VirtualDynamics(LeafSystem):
         name: VirtualDynamics
         input_ports:
         - total
-        - damping
+        - damping (with measured_damping)
         output_ports:
         - state
 
-    ``total`` is MoBeE's total force and ``damping`` its damping term ``-C v`` (both n). The
-    damping is linear and stiff (``h C / M`` reaches 1 at MoBeE's rates), so it is integrated
-    implicitly and every other force explicitly (semi-implicit Euler):
+    ``total`` is MoBeE's total force (n). MoBeE's damping term ``-C v`` is linear and stiff
+    (``h C / M`` reaches 1 at MoBeE's rates), so it is integrated implicitly and every other
+    force explicitly (semi-implicit Euler):
 
-        v+ = (v + h (total - damping) / M) / (1 + h C / M),     q+ = q + h v+.
+        v+ = (v + h (total - damping) / M) / (1 + h C / M),     q+ = q + h v+,
 
-    The ``damping`` input carries ``-C v`` of whatever velocity MoBeE saw (the dynamic robot's
-    measured one), and is replaced by the implicit damping of this system's own velocity. Left
-    unconnected, MoBeE saw this system's own velocity (the kinematic robot, whose MoBeE reads this
-    state), and ``damping = -C v`` is computed here (the same numbers, one port read fewer).
-    The state (q, v) is the output, in MoBeE's joint order.
+    where ``damping`` is the ``-C v`` MoBeE put into ``total``. For the kinematic robot MoBeE
+    reads this system's own state, so ``damping = -C v`` of this state; with
+    ``measured_damping`` (the dynamic robot, whose MoBeE sees the plant's measured velocity) it
+    is an input, MoBeE's ``damping`` port. Either way the update is linear in (q, v) and the
+    inputs: a Drake :class:`LinearSystem` with period ``h`` (no Python in the loop). The state
+    (q, v) is the output, in MoBeE's joint order.
     """
 
     def __init__(
-        self, *, mass: np.ndarray, damping: np.ndarray, period: float, initial_positions: np.ndarray
+        self,
+        *,
+        mass: np.ndarray,
+        damping: np.ndarray,
+        period: float,
+        initial_positions: np.ndarray,
+        measured_damping: bool = False,
     ):
         super().__init__()
-        n = len(mass)
         mass, damping = np.asarray(mass, dtype=float), np.asarray(damping, dtype=float)
-        self._period = period
-        self._h_over_mass = period / mass
-        self._damping = damping
-        self._damping_factor = 1.0 / (1.0 + period * damping / mass)
-        self._total_port = self.DeclareVectorInputPort("total", n)
-        self._damping_port = self.DeclareVectorInputPort("damping", n)
-        state = self.DeclareDiscreteState(
-            BasicVector(np.concatenate([initial_positions, np.zeros(n)]))
+        n, h = len(mass), period
+        gain = h / mass / (1.0 + h * damping / mass)  # v+ = keep v + gain (total - damping)
+        # With the damping of this state, total - damping = total + C v, and keep = 1.
+        keep = 1.0 / (1.0 + h * damping / mass) if measured_damping else np.ones(n)
+        A = np.block([[np.eye(n), h * np.diag(keep)], [np.zeros((n, n)), np.diag(keep)]])
+        B_total = np.vstack([h * np.diag(gain), np.diag(gain)])
+        B = np.hstack([B_total, -B_total]) if measured_damping else B_total
+        builder = DiagramBuilder()
+        linear = builder.AddNamedSystem(
+            "integrator",
+            LinearSystem(A, B, np.eye(2 * n), np.zeros((2 * n, B.shape[1])), time_period=h),
         )
-        self.DeclareStateOutputPort("state", state)
-        self.DeclarePeriodicDiscreteUpdateEvent(
-            period_sec=period, offset_sec=0.0, update=self._Update
-        )
-
-    def _Update(self, context, discrete_state) -> None:
-        x = context.get_discrete_state_vector().value()
-        n = len(self._h_over_mass)
-        if self._damping_port.HasValue(context):
-            undamped = self._total_port.Eval(context) - self._damping_port.Eval(context)
-        else:  # total - (-C v)
-            undamped = self._total_port.Eval(context) + self._damping * x[n:]
-        v_next = (x[n:] + self._h_over_mass * undamped) * self._damping_factor
-        discrete_state.get_mutable_vector().SetFromVector(
-            np.concatenate([x[:n] + self._period * v_next, v_next])
-        )
+        linear.configure_default_state(np.concatenate([initial_positions, np.zeros(n)]))
+        if measured_damping:
+            inputs = builder.AddNamedSystem("inputs", Multiplexer([n, n]))
+            builder.Connect(inputs.get_output_port(), linear.get_input_port())
+            builder.ExportInput(inputs.get_input_port(0), "total")
+            builder.ExportInput(inputs.get_input_port(1), "damping")
+        else:
+            builder.ExportInput(linear.get_input_port(), "total")
+        builder.ExportOutput(linear.get_output_port(), "state")
+        builder.BuildInto(self)
