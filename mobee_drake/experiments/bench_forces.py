@@ -203,6 +203,56 @@ def MeasureForceEvaluations(
     )
 
 
+# The stages of one evaluation timed by ``--stages``, each after the previous ones (so each
+# stage's time is its own: the caches of the earlier stages are up to date).
+STAGES = (
+    "pose update",  # SceneGraph's poses of the robot's geometries (forward kinematics)
+    "query",  # the signed-distance query up to the largest field margin
+    "field pairs",  # reading the query's results into MoBeE's field pairs (the query again)
+    "forces",  # MoBeE's total: its plant context, screws, normals and every term
+)
+
+
+def MeasureStages(
+    num_obstacles: int, *, robot: str = "icub", num_poses: int = 2000, repeats: int = 5, seed=0
+) -> dict[str, float]:
+    """Microseconds per evaluation of each of :data:`STAGES` (best of ``repeats`` sweeps), through
+    MoBeE's public ports; "field pairs" includes a second query (MoBeE's own), which is then
+    subtracted, so that the stages add up to one evaluation."""
+    rng = np.random.default_rng(seed)
+    objects = [_RandomBox(f"box{i}", robot, rng) for i in range(num_obstacles)]
+    scene = BuildPosedScene(ROBOTS[robot](), objects)
+    plant, mobee = scene.plant, scene.mobee
+    _, plant_context, mobee_context = scene.Contexts()
+    order, poses = scene.PositionOrder(), _OscillatorPoses(mobee, num_poses, rng)
+    x = plant.GetPositions(plant_context)
+    query_port = mobee.GetInputPort("geometry_query")
+    pairs_port, total_port = mobee.GetOutputPort("field_pairs"), mobee.GetOutputPort("total")
+    some_geometry = query_port.Eval(mobee_context).inspector().GetAllGeometryIds()[0]
+    best = dict.fromkeys(STAGES, np.inf)
+    clock = time.perf_counter
+    for _ in range(repeats):
+        spent = dict.fromkeys(STAGES, 0.0)
+        for q in poses:
+            x[order] = q
+            plant.SetPositions(plant_context, x)
+            t0 = clock()
+            query = query_port.Eval(mobee_context)
+            query.GetPoseInWorld(some_geometry)
+            t1 = clock()
+            query.ComputeSignedDistancePairwiseClosestPoints(scene.max_margin)
+            t2 = clock()
+            pairs_port.Eval(mobee_context)
+            t3 = clock()
+            total_port.Eval(mobee_context)
+            t4 = clock()
+            for stage, seconds in zip(STAGES, (t1 - t0, t2 - t1, t3 - t2 - (t2 - t1), t4 - t3)):
+                spent[stage] += seconds
+        for stage in STAGES:
+            best[stage] = min(best[stage], 1e6 * spent[stage] / num_poses)
+    return best
+
+
 def ScalabilityFigure(curves: dict[str, list[tuple]], churn: bool) -> Figure:
     """Fig. 2.4: MoBeE evaluations per second against the boxes in the workspace, per robot
     (``curves``: robot -> rows of boxes, best and median rate)."""
@@ -255,7 +305,23 @@ def main(argv=None) -> None:
     parser.add_argument(
         "--seed", type=NonNegativeInt, default=0, help="seed of the boxes and the oscillators"
     )
+    parser.add_argument(
+        "--stages",
+        action="store_true",
+        help="instead, time each stage of one evaluation: " + ", ".join(STAGES),
+    )
     args = parser.parse_args(argv)
+    if args.stages:
+        print("| robot | boxes | " + " | ".join(f"{s} (us)" for s in STAGES) + " |")
+        print("|---|---:|" + "---:|" * len(STAGES))
+        for robot in args.robot:
+            for n in args.obstacles:
+                stages = MeasureStages(
+                    n, robot=robot, num_poses=args.poses, repeats=args.repeats, seed=args.seed
+                )
+                cells = " | ".join(f"{stages[s]:.1f}" for s in STAGES)
+                print(f"| {robot} | {n} | {cells} |", flush=True)
+        return
     print(
         "| robot | boxes | evaluations/s (best) | evaluations/s (median) | us/evaluation (best) "
         "| floor us (best) | ratio | pairs inside fields (mean) | peak RSS (MiB) |"
