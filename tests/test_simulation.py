@@ -12,6 +12,7 @@ from pydrake.systems.framework import LeafSystem
 from mobee_drake import cli
 from mobee_drake.atomic_files import CurrentGeneration
 from mobee_drake.mobee.fields import FieldPairs
+from mobee_drake.mobee.system import FORCE_TERMS
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.scenario import BuildScenario, LoadScenario, ResumableConfiguration, RunScenario
 from mobee_drake.station.attractors import RandomAttractorSource
@@ -113,6 +114,14 @@ class TestScenarioFiles(unittest.TestCase):
             LoadScenario(REACH, "{mver: !Dynamic {}}")
 
 
+def Forces(total, damping) -> np.ndarray:
+    """MoBeE's ``forces`` vector with only its ``damping`` term and its ``total`` set."""
+    n = len(total)
+    forces = np.zeros((len(FORCE_TERMS) + 1, n))
+    forces[FORCE_TERMS.index("damping")], forces[-1] = damping, total
+    return forces.ravel()
+
+
 class TestVirtualDynamics(unittest.TestCase):
     def test_one_step_is_semi_implicit_euler_with_implicit_damping(self):
         mass, damping, h = np.array([2.0, 1.0]), np.array([10.0, 0.0]), 0.02
@@ -127,8 +136,7 @@ class TestVirtualDynamics(unittest.TestCase):
         v0 = np.array([0.5, 1.0])
         context.SetDiscreteState(np.concatenate([q0, v0]))
         total, damping_term = np.array([3.0, -4.0]), np.array([-1.0, 0.0])
-        dut.GetInputPort("total").FixValue(context, total)
-        dut.GetInputPort("damping").FixValue(context, damping_term)
+        dut.GetInputPort("forces").FixValue(context, Forces(total, damping_term))
         state = dut.EvalUniquePeriodicDiscreteUpdate(context).get_vector().value()
         v1 = (v0 + h * (total - damping_term) / mass) / (1 + h * damping / mass)
         np.testing.assert_allclose(state, np.concatenate([q0 + h * v1, v1]))
@@ -136,7 +144,7 @@ class TestVirtualDynamics(unittest.TestCase):
         kinematic = VirtualDynamics(mass=mass, damping=damping, period=h, initial_positions=q0)
         own = kinematic.CreateDefaultContext()
         own.SetDiscreteState(np.concatenate([q0, v0]))
-        kinematic.GetInputPort("total").FixValue(own, total)
+        kinematic.GetInputPort("forces").FixValue(own, Forces(total, damping_term))
         state = kinematic.EvalUniquePeriodicDiscreteUpdate(own).get_vector().value()
         v1 = (v0 + h * (total + damping * v0) / mass) / (1 + h * damping / mass)
         np.testing.assert_allclose(state, np.concatenate([q0 + h * v1, v1]))
@@ -151,7 +159,7 @@ class TestVirtualDynamics(unittest.TestCase):
         context = dut.CreateDefaultContext()
         for _ in range(1500):
             q, v = context.get_discrete_state_vector().value()
-            dut.GetInputPort("total").FixValue(context, [-K * (q - 1.0) - C * v])
+            dut.GetInputPort("forces").FixValue(context, Forces([-K * (q - 1.0) - C * v], [-C * v]))
             context.SetDiscreteState(dut.EvalUniquePeriodicDiscreteUpdate(context).value())
         np.testing.assert_allclose(
             context.get_discrete_state_vector().value(), [1.0, 0.0], atol=1e-6

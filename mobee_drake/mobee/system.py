@@ -1,5 +1,7 @@
 """MoBeE 2.0 as a Drake LeafSystem: the forces of dissertation eq. 5.7-5.17, one port per term."""
 
+import math
+
 import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.geometry import QueryObject
@@ -196,13 +198,6 @@ class Mobee(LeafSystem):
             prerequisites_of_calc={plant_ticket},
         )
         screws_ticket = self._screws_entry.ticket()
-        self._field_pairs_entry = self.DeclareCacheEntry(
-            description="geometry pairs inside their fields",
-            value_producer=ValueProducer(
-                allocate=lambda: AbstractValue.Make(NO_FIELD_PAIRS), calc=self._CalcFieldPairs
-            ),
-            prerequisites_of_calc={self._query_port.ticket()},
-        )
         self._marker_pose_entry = self.DeclareCacheEntry(
             description="marker positions and directions",
             value_producer=ValueProducer(
@@ -212,44 +207,38 @@ class Mobee(LeafSystem):
             prerequisites_of_calc={plant_ticket},
         )
 
-        self._forces_entry = self.DeclareCacheEntry(
-            description="force terms of eq. 5.7",
-            value_producer=ValueProducer(
-                # One row per term, then their total.
-                allocate=lambda: AbstractValue.Make(np.zeros((len(FORCE_TERMS) + 1, n))),
-                calc=self._CalcForces,
-            ),
-            prerequisites_of_calc={
-                state_ticket,
-                screws_ticket,
-                self._marker_pose_entry.ticket(),
-                self._field_pairs_entry.ticket(),
-                self._attractor_entry.ticket(),
-                self._config_force_port.ticket(),
-                self._marker_forces_port.ticket(),
-            },
-        )
+        # The forces and the field pairs are computed by their own output ports, whose values Drake
+        # caches: the other ports, MoBeE's own terms and every client share one evaluation.
+        forces_prerequisites = {
+            state_ticket,
+            screws_ticket,
+            self._marker_pose_entry.ticket(),
+            self._query_port.ticket(),  # (the field pairs)
+            self._attractor_entry.ticket(),
+            self._config_force_port.ticket(),
+            self._marker_forces_port.ticket(),
+        }
         for row, term in enumerate(FORCE_TERMS):
             self.DeclareVectorOutputPort(
                 term,
                 n,
                 lambda context, output, row=row: output.SetFromVector(
-                    self._forces_entry.Eval(context)[row]
+                    self._forces_port.Eval(context)[row * n : (row + 1) * n]
                 ),
-                prerequisites_of_calc={self._forces_entry.ticket()},
+                prerequisites_of_calc=forces_prerequisites,
             )
         self.DeclareVectorOutputPort(
             "total",
             n,
-            lambda context, output: output.SetFromVector(self._forces_entry.Eval(context)[-1]),
-            prerequisites_of_calc={self._forces_entry.ticket()},
+            lambda context, output: output.SetFromVector(self._forces_port.Eval(context)[-n:]),
+            prerequisites_of_calc=forces_prerequisites,
         )
-        # Every term and the total in one vector (term-major), for loggers: one read, not eight.
-        self.DeclareVectorOutputPort(
+        # Every term and then the total in one vector (term-major).
+        self._forces_port = self.DeclareVectorOutputPort(
             "forces",
             (len(FORCE_TERMS) + 1) * n,
-            lambda context, output: output.SetFromVector(self._forces_entry.Eval(context).ravel()),
-            prerequisites_of_calc={self._forces_entry.ticket()},
+            self._CalcForces,
+            prerequisites_of_calc=forces_prerequisites,
         )
         for row, name in enumerate(("marker_positions", "marker_directions")):
             self.DeclareVectorOutputPort(
@@ -270,13 +259,13 @@ class Mobee(LeafSystem):
             "field_contacts",
             lambda: AbstractValue.Make([]),
             self._CalcFieldContacts,
-            prerequisites_of_calc={self._field_pairs_entry.ticket()},
+            prerequisites_of_calc={self._query_port.ticket()},
         )
-        self.DeclareAbstractOutputPort(
+        self._field_pairs_port = self.DeclareAbstractOutputPort(
             "field_pairs",
             lambda: AbstractValue.Make(NO_FIELD_PAIRS),
-            lambda context, output: output.set_value(self._field_pairs_entry.Eval(context)),
-            prerequisites_of_calc={self._field_pairs_entry.ticket()},
+            self._CalcFieldPairs,
+            prerequisites_of_calc={self._query_port.ticket()},
         )
 
     @staticmethod
@@ -376,7 +365,9 @@ class Mobee(LeafSystem):
     # Input checks.
 
     def _CheckFinite(self, what: str, value: np.ndarray, names: list[str]) -> None:
-        if not np.isfinite(value).all():
+        if math.isfinite(value.sum()):  # NaN and inf propagate through a sum: all are finite.
+            return
+        if not np.isfinite(value).all():  # (A finite vector whose sum overflowed passes.)
             i = np.flatnonzero(~np.isfinite(value))[0]
             raise ValueError(f"MoBeE: {what} for '{names[i]}' is not finite: {value[i]}")
 
@@ -404,13 +395,13 @@ class Mobee(LeafSystem):
         positions = self._robot.PlantPositions(q, self._default_positions.copy())
         self._plant.SetPositions(plant_context, positions)
 
-    def _CalcFieldPairs(self, context, value) -> None:
-        value.set_value(self._fields.FindPairs(self._query_port.Eval(context)))
+    def _CalcFieldPairs(self, context, output) -> None:
+        output.set_value(self._fields.FindPairs(self._query_port.Eval(context)))
 
     def _CalcFieldContacts(self, context, output) -> None:
         output.set_value(
             ToFieldContacts(
-                self._field_pairs_entry.Eval(context),
+                self._field_pairs_port.Eval(context),
                 self._query_port.Eval(context),
                 self._geometry_names,
             )
@@ -427,11 +418,11 @@ class Mobee(LeafSystem):
             self._screws_entry.Eval(context), moves, pairs.p_WCa, pairs.nhat_BA_W
         )
 
-    def _CalcForces(self, context, value) -> None:
+    def _CalcForces(self, context, output) -> None:
         p = self._params
         q, v = self._ReadState(context)
         q_star = self._attractor_entry.Eval(context)
-        terms = value.get_mutable_value()
+        terms = output.get_mutable_value().reshape(len(FORCE_TERMS) + 1, len(q))  # (a view)
 
         # -L(K(q - q*)) as L(K(q* - q)): L is odd (the same numbers, one operation fewer).
         terms[0] = Squash(self._stiffness * (q_star - q), *self._squash["spring"])
@@ -445,7 +436,7 @@ class Mobee(LeafSystem):
                 depths[2 * n :], p.constraint_delta, p.constraint_force
             )
 
-        pairs = self._field_pairs_entry.Eval(context)
+        pairs = self._field_pairs_port.Eval(context)
         normals = None
         if len(pairs):
             normals = self._FieldNormals(context, pairs)

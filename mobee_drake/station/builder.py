@@ -146,9 +146,7 @@ def _AddMobee(
                 measured_damping=isinstance(mover_config, Dynamic),
             ),
         )
-        builder.Connect(mobee.GetOutputPort("total"), mover.GetInputPort("total"))
-        if isinstance(mover_config, Dynamic):
-            builder.Connect(mobee.GetOutputPort("damping"), mover.GetInputPort("damping"))
+        builder.Connect(mobee.GetOutputPort("forces"), mover.GetInputPort("forces"))
     S, s0 = mobee.PlantStateMap()
     to_plant = builder.AddNamedSystem(f"{prefix}to_plant_state", LinearMapSystem(S, s0))
     builder.Connect(mover.GetOutputPort("state"), to_plant.get_input_port())

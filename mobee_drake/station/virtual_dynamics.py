@@ -2,7 +2,9 @@
 
 import numpy as np
 from pydrake.systems.framework import Diagram, DiagramBuilder
-from pydrake.systems.primitives import LinearSystem, Multiplexer
+from pydrake.systems.primitives import LinearSystem
+
+from mobee_drake.mobee.system import FORCE_TERMS
 
 
 class VirtualDynamics(Diagram):
@@ -12,12 +14,12 @@ class VirtualDynamics(Diagram):
 
         name: VirtualDynamics
         input_ports:
-        - total
-        - damping (with measured_damping)
+        - forces
         output_ports:
         - state
 
-    ``total`` is MoBeE's total force (n). MoBeE's damping term ``-C v`` is linear and stiff
+    ``forces`` is MoBeE's ``forces`` port (every term, then the total; n each), of which this
+    system reads the ``total`` and the ``damping`` term ``-C v``. The damping is linear and stiff
     (``h C / M`` reaches 1 at MoBeE's rates), so it is integrated implicitly and every other
     force explicitly (semi-implicit Euler):
 
@@ -26,9 +28,9 @@ class VirtualDynamics(Diagram):
     where ``damping`` is the ``-C v`` MoBeE put into ``total``. For the kinematic robot MoBeE
     reads this system's own state, so ``damping = -C v`` of this state; with
     ``measured_damping`` (the dynamic robot, whose MoBeE sees the plant's measured velocity) it
-    is an input, MoBeE's ``damping`` port. Either way the update is linear in (q, v) and the
-    inputs: a Drake :class:`LinearSystem` with period ``h`` (no Python in the loop). The state
-    (q, v) is the output, in MoBeE's joint order.
+    is MoBeE's. Either way the update is linear in (q, v) and the forces: a Drake
+    :class:`LinearSystem` with period ``h`` (no Python in the loop). The state (q, v) is the
+    output, in MoBeE's joint order.
     """
 
     def __init__(
@@ -48,19 +50,18 @@ class VirtualDynamics(Diagram):
         keep = 1.0 / (1.0 + h * damping / mass) if measured_damping else np.ones(n)
         A = np.block([[np.eye(n), h * np.diag(keep)], [np.zeros((n, n)), np.diag(keep)]])
         B_total = np.vstack([h * np.diag(gain), np.diag(gain)])
-        B = np.hstack([B_total, -B_total]) if measured_damping else B_total
+        # Reads the total (the last block of the forces) and, measured, MoBeE's damping term.
+        B = np.zeros((2 * n, (len(FORCE_TERMS) + 1) * n))
+        B[:, -n:] = B_total
+        if measured_damping:
+            damping_row = FORCE_TERMS.index("damping")
+            B[:, damping_row * n : (damping_row + 1) * n] = -B_total
         builder = DiagramBuilder()
         linear = builder.AddNamedSystem(
             "integrator",
             LinearSystem(A, B, np.eye(2 * n), np.zeros((2 * n, B.shape[1])), time_period=h),
         )
         linear.configure_default_state(np.concatenate([initial_positions, np.zeros(n)]))
-        if measured_damping:
-            inputs = builder.AddNamedSystem("inputs", Multiplexer([n, n]))
-            builder.Connect(inputs.get_output_port(), linear.get_input_port())
-            builder.ExportInput(inputs.get_input_port(0), "total")
-            builder.ExportInput(inputs.get_input_port(1), "damping")
-        else:
-            builder.ExportInput(linear.get_input_port(), "total")
+        builder.ExportInput(linear.get_input_port(), "forces")
         builder.ExportOutput(linear.get_output_port(), "state")
         builder.BuildInto(self)
