@@ -165,6 +165,7 @@ def _Bench(args: list[str]) -> None:
             "babbling": "mobee_drake.experiments.bench_babbling",
             "forces": "mobee_drake.experiments.bench_forces",
             "ik": "mobee_drake.experiments.bench_ik",
+            "reactive": "mobee_drake.experiments.bench_reactive",
             "safety": "mobee_drake.experiments.bench_safety",
             "simulation": "mobee_drake.experiments.bench_simulation",
         },

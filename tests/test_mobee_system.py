@@ -74,7 +74,7 @@ class TestPerJointConstants(unittest.TestCase):
         own = JointParams(
             mass=2.0, spring_squash=SquashParams(5.0, 2.0), limit_delta=0.2, limit_force=10.0
         )
-        params = MobeeParams(damping=7.0, joint_overrides={"joint2": own})
+        params = MobeeParams(damping=7.0, stiffness=50.0, joint_overrides={"joint2": own})
         values = params.PerJoint(["joint1", "joint2", "joint3"])
         np.testing.assert_array_equal(values.mass, [1.0, 2.0, 1.0])
         np.testing.assert_array_equal(values.damping, [7.0, 7.0, 7.0])

@@ -166,14 +166,26 @@ def PushedRun(
     return RunStation(station, scenario.duration, simulator_config=scenario.simulator_config)
 
 
-def SceneRun(scene: Scene, mover: str, *, barrier: bool = True, seconds: float = 4.0) -> RunSummary:
-    """One fixed push of ``scene`` on the robot ``mover`` (a key of MOVERS)."""
+# MoBeE's constants under test, as a scenario's YAML tags them (mobee_drake/mobee/params.py).
+PRESETS = {"defaults": "!MobeeParams", "dissertation": "!Dissertation"}
+
+
+def SceneRun(
+    scene: Scene,
+    mover: str,
+    *,
+    barrier: bool = True,
+    seconds: float = 4.0,
+    preset: str = "defaults",
+) -> RunSummary:
+    """One fixed push of ``scene`` on the robot ``mover`` (a key of MOVERS), with MoBeE's
+    constants ``preset`` (a key of PRESETS)."""
     scenario = LoadScenario(
         "reach_around_ball",
         [
             scene.overrides,
             f"{{mover: {MOVERS[mover]}, duration: {seconds}, data_log: {{enabled: false}}, "
-            f"mobee: {{barrier: {{enabled: {str(barrier).lower()}}}}}}}",
+            f"mobee: {PRESETS[preset]} {{barrier: {{enabled: {str(barrier).lower()}}}}}}}",
         ],
     )
     return PushedRun(scenario, marker=scene.marker, direction=scene.direction)
@@ -204,17 +216,23 @@ def main(argv=None) -> None:
         default=["scenes", "babbling"],
         help="which parts to run",
     )
+    parser.add_argument(
+        "--preset", choices=sorted(PRESETS), default="defaults", help="MoBeE's constants (scenes)"
+    )
     args = parser.parse_args(argv)
     header = (
         "| run | closest to the obstacle (mm) | closest to itself (mm) | penetrating periods "
         "| deepest (mm) |\n|---|---:|---:|---:|---:|"
     )
     if "scenes" in args.part:
-        print(f"Saturated pushes (c = f = {PUSH:g}) for 4 s, barrier off and on:\n{header}")
+        print(
+            f"Saturated pushes (c = f = {PUSH:g}) for 4 s, MoBeE's {args.preset}, barrier off "
+            f"and on:\n{header}"
+        )
         for scene in SCENES:
             for mover in MOVERS:
                 for barrier in (False, True):
-                    summary = SceneRun(scene, mover, barrier=barrier)
+                    summary = SceneRun(scene, mover, barrier=barrier, preset=args.preset)
                     label = f"{scene.name}, {mover}, barrier {'on' if barrier else 'off'}"
                     print(_Row(label, summary, scene.obstacle), flush=True)
     if "babbling" in args.part:

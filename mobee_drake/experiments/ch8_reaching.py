@@ -59,6 +59,7 @@ from mobee_drake.experiments.battery import (
 )
 from mobee_drake.experiments.exploration import ExplorationScenario, Explore
 from mobee_drake.experiments.plots import Figure, SaveFigure, StackedBars, plt
+from mobee_drake.mobee.params import Dissertation
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig, LoadAgentModel
 from mobee_drake.planning.state_space import Lattice
@@ -138,6 +139,7 @@ def ReachScenario(reach_force: float = ReachForcing().force) -> Scenario:
     scenario.attractor = StateActionAttractor()
     scenario.attractor.forcing.force = reach_force
     scenario.time_step = 0.02
+    scenario.mobee = Dissertation()  # (ch. 8 with the source's constants)
     scenario.data_log.enabled = False  # (The battery keeps its own data.)
     return scenario
 

@@ -8,6 +8,7 @@ import numpy as np
 from pydrake.systems.analysis import InitializeParams
 
 from mobee_drake.experiments.battery import JobStopped
+from mobee_drake.mobee.params import Dissertation
 from mobee_drake.planning.explorers import INITIALIZATIONS
 from mobee_drake.planning.supervisor import ExploreAttractor, ExploringAgent
 from mobee_drake.scenario import BuildScenario, ResumableConfiguration, Scenario
@@ -27,6 +28,7 @@ def ExplorationScenario(
     scenario.objects = list(objects)
     scenario.attractor = ExploreAttractor(agents=agents)
     scenario.time_step = 0.02
+    scenario.mobee = Dissertation()  # (ch. 7 with the source's constants)
     scenario.random_seed = random_seed
     scenario.data_log.enabled = False  # (The experiments keep their own data.)
     return scenario

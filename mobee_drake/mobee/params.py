@@ -4,13 +4,25 @@ Units: joint positions in radians, lengths in metres, time in seconds. With the 
 every force is a joint acceleration in rad/s^2 (and the collision gain is in (rad/s^2) per metre of
 field penetration per metre of lever arm).
 
-Where the defaults come from: the 2014 MoBeE of the dissertation used unit mass, damping 50,
-an attractor spring of slope 50 squashed to 1000 deg/s^2 (17.5 rad/s^2), joint limits with a
-10-degree spring and 1000 deg/s^2 at the limit, constraint forces of 1500 deg/s^2, and collision
-forces squashed to 1200 deg/s^2 (docs/mobee.md). We keep mass, damping, stiffness and the
-10-degree springs, and choose the maxima in a fixed order that the text asks for (ch. 5.2.1-5.2.2):
-the client's forces (20 rad/s^2) must be able to beat the attractor spring (20) but never the
-constraint forces (limits, constraints and collisions: 40).
+Two presets (docs/mobee.md, "Presets"):
+
+- :class:`MobeeParams`, the defaults, chosen by measurement against Drake's differential IK
+  (docs/reactive.md). Far from the attractor the spring is squashed to its maximum ``m_s`` and
+  the damping ``C`` caps a joint's speed at ``m_s / C``; near it the spring is linear (slope
+  ``k K``) and eq. 5.7 is ``q'' = -C q' - k K (q - q*)``, critically damped when ``C^2 = 4 k K``,
+  with time constant ``1 / sqrt(k K)``. We take ``C = 20/s`` and ``K = 100/s^2`` (k = 1): critical
+  damping, a 0.1 s time constant and a 1 rad/s (57 deg/s) speed cap from the attractor alone.
+  The maxima keep the order the text asks for (ch. 5.2.1-5.2.2): each client force (20) can beat
+  the spring (20), and the forces that keep the robot safe (limits, constraints, collisions: 80)
+  beat the spring and both client forces together (60). The obstacle-aware flow is on.
+- :class:`Dissertation`, the constants of the dissertation's experiments: the 2014 MoBeE used unit
+  mass, damping 50, an attractor spring of slope 50 squashed to 1000 deg/s^2 (17.5 rad/s^2),
+  joint limits with a 10-degree spring and 1000 deg/s^2 at the limit, constraint forces of 1500
+  deg/s^2, and collision forces squashed to 1200 deg/s^2 (docs/mobee.md). It keeps mass, damping,
+  stiffness and the 10-degree springs, with maxima in the same order (client 20, spring 20,
+  safety 40): an overdamped approach (slow pole 1.02/s, so a 1 s time constant) capped at 0.4
+  rad/s (23 deg/s), the source's slow and careful motion. No flow. The experiments of ch. 7 and 8
+  and the scenarios that reproduce them use it.
 """
 
 import dataclasses as dc
@@ -19,6 +31,7 @@ import math
 import numpy as np
 
 from mobee_drake.mobee.barrier import BarrierParams
+from mobee_drake.mobee.flow import FlowParams
 
 
 @dc.dataclass
@@ -71,8 +84,8 @@ class MobeeParams:
 
     # M, C, K of eq. 5.7 for every controlled joint ...
     mass: float = 1.0
-    damping: float = 50.0
-    stiffness: float = 50.0
+    damping: float = 20.0
+    stiffness: float = 100.0
     # ... and every other per-joint constant below, unless a joint has its own value here.
     joint_overrides: dict[str, JointParams] = dc.field(default_factory=dict)
 
@@ -83,19 +96,22 @@ class MobeeParams:
     # L of the projected workspace forces on markers (eq. 5.10).
     work_squash: SquashParams = dc.field(default_factory=lambda: SquashParams(20.0, 1.0))
     # L of the projected collision forces (eq. 5.11).
-    collision_squash: SquashParams = dc.field(default_factory=lambda: SquashParams(40.0, 1.0))
+    collision_squash: SquashParams = dc.field(default_factory=lambda: SquashParams(80.0, 1.0))
     # Workspace force per metre of field penetration, before projection (eq. 5.11).
     collision_gain: float = 1.0e4
 
     # Joint limits (eq. 5.12): spring length delta (rad) and force f_max at the limit.
     limit_delta: float = math.radians(10.0)
-    limit_force: float = 40.0
+    limit_force: float = 80.0
     # Linear constraints (eq. 5.15): spring length delta (rad of joint space) and f_max.
     constraint_delta: float = math.radians(10.0)
-    constraint_force: float = 40.0
+    constraint_force: float = 80.0
     # The safety barrier (ours): no force, a client's or MoBeE's, closes a gap between solids
     # faster than this (see mobee_drake/mobee/barrier.py).
     barrier: BarrierParams = dc.field(default_factory=BarrierParams)
+    # The obstacle-aware flow (ours): the goal-directed forces bent around the fields they push
+    # into (see mobee_drake/mobee/flow.py).
+    flow: FlowParams = dc.field(default_factory=FlowParams)
 
     def _Values(self, override: JointParams | None = None) -> dict[str, float]:
         """Every per-joint constant by name (``spring_squash.m``, ...), robot-wide or, where
@@ -164,3 +180,16 @@ class MobeeParams:
                 for squash in SQUASHES
             },
         )
+
+
+@dc.dataclass
+class Dissertation(MobeeParams):
+    """MoBeE 2.0 with the constants of the dissertation's experiments (see the module): in a
+    scenario, ``mobee: !Dissertation {}``."""
+
+    damping: float = 50.0
+    stiffness: float = 50.0
+    collision_squash: SquashParams = dc.field(default_factory=lambda: SquashParams(40.0, 1.0))
+    limit_force: float = 40.0
+    constraint_force: float = 40.0
+    flow: FlowParams = dc.field(default_factory=lambda: FlowParams(enabled=False))

@@ -12,6 +12,7 @@ from pydrake.systems.primitives import MatrixGain
 from mobee_drake.mobee.barrier import BarrierForce, StepModel
 from mobee_drake.mobee.constraints import ClauseSet
 from mobee_drake.mobee.fields import NO_FIELD_PAIRS, FieldPairs, RobotFields, ToFieldContacts
+from mobee_drake.mobee.flow import ModulatedFlow
 from mobee_drake.mobee.joint_limits import JointLimits
 from mobee_drake.mobee.joint_screws import JointScrews
 from mobee_drake.mobee.params import MobeeParams
@@ -30,6 +31,7 @@ FORCE_TERMS = (
     "f_coll",
     "f_config",
     "f_work",
+    "f_flow",
     "f_barrier",
 )
 
@@ -56,6 +58,8 @@ class Mobee(LeafSystem):
         - f_coll
         - f_config
         - f_work
+        - f_flow
+        - f_barrier
         - total
         - forces
         - marker_positions
@@ -76,17 +80,19 @@ class Mobee(LeafSystem):
     ``M q'' = total``):
 
     - ``spring`` = -L(K(q - q*)), ``damping`` = -C q', ``f_lim``, ``f_cst``, ``f_coll``,
-      ``f_config``, ``f_work``, the safety barrier ``f_barrier`` (ours: zero unless the others
-      would close a gap between solids too fast in the next period; needs ``step``, see
-      :mod:`mobee_drake.mobee.barrier`), and ``total``, their sum; ``forces`` (9n) all nine,
-      in that order, for loggers.
+      ``f_config``, ``f_work``, the obstacle-aware flow ``f_flow`` (ours, off unless
+      ``params.flow`` is on: the goal-directed forces bent around the fields they push into,
+      :mod:`mobee_drake.mobee.flow`), the safety barrier ``f_barrier`` (ours: zero unless the
+      others would close a gap between solids too fast in the next period; needs ``step``, see
+      :mod:`mobee_drake.mobee.barrier`), and ``total``, their sum; ``forces`` (10n) all ten, in
+      that order (the evaluation: the other ports read it).
     - ``marker_positions`` (3m) and ``marker_directions`` (3m): in world, marker after marker.
     - ``marker_jacobians`` (3mn): the translational Jacobians dp_WM/dq, marker after marker, each
       3 x n in row-major order (reshape with ``(m, 3, n)``).
     - ``field_contacts``: the list of :class:`~mobee_drake.mobee.fields.FieldContact` pairs
       inside their fields, witness points in world.
-    - ``field_pairs``: the same pairs as arrays (:class:`~mobee_drake.mobee.fields.FieldPairs`,
-      witness points in their geometries' frames): cheaper, for monitors that run every step.
+    - ``field_pairs``: the same pairs as arrays (:class:`~mobee_drake.mobee.fields.FieldPairs`):
+      cheaper, for monitors that run every step.
 
     The robot's kinematics are evaluated in a plant context held in a cache entry; the system
     keeps no state of its own. ``step`` says how the next period integrates ``total`` (the
@@ -462,12 +468,21 @@ class Mobee(LeafSystem):
                 ).sum(axis=0)
                 terms[6] = Squash(generalized, *self._squash["work"])
 
+        if p.flow.enabled and normals is not None:
+            goal_directed = terms[0] + terms[5] + terms[6]  # the spring and the client's forces
+            terms[7] = (
+                ModulatedFlow(
+                    goal_directed, normals, pairs.distance, pairs.margin, p.barrier.clearance
+                )
+                - goal_directed
+            )
+
         if self._barrier and normals is not None:
-            terms[7] = BarrierForce(
+            terms[8] = BarrierForce(
                 normals,
                 pairs.distance,
                 v,
-                terms[:7].sum(axis=0),
+                terms[:8].sum(axis=0),
                 self._mass,
                 self._step_gain,
                 self._step.period,

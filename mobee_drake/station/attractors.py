@@ -1,6 +1,6 @@
-"""The station's own attractor programs: fixed, random for motor babbling (ch. 4.1.1), or moved
-by hand with Meshcat sliders. Each config is a client of the station (see
-:mod:`mobee_drake.station.parts`)."""
+"""The station's own attractor programs: fixed (with optional workspace goals for markers),
+random for motor babbling (ch. 4.1.1), or moved by hand with Meshcat sliders. Each config is a
+client of the station (see :mod:`mobee_drake.station.parts`)."""
 
 import dataclasses as dc
 
@@ -15,13 +15,35 @@ SLIDER_PERIOD = 0.05
 
 
 @dc.dataclass
-class FixedAttractor:
-    """One attractor for the whole run: the home posture with the given joints changed."""
+class MarkerGoal:
+    """A workspace goal for one of MoBeE's markers: a spring that pulls the marker to a point,
+    MoBeE's workspace forcing (eq. 5.10), ``f = gain (position - p_marker)``."""
 
-    joints_deg: dict[str, float] = dc.field(default_factory=dict)
+    marker: str = "r_palm"
+    # The goal (world, m).
+    position: list[float] = dc.field(default_factory=lambda: [0.0, 0.0, 0.0])
+    # The spring's gain: workspace force (M rad/s^2 per m of lever) per metre of error.
+    gain: float = 200.0
 
     def Validate(self) -> None:
-        """Nothing to check before the robot is known (the joints are checked when built)."""
+        if len(self.position) != 3 or not np.isfinite(self.position).all():
+            raise ValueError(f"marker goal position must be 3 finite numbers, got {self.position}")
+        if not (np.isfinite(self.gain) and self.gain > 0):
+            raise ValueError(f"marker goal gain must be > 0, got {self.gain}")
+
+
+@dc.dataclass
+class FixedAttractor:
+    """One attractor for the whole run: the home posture with the given joints changed; and
+    optionally workspace goals for markers (the goal a differential-IK controller is given)."""
+
+    joints_deg: dict[str, float] = dc.field(default_factory=dict)
+    marker_goals: list[MarkerGoal] = dc.field(default_factory=list)
+
+    def Validate(self) -> None:
+        """The goals' values (the joints and markers are checked when built)."""
+        for goal in self.marker_goals:
+            goal.Validate()
 
     def AddToBuilder(self, parts: StationParts) -> ClientPorts:
         mobee = parts.mobee
@@ -32,7 +54,52 @@ class FixedAttractor:
         source = parts.builder.AddNamedSystem(
             f"{parts.prefix}fixed_attractor", ConstantVectorSource(q_star)
         )
-        return ClientPorts(system=source, attractor=source.get_output_port())
+        marker_forces = None
+        if self.marker_goals:
+            springs = parts.builder.AddNamedSystem(
+                f"{parts.prefix}marker_goals",
+                MarkerGoalSprings(
+                    num_markers=len(mobee.marker_names),
+                    goals={mobee.marker_index(g.marker): g for g in self.marker_goals},
+                ),
+            )
+            parts.builder.Connect(mobee.GetOutputPort("marker_positions"), springs.get_input_port())
+            marker_forces = springs.get_output_port()
+        return ClientPorts(
+            system=source, attractor=source.get_output_port(), marker_forces=marker_forces
+        )
+
+
+class MarkerGoalSprings(LeafSystem):
+    """The forces of :class:`MarkerGoal` springs on MoBeE's markers (zero on the others).
+
+    .. pydrake_system::
+
+        name: MarkerGoalSprings
+        input_ports:
+        - marker_positions
+        output_ports:
+        - marker_forces
+    """
+
+    def __init__(self, *, num_markers: int, goals: dict[int, MarkerGoal]):
+        super().__init__()
+        self._rows = np.array(sorted(goals), dtype=int)
+        self._targets = np.array([goals[i].position for i in self._rows], dtype=float)
+        self._gains = np.array([goals[i].gain for i in self._rows], dtype=float)[:, None]
+        positions = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
+        self.DeclareVectorOutputPort(
+            "marker_forces",
+            3 * num_markers,
+            self._CalcForces,
+            prerequisites_of_calc={positions.ticket()},
+        )
+
+    def _CalcForces(self, context, output) -> None:
+        p = self.get_input_port().Eval(context).reshape(-1, 3)
+        forces = np.zeros_like(p)
+        forces[self._rows] = self._gains * (self._targets - p[self._rows])
+        output.SetFromVector(forces.ravel())
 
 
 @dc.dataclass

@@ -18,7 +18,7 @@ import math
 
 from pydrake.multibody.plant import MultibodyPlantConfig
 
-from mobee_drake.mobee.params import MobeeParams
+from mobee_drake.mobee.params import Dissertation, MobeeParams
 from mobee_drake.mobee.reflex import ReflexParams
 from mobee_drake.robots.icub import IcubConfig
 from mobee_drake.robots.zero_position import ZeroPositionConfig
@@ -90,7 +90,8 @@ class Companion:
     # Pose of the companion's root in world: metres, degrees.
     position: list[float] = dc.field(default_factory=_Zeros3)
     rpy_deg: list[float] = dc.field(default_factory=_Zeros3)
-    mobee: MobeeParams = dc.field(default_factory=MobeeParams)
+    # MoBeE's constants: the defaults, or ``!Dissertation {}`` (mobee_drake/mobee/params.py).
+    mobee: MobeeParams | Dissertation = dc.field(default_factory=MobeeParams)
     attractor: RandomAttractors | FixedAttractor = dc.field(default_factory=RandomAttractors)
 
 
@@ -136,7 +137,8 @@ class StationConfig:
     objects: list[SceneObject] = dc.field(default_factory=list)
     # Other robots in the same world, each with its own MoBeE (not with the !Dynamic mover).
     companions: list[Companion] = dc.field(default_factory=list)
-    mobee: MobeeParams = dc.field(default_factory=MobeeParams)
+    # MoBeE's constants: the defaults, or ``!Dissertation {}`` (mobee_drake/mobee/params.py).
+    mobee: MobeeParams | Dissertation = dc.field(default_factory=MobeeParams)
     # What moves the robot (see the module).
     mover: Mover = dc.field(default_factory=Kinematic)
     # MoBeE's period (s): the kinematic robot's integration step, the dynamic robot's control rate.
