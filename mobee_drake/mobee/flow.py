@@ -59,16 +59,19 @@ def ModulatedFlow(
     to its length, as the module says; ``clearance`` (m) is where a pair's proximity reaches 1."""
     proximity = np.clip((margins - distances) / (margins - clearance), 0.0, 1.0)
     lengths = np.linalg.norm(normals, axis=1)
+    acting = np.flatnonzero((proximity > 0.0) & (lengths > 0.0))
+    if not acting.size:
+        return force
+    # The nearest pair last: its surface is the one to follow.
+    acting = acting[np.argsort(-distances[acting], kind="stable")]
+    units = normals[acting] / lengths[acting, None]
     flow = force
-    for k in np.argsort(-distances):  # the nearest pair last: its surface is the one to follow
-        if lengths[k] == 0.0 or proximity[k] == 0.0:
-            continue
-        unit = normals[k] / lengths[k]
-        into = flow @ unit
+    for unit, w in zip(units, proximity[acting].tolist()):
+        into = float(flow @ unit)
         if into >= 0.0:
             continue  # The flow already points away from the pair (or along it).
-        normal = into * unit
-        flow = (1.0 - proximity[k]) * normal + (1.0 + proximity[k]) * (flow - normal)
+        # (1 - w) f_n + (1 + w) f_t = (1 + w) f - 2 w f_n
+        flow = (1.0 + w) * flow - (2.0 * w * into) * unit
     length = np.linalg.norm(flow)
     if flow is force or length == 0.0:  # (zero: a pull straight into a pair at its clearance)
         return flow
