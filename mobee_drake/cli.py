@@ -174,7 +174,8 @@ def _Bench(args: list[str]) -> None:
 
 def _Experiment(args: list[str]) -> None:
     """Batteries of experiments that write data, plots and a report: ch7 (the model-learning
-    experiments of the dissertation's ch. 7), ch8 (learning to reach, ch. 8), saggriac (SAGG-RIAC
+    experiments of the dissertation's ch. 7), ch8 (learning to reach, ch. 8; ch8-discounting: when
+    its greedy reach planner moves, closed form against value iteration), saggriac (SAGG-RIAC
     on the 15-joint arm), trm (task-relevant roadmaps, ch. 3), roadmaps (adaptive roadmap
     planning on MoBeE 1.0, ch. 4.3)."""
     _Dispatch(
@@ -183,6 +184,7 @@ def _Experiment(args: list[str]) -> None:
         {
             "ch7": "mobee_drake.experiments.ch7_model_learning",
             "ch8": "mobee_drake.experiments.ch8_reaching",
+            "ch8-discounting": "mobee_drake.experiments.ch8_discounting",
             "saggriac": "mobee_drake.experiments.saggriac",
             "roadmaps": "mobee_drake.experiments.ch4_roadmaps",
             "trm": "mobee_drake.experiments.trm_roadmaps",

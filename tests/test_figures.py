@@ -136,7 +136,12 @@ class TestCh8Figures(FigureTest):
         evaluations = {
             str(stage): [
                 [
-                    dict(problem=p, reach=self.K + int(RNG.integers(self.M)), reward=RNG.random())
+                    dict(
+                        problem=p,
+                        reach=self.K + int(RNG.integers(self.M)),
+                        reward=RNG.random(),
+                        failed_transitions=int(RNG.integers(2)),
+                    )
                     for p in range(self.PROBLEMS)
                 ]
                 for _ in range(2)

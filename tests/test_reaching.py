@@ -1,6 +1,9 @@
 """Reward predictors of ch. 8 against their closed forms (eq. 8.1-8.7)."""
 
+import pathlib
+import tempfile
 import unittest
+from unittest import mock
 
 import numpy as np
 
@@ -407,3 +410,276 @@ class TestGaussianProcessPredictor(unittest.TestCase):
             RewardHistories([True], PredictorConfig("net"))
         with self.assertRaisesRegex(ValueError, "length_scale"):
             RewardHistories([True], PredictorConfig("gaussian_process", length_scale=0.0))
+
+
+class TestDiscounting(unittest.TestCase):
+    """Issue 23, point 5: when a greedy planner moves, closed form against value iteration."""
+
+    def test_closed_form_against_value_iteration(self):
+        from mobee_drake.planning.state_space import Lattice
+        from mobee_drake.reaching.discounting import (
+            MoveThreshold,
+            PathRatio,
+            StepRatio,
+            Steps,
+        )
+        from mobee_drake.reaching.learner import ReachLearner, ReachLearningConfig
+
+        # The rank-3 lattice of ch. 8 with every transition succeeding with p, else staying.
+        gamma, p = 0.9, 0.81
+        space = Lattice([0.25, 0.5, 0.75], 4)
+        T = np.zeros((space.num_state_actions, space.num_states))
+        rows = np.arange(space.num_state_actions)
+        T[rows, space.action_goal] = p
+        T[rows, space.action_state] = 1 - p
+        learner = ReachLearner(
+            space, T, np.zeros((1, 3)), ReachLearningConfig(gamma=gamma, delta=1e-10)
+        )
+        self.assertAlmostEqual(StepRatio(gamma, p), (1 - 0.9 * 0.19) / (0.9 * 0.81))
+        self.assertAlmostEqual(StepRatio(gamma, p), 1.137, places=3)
+        steps = Steps(learner, [57])
+        self.assertEqual(steps[57], 0)
+        for d in (1, 2, 3, 4):
+            start = int(np.flatnonzero(steps == d)[0])
+            self.assertAlmostEqual(
+                MoveThreshold(learner, start, [57]), PathRatio(gamma, p, d), delta=1e-5
+            )
+        # Never worth it from state 57 itself; p = 1 leaves only the discount.
+        self.assertAlmostEqual(StepRatio(gamma, 1.0), 1 / gamma)
+
+    def test_predicted_spread(self):
+        from mobee_drake.reaching.discounting import PredictedSpread
+
+        # Fresh: every reach predicts 1 (eq. 8.5), nobody moves.
+        _, learner = _Learner(targets=np.zeros((1, 3)))
+        ratios, moving = PredictedSpread(learner)
+        np.testing.assert_array_equal(ratios, [1.0])
+        np.testing.assert_array_equal(moving, [0.0])
+        # A reach of state 0 that paid 0.5 at the target predicts (1 + 0.5) / 2 = 0.75 there;
+        # its neighbours' reaches (worth 0.9 from state 0, transitions never fail) beat it.
+        learner.histories.Record(learner.Reach(0), np.zeros(3), 1.0, 0.5)
+        ratios, moving = PredictedSpread(learner)
+        np.testing.assert_allclose(ratios, [1 / 0.75])
+        np.testing.assert_allclose(moving, [1 / 4])
+
+    def test_reward_ratio_of_misses(self):
+        from mobee_drake.reaching.discounting import RewardRatio
+
+        self.assertAlmostEqual(RewardRatio(0.01, 0.33, 1.0), 1.33 / 1.01)  # metres: 1.32
+        self.assertAlmostEqual(RewardRatio(0.01, 0.33, 0.01), 34 / 2)  # centimetres: 17
+        with self.assertRaisesRegex(ValueError, "need 0 <= miss_min <= miss_max"):
+            RewardRatio(0.3, 0.1, 1.0)
+        from mobee_drake.reaching.discounting import StepRatio
+
+        with self.assertRaisesRegex(ValueError, "need 0 < gamma < 1 and 0 < p <= 1"):
+            StepRatio(0.9, 0.0)
+
+
+class TestTieBreak(unittest.TestCase):
+    def test_first_takes_the_lowest_state_action(self):
+        # From state 0 of the 2 x 2 lattice the drawn reach of state 3 lies two steps away by
+        # two equal paths (via 1 or via 2): "first" always takes the first transition.
+        space, learner = _Learner("random")
+        rewards = np.zeros(learner.num_state_actions)
+        rewards[learner.Reach(3)] = 1.0
+        q, _ = learner.Values(rewards)
+        actions = space.Actions(0)
+        self.assertAlmostEqual(q[actions[0]], q[actions[1]])
+        rng = np.random.default_rng(0)
+        chosen = {learner._Greedy(q, 0, rng) for _ in range(20)}
+        self.assertEqual(chosen, {int(actions[0])})
+        _, drawing = _Learner("random")
+        drawing.config.tie_break = "random"
+        chosen = {drawing._Greedy(q, 0, rng) for _ in range(40)}
+        self.assertEqual(chosen, set(actions[:2].tolist()))
+
+    def test_bad_tie_break(self):
+        from mobee_drake.reaching.learner import ReachLearningConfig
+
+        with self.assertRaisesRegex(ValueError, "unknown tie_break 'last'; tie breaks are first"):
+            ReachLearningConfig(tie_break="last").Validate()
+
+
+def _Try(problem, reward, reach, failed, actions=1):
+    return dict(
+        problem=problem, actions=actions, reward=reward, reach=reach, failed_transitions=failed
+    )
+
+
+def _SyntheticRun(strategy, seed, log, evaluations, hours=1.0, problems=3):
+    """A battery result on a lattice of 4 transitions and 2 states (reaches 4 and 5)."""
+    settings = dict(
+        strategy=strategy,
+        seed=seed,
+        problem_tries=int(max(r[0] for r in log)) + 1,
+        stages=sorted(int(s) for s in evaluations),
+        evaluations=len(next(iter(evaluations.values()))),
+        checkpoint_every=50,
+    )
+    return dict(
+        settings=settings,
+        evaluations=evaluations,
+        log=[list(r) + [0.0] * (10 - len(r)) for r in log],
+        simulated_seconds=3600.0 * hours,
+        wall_seconds=1.0,
+        penetrating_steps=0,
+        num_transitions=4,
+        num_states=2,
+    )
+
+
+class TestEvaluationSums(unittest.TestCase):
+    """Issue 23, points 7 and 8: the source's sum, fingerprints and run-level report."""
+
+    def test_sum_with_and_without_penalties(self):
+        from mobee_drake.experiments.ch8_reaching import EvaluationSum
+
+        evaluation = [_Try(0, 0.5, 4, 0), _Try(1, None, -1, 2, actions=10), _Try(2, 0.25, 5, 1)]
+        self.assertAlmostEqual(EvaluationSum(evaluation, penalties=False), 0.75)
+        self.assertAlmostEqual(EvaluationSum(evaluation), 0.75 - 30.0)
+
+    def test_fingerprints_closed_form(self):
+        from mobee_drake.experiments.ch8_reaching import FAVOURITES, Fingerprints
+
+        self.assertEqual(FAVOURITES, 2)
+        # try, problem, state-action: tries 0-1 reach from states 0 and 1 (problems 0, 1), try 2
+        # moves (transition 0) then reaches from 1 on problem 2, try 3 reaches from 0 again.
+        log = [(0, 0, 4), (1, 1, 5), (2, 2, 0), (2, 2, 5), (3, 0, 4)]
+        evaluation = [_Try(0, 0.5, 4, 0), _Try(1, 0.5, 4, 0, actions=2), _Try(2, 0.5, 5, 0)]
+        run = _SyntheticRun("greedy", 0, log, {"2": [evaluation], "4": [evaluation]}, hours=2.0)
+        f = Fingerprints(run)
+        # Two states only, so the two favourites hold every reach.
+        self.assertEqual((f["favourite_share"], f["reach_states"]), (1.0, 2))
+        self.assertEqual(f["favourite_reaches"], [4, 5])
+        self.assertAlmostEqual(f["evaluation_actions"], 4 / 3)
+        # Coverage: before try 2 the pairs (0, 4), (1, 5) of 3 x 2; before 4 also (2, 5).
+        self.assertEqual(f["coverage"], {2: 2 / 6, 4: 3 / 6})
+        self.assertEqual(f["line_share"], {2: 1.0, 4: 1.0})
+        self.assertEqual(f["robot_hours"], 2.0)
+
+    def test_report_tests_runs_not_evaluations(self):
+        from mobee_drake.experiments.ch8_reaching import Report
+        from mobee_drake.reaching.statistics import CompareRuns
+
+        log = [(0, 0, 4), (1, 1, 5)]
+        results = []
+        # Two runs per strategy, five identical evaluations each: run means 1, 3 (intrinsic),
+        # 2, 4 (random and greedy); the intrinsic runs' evaluations fail a transition each.
+        for strategy, means, failed in (("random", (2, 4), 0), ("greedy", (2, 4), 0)) + (
+            ("intrinsic", (1, 3), 1),
+        ):
+            for seed, mean in enumerate(means):
+                evaluation = [_Try(0, mean, 4, failed), _Try(1, 0.0, 4, 0), _Try(2, 0.0, 5, 0)]
+                results.append(
+                    _SyntheticRun(strategy, seed, log, {"2": [evaluation] * 5}, hours=1 + seed)
+                )
+        with tempfile.TemporaryDirectory() as folder:
+            report = Report(pathlib.Path(folder), results)
+        reaches_only = CompareRuns([1.0, 3.0], [2.0, 4.0]).Text()
+        self.assertIn(
+            f"reaches only, after 2 problem-tries, intrinsic minus random {reaches_only}", report
+        )
+        with_penalties = CompareRuns([-9.0, -7.0], [2.0, 4.0]).Text()
+        self.assertIn(
+            f"the source's sum, after 2 problem-tries, intrinsic minus random {with_penalties}",
+            report,
+        )
+        self.assertIn("2 vs 2 runs", report)
+        # The source's sum per run: -9 and -7 (mean -8, sd sqrt(2)).
+        self.assertIn("| intrinsic | 2 | -8.00 ± 1.41 |", report)
+        self.assertIn("1.00 times the robot time", report)
+
+    def test_sweep_names_and_report(self):
+        from mobee_drake.experiments import ch8_reaching as ch8
+
+        settings = [
+            ch8.RunSettings("random", 0, 4, [4], 1, 2, distance_unit=unit) for unit in (0.01, 0.1)
+        ]
+        jobs = []
+        with mock.patch.object(ch8, "RunBattery", lambda j, *a, **k: jobs.extend(j) or {}):
+            ch8.RunReachBattery(pathlib.Path("unused"), ["random", "greedy"], 2, settings, 5, None)
+        names = [j.name for j in jobs]
+        self.assertIn("mdp_tries5", names)
+        self.assertIn("greedy_unit0.01_force300_seed1", names)
+        self.assertIn("random_unit0.1_force300_seed0", names)
+        self.assertEqual(len(names), 1 + 2 * 2 * 2)
+        with self.assertRaisesRegex(ValueError, "settings repeat"):
+            ch8.RunReachBattery(pathlib.Path("unused"), ["random"], 1, settings * 2, 5, None)
+        # A report of two settings: a fingerprint row each, figures in a folder each.
+        log = [(0, 0, 4), (1, 1, 5)]
+        results = [
+            _SyntheticRun(s, seed, log, {"2": [[_Try(p, 0.5, 4, 0) for p in range(3)]] * 2})
+            for s in ("random", "greedy", "intrinsic")
+            for seed in (0, 1)
+        ]
+        swept = [
+            dict(r, settings=dict(r["settings"], distance_unit=u))
+            for u in (0.01, 0.1)
+            for r in results
+        ]
+        with tempfile.TemporaryDirectory() as folder:
+            report = ch8.Report(pathlib.Path(folder), swept)
+            self.assertTrue(
+                (pathlib.Path(folder) / "unit0.01_force300" / "8.7_problem_tries.png").is_file()
+            )
+        self.assertIn("| unit0.01_force300 | 1.00 | 1.00 ± 0.00 |", report)
+        self.assertIn("# unit0.1_force300", report)
+
+    def test_command_line_sweep(self):
+        from mobee_drake.experiments import ch8_reaching as ch8
+
+        captured = {}
+
+        def Fake(output, strategies, seeds, settings, mdp_tries, backend):
+            captured["settings"] = settings
+            raise SystemExit(0)
+
+        with (
+            tempfile.TemporaryDirectory() as folder,
+            mock.patch.object(ch8, "RunReachBattery", Fake),
+        ):
+            with self.assertRaises(SystemExit):
+                ch8.main(
+                    [
+                        "--output",
+                        folder,
+                        "--distance-unit",
+                        "0.01",
+                        "0.03",
+                        "0.1",
+                        "--tie-break",
+                        "random",
+                    ]
+                )
+        units = [s.distance_unit for s in captured["settings"]]
+        self.assertEqual(units, [0.01, 0.03, 0.1])
+        self.assertTrue(all(s.tie_break == "random" for s in captured["settings"]))
+
+    def test_report_only(self):
+        import contextlib
+        import io
+        import json
+
+        from mobee_drake.experiments import ch8_reaching as ch8
+
+        log = [(0, 0, 4), (1, 1, 5)]
+        with tempfile.TemporaryDirectory() as folder:
+            (pathlib.Path(folder) / ".mobee-drake").write_text('{"kind": "battery"}')
+            for strategy in ("random", "greedy", "intrinsic"):
+                for seed in (0, 1):
+                    run = pathlib.Path(folder) / "runs" / f"{strategy}_seed{seed}"
+                    run.mkdir(parents=True)
+                    result = _SyntheticRun(
+                        strategy, seed, log, {"2": [[_Try(p, 0.5, 4, 0) for p in range(3)]]}
+                    )
+                    (run / "result.json").write_text(json.dumps(result))
+            (pathlib.Path(folder) / "runs" / "mdp_tries5").mkdir()
+            (pathlib.Path(folder) / "runs" / "mdp_tries5" / "result.json").write_text("{}")
+            with contextlib.redirect_stdout(io.StringIO()):
+                ch8.main(["--output", folder, "--report-only"])
+            report = (pathlib.Path(folder) / "report.md").read_text()
+            self.assertIn("| greedy | 2 | 1.50 ± 0.00 |", report)
+            self.assertIn("random (a run made before the option)", report)
+        with tempfile.TemporaryDirectory() as folder, contextlib.redirect_stderr(io.StringIO()):
+            with self.assertRaises(SystemExit):
+                ch8.main(["--output", folder, "--report-only"])

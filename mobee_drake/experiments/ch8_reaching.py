@@ -22,7 +22,17 @@ from the optimistic initialisation of ch. 6 and learns the MDP with the reaches,
 update from a penalty by whether MoBeE's fields felt the target (see
 :mod:`mobee_drake.reaching.learner`); each run keeps its final counts in ``mdp.npz``.
 ``--reach-force`` sets the reach's force on the palm (the source gives none; 300 N by default),
-``--distance-unit`` the unit of eq. 8.1-8.7's distances (none given; metres by default).
+``--distance-unit`` the unit of eq. 8.1-8.7's distances (none given; metres by default); several
+values of either make a sweep: one battery on one MDP, a run of every strategy and seed per
+combination, and a report that scores each combination against the source's behavioural
+fingerprints (:func:`Fingerprints`). ``--tie-break`` chooses how the greedy policy breaks ties
+of value (the first state-action by default, or a random one). ``--report-only`` rewrites the
+plots and report of the finished runs in ``--output`` without running anything.
+
+The report sums every evaluation as the source does (the reaches' rewards and the -10 of every
+failed transition, ch. 8.3.1 and 8.3.3) and also without the penalties, and tests the source's
+claims at run level (:mod:`mobee_drake.reaching.statistics`: one value per run and stage, the
+mean of the run's evaluations, never a pool of them; effect sizes beside the p-values).
 
 Run: ``mobee-drake experiment ch8 --output results/ch8`` (the whole battery), or a reduced one:
 ``mobee-drake experiment ch8 --problem-tries 400 --seeds 2``; watch one run in Meshcat:
@@ -31,13 +41,13 @@ Run: ``mobee-drake experiment ch8 --output results/ch8`` (the whole battery), or
 
 import dataclasses as dc
 import json
+import math
 import pathlib
 import sys
 import time
 
 import numpy as np
 from pydrake.geometry import StartMeshcat
-from scipy.stats import ttest_ind
 
 from mobee_drake.atomic_files import CurrentGeneration, StrictJson, WriteGeneration
 from mobee_drake.experiments.arguments import (
@@ -64,9 +74,19 @@ from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig, LoadAgentModel
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import ExploringAgent
-from mobee_drake.reaching.learner import LOG_COLUMNS, ReachLearner, ReachLearningConfig
-from mobee_drake.reaching.predictors import PREDICTORS, PredictorConfig
+from mobee_drake.reaching.learner import (
+    LOG_COLUMNS,
+    TIE_BREAKS,
+    ReachLearner,
+    ReachLearningConfig,
+)
+from mobee_drake.reaching.predictors import (
+    FAILED_TRANSITION_REWARD,
+    PREDICTORS,
+    PredictorConfig,
+)
 from mobee_drake.reaching.robot import SimulatedRobot
+from mobee_drake.reaching.statistics import CompareRuns, RunMeans
 from mobee_drake.reaching.strategies import REACH_STRATEGIES
 from mobee_drake.reaching.targets import LoadTargetGrid
 from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS, IcubConfig
@@ -129,6 +149,8 @@ class RunSettings:
     reach_force: float = ReachForcing().force
     # The length (m) that counts as 1 in eq. 8.1-8.7 (the source gives no unit).
     distance_unit: float = PredictorConfig().distance_unit
+    # How the greedy policy breaks ties of value (one of TIE_BREAKS; the source is silent).
+    tie_break: str = ReachLearningConfig().tie_break
 
 
 def ReachScenario(reach_force: float = ReachForcing().force) -> Scenario:
@@ -199,6 +221,7 @@ def RunOne(
             seed=settings.seed,
             predictor=PredictorConfig(settings.predictor, distance_unit=settings.distance_unit),
             learn_mdp=simultaneous,
+            tie_break=settings.tie_break,
         ),
     )
     robot = ReachRobot(model.space, grid.radius, settings.reach_force, meshcat)
@@ -279,18 +302,34 @@ def ReachJob(run: RunFolder, mdp: str, settings: dict) -> dict:
     )
 
 
+def SettingLabel(settings: RunSettings) -> str:
+    """A sweep's name for a run's distance unit and reach force (job names, report sections)."""
+    return f"unit{settings.distance_unit:g}_force{settings.reach_force:g}"
+
+
 def RunReachBattery(
     output: pathlib.Path,
     strategies,
     seeds: int,
-    settings: RunSettings,
+    settings: RunSettings | list[RunSettings],
     mdp_tries: int,
     backend: Backend,
 ) -> list[dict]:
     """The MDP (unless learned with the reaches), then a run of ``settings`` for every strategy
-    and seed, on ``backend`` (see :mod:`mobee_drake.experiments.battery`)."""
+    and seed, on ``backend`` (see :mod:`mobee_drake.experiments.battery`). A list of settings is
+    a sweep: every setting's runs share the MDP and are named ``<strategy>_<SettingLabel>_seed<k>``
+    (a single setting's ``<strategy>_seed<k>``)."""
+    variants = [settings] if isinstance(settings, RunSettings) else list(settings)
+    if not variants:
+        raise ValueError("a reach-learning battery needs at least one setting")
+    if len({v.mdp for v in variants}) > 1:
+        raise ValueError("a sweep's settings must share --mdp")
+    labels = [SettingLabel(v) for v in variants]
+    if len(set(labels)) < len(labels):
+        raise ValueError(f"a sweep's settings repeat: {sorted(labels)}")
+    sweep = len(variants) > 1
     mdp = f"mdp_tries{mdp_tries}"
-    if settings.mdp == "learned_first":
+    if variants[0].mdp == "learned_first":
         RunBattery(
             [Job(mdp, MdpJob, dict(min_tries=mdp_tries))],
             output,
@@ -299,23 +338,31 @@ def RunReachBattery(
         )
     jobs = [
         Job(
-            f"{strategy}_seed{seed}",
+            f"{strategy}_{SettingLabel(variant)}_seed{seed}" if sweep else f"{strategy}_seed{seed}",
             ReachJob,
             dict(
                 mdp=mdp,
-                settings=dc.asdict(dc.replace(settings, strategy=strategy, seed=seed)),
+                settings=dc.asdict(dc.replace(variant, strategy=strategy, seed=seed)),
             ),
-            total=settings.problem_tries,
+            total=variant.problem_tries,
         )
+        for variant in variants
         for strategy in strategies
         for seed in range(seeds)
     ]
     return list(RunBattery(jobs, output, backend=backend, description="reach learning").values())
 
 
-def _Cumulative(evaluation: list[dict]) -> float:
-    """The reward summed over an evaluation's problem-tries (reaches only; a timeout gets 0)."""
-    return sum(r["reward"] or 0.0 for r in evaluation)
+def EvaluationSum(evaluation: list[dict], penalties: bool = True) -> float:
+    """The reward summed over an evaluation's problem-tries: the reaches' rewards (eq. 8.4; a
+    try that timed out has none) and, with ``penalties`` (the source's definition, ch. 8.3.1 and
+    8.3.3), the -10 of every failed transition."""
+    reaches = sum(r["reward"] or 0.0 for r in evaluation)
+    if not penalties:
+        return reaches
+    if any("failed_transitions" not in r for r in evaluation):
+        return math.nan  # A result file written before the count was kept: unknown.
+    return reaches + FAILED_TRANSITION_REWARD * sum(r["failed_transitions"] for r in evaluation)
 
 
 def _Log(run: dict) -> np.ndarray:
@@ -323,10 +370,17 @@ def _Log(run: dict) -> np.ndarray:
     return np.array(run["log"]).reshape(-1, len(LOG_COLUMNS))
 
 
-def _Cumulatives(runs: list[dict], stages: list[int]) -> np.ndarray:
-    """The cumulative reward of every evaluation: runs x stages x evaluations."""
+def _Cumulatives(runs: list[dict], stages: list[int], penalties: bool = True) -> np.ndarray:
+    """The summed reward of every evaluation (:func:`EvaluationSum`): runs x stages x
+    evaluations."""
     return np.array(
-        [[[_Cumulative(e) for e in r["evaluations"][str(stage)]] for stage in stages] for r in runs]
+        [
+            [
+                [EvaluationSum(e, penalties) for e in r["evaluations"][str(stage)]]
+                for stage in stages
+            ]
+            for r in runs
+        ]
     )
 
 
@@ -337,12 +391,13 @@ def _Seeds(runs: list[dict], repeat: int = 1) -> list[str]:
 
 def CumulativeRewardFigure(by_strategy: dict[str, list[dict]], stages: list[int]) -> Figure:
     """Fig. 8.2: the cumulative reward of every evaluation, stacked per stage, one colour per
-    seed (its evaluations split by white edges)."""
+    seed (its evaluations split by white edges): the reaches' rewards as bars, and a black tick
+    where the stack ends with the failed transitions' penalties counted (the source's sum)."""
     figure, axes = plt.subplots(
         1, len(by_strategy), figsize=(6.5 * len(by_strategy), 4.5), squeeze=False, sharey=True
     )
     for axis, (strategy, runs) in zip(axes[0], by_strategy.items()):
-        table = _Cumulatives(runs, stages)
+        table = _Cumulatives(runs, stages, penalties=False)
         evaluations = table.shape[2]
         StackedBars(
             axis,
@@ -350,6 +405,13 @@ def CumulativeRewardFigure(by_strategy: dict[str, list[dict]], stages: list[int]
             _Seeds(runs, evaluations),
             x=np.arange(len(stages)),
             width=0.6,
+        )
+        axis.hlines(
+            _Cumulatives(runs, stages).sum(axis=(0, 2)),
+            np.arange(len(stages)) - 0.35,
+            np.arange(len(stages)) + 0.35,
+            colors="black",
+            label="with the -10 penalties",
         )
         axis.set_xticks(np.arange(len(stages)), [str(s) for s in stages])
         axis.set(
@@ -445,12 +507,190 @@ def FailedTransitionsFigure(by_strategy: dict[str, list[dict]], k: int) -> Figur
     return figure
 
 
-def Report(output: pathlib.Path, results: list[dict]) -> str:
-    """Plots like Fig. 8.2, 8.4-8.8 and a markdown report; returns the report."""
+# The reaches a run's favourites (Fig. 8.4) and a window's vertical lines (Fig. 8.7) count.
+FAVOURITES = 2
+# Where the source's fingerprints are read (ch. 8.4.3): greedy and intrinsic alike up to about
+# 800 problem-tries; the intrinsic agent's coverage by 3200.
+ALIKE_UNTIL, COVERAGE_AT = 800, 3200
+
+
+def _TopShare(counts: np.ndarray) -> float:
+    """The share of ``counts`` in its FAVOURITES largest entries (nan when empty)."""
+    total = counts.sum()
+    return float(np.sort(counts)[::-1][:FAVOURITES].sum() / total) if total else math.nan
+
+
+def Fingerprints(run: dict) -> dict:
+    """One run's values of the behaviour the source describes (ch. 8.4.2-8.4.4).
+
+    - ``favourite_share``: at the run's last stage, the share of its evaluations' reaches made
+      from its FAVOURITES most used states (the source's intrinsic agent settles on a few, Fig.
+      8.4; its favourites 489 and 509); ``favourite_reaches``: those reaching state-actions;
+      ``reach_states``: how many states the evaluations reached from; ``evaluation_actions``:
+      actions per evaluation problem-try (1.00: exploitation never moves);
+    - ``line_share``: per window of exploratory problem-tries between consecutive stages (keyed
+      by the window's end), the share of the window's reaches that went to its FAVOURITES most
+      tried reaching state-actions: Fig. 8.7's vertical lines (a few reaches tried on every
+      problem) make it large;
+    - ``coverage``: per stage, the share of the (reach state, problem) pairs tried in the
+      exploratory problem-tries before it (the source's intrinsic agent: almost all 81 x 27 by
+      3200);
+    - ``robot_hours``: the run's simulated time, evaluations included.
+    """
+    k, m = run["num_transitions"], run["num_states"]
+    stages = sorted(int(s) for s in run["evaluations"])
+    last = run["evaluations"][str(stages[-1])]
+    tries = [t for e in last for t in e]
+    counts = np.bincount([t["reach"] - k for t in tries if t["reach"] >= 0], minlength=m)
+    log = _Log(run)
+    reaches = log[log[:, 2] >= k]
+    line_share, coverage = {}, {}
+    for start, end in zip([0] + stages[:-1], stages):
+        window = reaches[(reaches[:, 0] >= start) & (reaches[:, 0] < end), 2].astype(int) - k
+        if end > start:
+            line_share[end] = _TopShare(np.bincount(window, minlength=m))
+        before = reaches[reaches[:, 0] < end]
+        pairs = {(int(p), int(sa)) for p, sa in zip(before[:, 1], before[:, 2])}
+        coverage[end] = len(pairs) / (len(last[0]) * m)
+    return dict(
+        favourite_share=_TopShare(counts),
+        favourite_reaches=[
+            int(k + s) for s in np.argsort(-counts, kind="stable")[:FAVOURITES] if counts[s]
+        ],
+        reach_states=int(np.count_nonzero(counts)),
+        evaluation_actions=float(np.mean([t["actions"] for t in tries])),
+        line_share=line_share,
+        coverage=coverage,
+        robot_hours=run["simulated_seconds"] / 3600,
+    )
+
+
+def _Compare(a, b) -> str:
+    """:func:`CompareRuns` of two lists of run values as report text (nan values dropped)."""
+    a, b = [v for v in a if not math.isnan(v)], [v for v in b if not math.isnan(v)]
+    if len(a) < 2 or len(b) < 2:
+        return f"n/a ({len(a)} vs {len(b)} runs; at least 2 a side)"
+    return CompareRuns(a, b).Text()
+
+
+def _MeanSd(values) -> str:
+    values = [v for v in values if not math.isnan(v)]
+    if not values:
+        return "-"
+    return f"{np.mean(values):.2f} ± {np.std(values, ddof=1) if len(values) > 1 else 0.0:.2f}"
+
+
+def _RunSums(runs: list[dict], stage: int, penalties: bool) -> np.ndarray:
+    """One value per run: the mean of its evaluations' sums at ``stage``."""
+    return RunMeans(
+        [[EvaluationSum(e, penalties) for e in r["evaluations"][str(stage)]] for r in runs]
+    )
+
+
+def _RobotTimeRatio(by_strategy: dict[str, list[dict]]) -> float:
+    """Random's mean robot time over that of greedy and intrinsic (the source: 1.86)."""
+    hours = {s: np.mean([r["simulated_seconds"] for r in by_strategy[s]]) for s in by_strategy}
+    return hours["random"] / np.mean([hours["greedy"], hours["intrinsic"]])
+
+
+def _WindowAtOrBefore(windows, end: int) -> int | None:
+    ends = [w for w in windows if w <= end]
+    return max(ends) if ends else None
+
+
+def _Group(results: list[dict]) -> dict[str, list[dict]]:
     strategies = [
         s for s in REACH_STRATEGIES if any(r["settings"]["strategy"] == s for r in results)
     ]
-    by_strategy = {s: [r for r in results if r["settings"]["strategy"] == s] for s in strategies}
+    return {s: [r for r in results if r["settings"]["strategy"] == s] for s in strategies}
+
+
+def _SweepRow(label: str, results: list[dict]) -> str:
+    """A row of the sweep's fingerprint table for one setting's runs."""
+    by_strategy = _Group(results)
+    prints = {s: [Fingerprints(r) for r in runs] for s, runs in by_strategy.items()}
+    cells = [label]
+    cells.append(f"{np.mean([f['evaluation_actions'] for p in prints.values() for f in p]):.2f}")
+    intrinsic = prints.get("intrinsic", [])
+    cells.append(_MeanSd([f["favourite_share"] for f in intrinsic]) if intrinsic else "-")
+    if intrinsic and "greedy" in prints:
+        windows = sorted(intrinsic[0]["line_share"])
+        for end in (_WindowAtOrBefore(windows, ALIKE_UNTIL), windows[-1]):
+            if end is None:
+                cells.append("-")
+                continue
+            g = [f["line_share"][end] for f in prints["greedy"]]
+            i = [f["line_share"][end] for f in intrinsic]
+            cells.append(f"{np.nanmean(g) - np.nanmean(i):+.2f} (to {end})")
+    else:
+        cells += ["-", "-"]
+    if intrinsic:
+        stage = _WindowAtOrBefore(sorted(intrinsic[0]["coverage"]), COVERAGE_AT)
+        cells.append(
+            f"{np.mean([f['coverage'][stage] for f in intrinsic]):.2f} (at {stage})"
+            if stage is not None
+            else "-"
+        )
+    else:
+        cells.append("-")
+    cells.append(
+        f"{_RobotTimeRatio(by_strategy):.2f}"
+        if {"random", "greedy", "intrinsic"} <= set(by_strategy)
+        else "-"
+    )
+    return "| " + " | ".join(cells) + " |"
+
+
+def Report(output: pathlib.Path, results: list[dict]) -> str:
+    """Plots like Fig. 8.2, 8.4-8.8 and a markdown report; returns the report. Results of
+    several settings (a sweep: distance unit, reach force) get a fingerprint table across the
+    settings, then a section each, their figures in ``output/<SettingLabel>/``."""
+    groups: dict[str, list[dict]] = {}
+    for r in results:
+        groups.setdefault(SettingLabel(RunSettings(**r["settings"])), []).append(r)
+    if len(groups) == 1:
+        return _SettingReport(output, results)
+    lines = [
+        "## The source's behavioural fingerprints across the settings (issue 23, point 6)",
+        "",
+        "Per setting: evaluation actions per problem-try (all strategies; 1.00 means "
+        "exploitation never moves); the intrinsic agent's favourite-reach share at the last "
+        f"stage (its evaluations' reaches from its {FAVOURITES} most used states; the source: "
+        "a few favourites); greedy minus intrinsic line share (exploratory reaches on a "
+        f"window's {FAVOURITES} most tried reaching state-actions) in the window up to "
+        f"{ALIKE_UNTIL} and in the last window (the source: about 0 up to {ALIKE_UNTIL}, "
+        "greedy's vertical lines after); the intrinsic agent's coverage of the "
+        f"(reach state, problem) pairs by {COVERAGE_AT} (the source: almost all of "
+        "81 x 27); random's robot time over the other two's (the source: 1.86). Run-level "
+        "statistics in each setting's section.",
+        "",
+        "| setting | evaluation actions per try | intrinsic favourite share | greedy - "
+        f"intrinsic line share, to {ALIKE_UNTIL} | the same, last window | intrinsic "
+        "coverage | random's robot time ratio |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    lines += [_SweepRow(label, runs) for label, runs in groups.items()]
+    for label, runs in groups.items():
+        folder = output / label
+        folder.mkdir(exist_ok=True)
+        lines += ["", f"# {label}", "", f"Figures in `{label}/`.", "", _SettingReport(folder, runs)]
+    return "\n".join(lines)
+
+
+def StoredResults(output: pathlib.Path) -> list[dict]:
+    """The results of the finished reach-learning runs in a battery folder, in name order."""
+    results = []
+    for path in sorted(pathlib.Path(output).glob("runs/*/result.json")):
+        result = json.loads(path.read_text())
+        if "evaluations" in result:  # (Not the MDP's.)
+            results.append(result)
+    return results
+
+
+def _SettingReport(output: pathlib.Path, results: list[dict]) -> str:
+    """Plots and the report of one setting's runs."""
+    by_strategy = _Group(results)
+    strategies = list(by_strategy)
     stages = sorted({int(k) for r in results for k in r["evaluations"]})
     k, m = results[0]["num_transitions"], results[0]["num_states"]
     SaveFigure(CumulativeRewardFigure(by_strategy, stages), output / "8.2_cumulative_reward.png")
@@ -464,24 +704,34 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
     lines = [
         "## Cumulative reward of the exploitation evaluations (Fig. 8.2)",
         "",
-        "Sum of the reaches' rewards (eq. 8.4) over the 27 problems of one evaluation (a "
-        "problem-try that timed out adds 0); mean and standard deviation over all "
-        "evaluations of all seeds.",
-        "",
-        "| strategy | " + " | ".join(str(s) for s in stages) + " |",
-        "|---|" + "---:|" * len(stages),
-    ]
-    means = {}
-    for strategy in strategies:
-        table = _Cumulatives(by_strategy[strategy], stages)
-        means[strategy] = table.mean(axis=(0, 2))
-        lines.append(
-            f"| {strategy} | "
-            + " | ".join(
-                f"{mu:.2f} ± {sd:.2f}" for mu, sd in zip(means[strategy], table.std(axis=(0, 2)))
+        "The summed reward of one evaluation over the 27 problems, as the source defines it "
+        "(ch. 8.3.1, 8.3.3): the reaches' rewards (eq. 8.4; a problem-try that timed out has "
+        "none) and the -10 of every failed transition; then the reaches' rewards alone. One "
+        "value per run (the mean of its evaluations at the stage), mean ± sd over the runs.",
+        "Ties of value broken by: "
+        + ", ".join(
+            sorted(
+                {
+                    r["settings"].get("tie_break", "random (a run made before the option)")
+                    for r in results
+                }
             )
-            + " |"
         )
+        + ".",
+    ]
+    for penalties, title in ((True, "with the penalties"), (False, "reaches only")):
+        lines += [
+            "",
+            f"| strategy ({title}) | runs | " + " | ".join(str(s) for s in stages) + " |",
+            "|---|---:|" + "---:|" * len(stages),
+        ]
+        for strategy in strategies:
+            runs = by_strategy[strategy]
+            lines.append(
+                f"| {strategy} | {len(runs)} | "
+                + " | ".join(_MeanSd(_RunSums(runs, s, penalties)) for s in stages)
+                + " |"
+            )
     lines += [
         "",
         "## Robot time, failed transitions and reaches",
@@ -491,7 +741,6 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
         "problem-tries | wall hours (all runs) | penetrating control periods |",
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
-    hours = {}
     for strategy in strategies:
         actions, failed, timeouts, tries = 0, 0, 0, 0
         for r in by_strategy[strategy]:
@@ -501,9 +750,9 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
             tries += r["settings"]["problem_tries"]
             reaches = log[log[:, 2] >= k]
             timeouts += r["settings"]["problem_tries"] - len(reaches)
-        hours[strategy] = sum(r["simulated_seconds"] for r in by_strategy[strategy]) / 3600
+        hours = sum(r["simulated_seconds"] for r in by_strategy[strategy]) / 3600
         lines.append(
-            f"| {strategy} | {len(by_strategy[strategy])} | {hours[strategy]:.1f} | "
+            f"| {strategy} | {len(by_strategy[strategy])} | {hours:.1f} | "
             f"{SOURCE_HOURS.get(strategy, '-')} | {actions / tries:.2f} | {failed / tries:.2f} | "
             f"{timeouts} | {sum(r['wall_seconds'] for r in by_strategy[strategy]) / 3600:.2f} | "
             f"{sum(r['penetrating_steps'] for r in by_strategy[strategy])} |"
@@ -532,39 +781,79 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
                 + (f"{np.mean(success):.2f} |" if success else "- |")
             )
 
+    prints = {s: [Fingerprints(r) for r in by_strategy[s]] for s in strategies}
+    lines += [
+        "",
+        "## Behavioural fingerprints (ch. 8.4.2-8.4.4), mean ± sd over runs",
+        "",
+        f"Favourite share: the last stage's evaluation reaches from the run's {FAVOURITES} "
+        "most used states; line share: exploratory reaches on the window's "
+        f"{FAVOURITES} most tried reaching state-actions, per window of problem-tries; "
+        "coverage: (reach state, problem) pairs tried, of "
+        f"{m} x {len(next(iter(results))['evaluations'][str(stages[0])][0])}.",
+        "",
+        "| strategy | evaluation actions per try | states reached from | favourite share | "
+        "favourite reaches (per run) | "
+        + " | ".join(f"line share to {s}" for s in stages if s > 0)
+        + " | "
+        + " | ".join(f"coverage at {s}" for s in stages)
+        + " |",
+        "|---|---:|---:|---:|---|" + "---:|" * (len([s for s in stages if s > 0]) + len(stages)),
+    ]
+    for strategy in strategies:
+        p = prints[strategy]
+        lines.append(
+            f"| {strategy} | {_MeanSd([f['evaluation_actions'] for f in p])} | "
+            f"{_MeanSd([f['reach_states'] for f in p])} | "
+            f"{_MeanSd([f['favourite_share'] for f in p])} | "
+            + ", ".join("/".join(str(a) for a in f["favourite_reaches"]) for f in p)
+            + " | "
+            + " | ".join(_MeanSd([f["line_share"][s] for f in p]) for s in stages if s > 0)
+            + " | "
+            + " | ".join(_MeanSd([f["coverage"][s] for f in p]) for s in stages)
+            + " |"
+        )
+    if {"greedy", "intrinsic"} <= set(prints):
+        lines += ["", "Greedy minus intrinsic line share, per window (run level):", ""]
+        for s in stages:
+            if s > 0:
+                g = [f["line_share"][s] for f in prints["greedy"]]
+                i = [f["line_share"][s] for f in prints["intrinsic"]]
+                lines.append(f"- problem-tries up to {s}: {_Compare(g, i)}")
+
     lines += [
         "",
         "## The source's claims (ch. 8.4)",
         "",
-        "Differences of the mean cumulative reward, with Welch's t-test over the "
-        "evaluations (a claim about an order holds only with p < 0.05).",
+        "Intrinsic minus each other strategy, one value per run and stage (the mean of the "
+        "run's evaluations; evaluations of one run share its learner and are never pooled): "
+        "the difference of means, Hedges' g, Welch's t-test, the probability that an "
+        "intrinsic run beats the other's and Mann-Whitney's test over the runs (a claim about "
+        "an order holds only with p < 0.05).",
         "",
     ]
-    if {"intrinsic", "random", "greedy"} <= set(means):
-
-        def Rewards(strategy, stage):
-            return [
-                _Cumulative(e) for r in by_strategy[strategy] for e in r["evaluations"][str(stage)]
-            ]
-
-        for i, stage in enumerate(stages):
-            mine = Rewards("intrinsic", stage)
-            comparisons = []
-            for other in [s for s in strategies if s != "intrinsic"]:
-                test = ttest_ind(mine, Rewards(other, stage), equal_var=False)
-                comparisons.append(
-                    f"{other} {means['intrinsic'][i] - means[other][i]:+.2f} "
-                    f"(p = {test.pvalue:.2g})"
+    if {"intrinsic", "random", "greedy"} <= set(strategies):
+        for penalties, title in ((True, "the source's sum"), (False, "reaches only")):
+            for stage in stages:
+                mine = _RunSums(by_strategy["intrinsic"], stage, penalties)
+                comparisons = [
+                    f"{other} {_Compare(mine, _RunSums(by_strategy[other], stage, penalties))}"
+                    for other in strategies
+                    if other != "intrinsic"
+                ]
+                lines.append(
+                    f"- {title}, after {stage} problem-tries, intrinsic minus "
+                    + "; ".join(comparisons)
                 )
-            lines.append(
-                f"- after {stage} problem-tries, intrinsic minus " + ", ".join(comparisons) + ";"
-            )
-        ratio = hours["random"] / np.mean([hours["greedy"], hours["intrinsic"]])
+        hours = {s: [f["robot_hours"] for f in prints[s]] for s in strategies}
         lines += [
             "- the source: intrinsic motivation is the least competent after 100 problem-tries, "
             "improves steadily and is clearly the best from about 800 on;",
-            f"- random exploration took {ratio:.2f} times the robot time of the other two "
-            f"(source: 207 h against 109 and 113 h, 1.86 times).",
+            f"- random exploration took {_RobotTimeRatio(by_strategy):.2f} times the robot time "
+            "of the other two (source: 207 h against 109 and 113 h, 1.86 times); robot hours per "
+            "run, random minus the other two's runs: "
+            + _Compare(hours["random"], hours["greedy"] + hours["intrinsic"])
+            + ".",
         ]
     return "\n".join(lines)
 
@@ -633,15 +922,32 @@ def main(argv=None) -> None:
     parser.add_argument(
         "--reach-force",
         type=PositiveFloat,
-        default=ReachForcing().force,
-        help="the reach's force on the palm in N (use another --output)",
+        nargs="+",
+        default=[ReachForcing().force],
+        help="the reach's force on the palm in N (use another --output); several values "
+        "sweep them (with every --distance-unit)",
     )
     parser.add_argument(
         "--distance-unit",
         type=PositiveFloat,
-        default=PredictorConfig().distance_unit,
+        nargs="+",
+        default=[PredictorConfig().distance_unit],
         help="the length in m that counts as 1 in the rewards and predictions "
-        "of eq. 8.1-8.7, e.g. 0.01 for centimetres (use another --output)",
+        "of eq. 8.1-8.7, e.g. 0.01 for centimetres (use another --output); several values "
+        "sweep them: one battery, one MDP, the runs named <strategy>_unit<u>_force<F>_seed<k>",
+    )
+    parser.add_argument(
+        "--tie-break",
+        choices=TIE_BREAKS,
+        default=ReachLearningConfig().tie_break,
+        help="how the greedy policy picks among state-actions of equal value: the first "
+        "(transitions before the reach) or a random one (use another --output)",
+    )
+    parser.add_argument(
+        "--report-only",
+        action="store_true",
+        help="run nothing: write the plots and report.md of the finished runs in --output "
+        "(runs/*/result.json; batteries of earlier versions too)",
     )
     AddBackendArguments(parser, workers=2)
     argv = sys.argv[1:] if argv is None else argv
@@ -651,18 +957,24 @@ def main(argv=None) -> None:
         parser.error(f"--stages must lie in 0..{args.problem_tries}")
     output = pathlib.Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
-    settings = RunSettings(
-        args.strategies[0],
-        0,
-        args.problem_tries,
-        stages,
-        args.evaluations,
-        args.checkpoint_every,
-        args.predictor,
-        args.mdp,
-        args.reach_force,
-        args.distance_unit,
-    )
+    variants = [
+        RunSettings(
+            args.strategies[0],
+            0,
+            args.problem_tries,
+            stages,
+            args.evaluations,
+            args.checkpoint_every,
+            args.predictor,
+            args.mdp,
+            force,
+            unit,
+            args.tie_break,
+        )
+        for unit in dict.fromkeys(args.distance_unit)
+        for force in dict.fromkeys(args.reach_force)
+    ]
+    settings = variants[0]
     if args.watch:  # In the battery's folder, beside its runs.
         watch = output / "watch"
         with OwnedFolder(output, "battery"):
@@ -671,9 +983,20 @@ def main(argv=None) -> None:
                 TrainMdp(mdp_dir, args.mdp_tries)
             RunOne(watch / settings.strategy, mdp_dir, settings, StartMeshcat())
         return
-    results = RunReachBattery(
-        output, args.strategies, args.seeds, settings, args.mdp_tries, BackendOf(args)
-    )
+    if args.report_only:
+        with OwnedFolder(output, "battery"):
+            results = StoredResults(output)
+        if not results:
+            parser.error(f"--report-only: no finished reach-learning runs in {output / 'runs'}")
+    else:
+        results = RunReachBattery(
+            output,
+            args.strategies,
+            args.seeds,
+            variants if len(variants) > 1 else settings,
+            args.mdp_tries,
+            BackendOf(args),
+        )
     report = output / "report.md"
     report.write_text(
         f"# Reach learning (ch. 8.4)\n\n`mobee-drake experiment ch8 "

@@ -19,10 +19,12 @@ without a reach the try times out.
 
 Exploration (ch. 8.3.2) picks the least-tried problem (random among ties). Evaluations (ch. 8.3.3)
 put the robot in a random state (a reward of 1 on every transition into it), then try the
-shuffled problems greedily (eq. 8.1 and 8.5) and sum the reaches' rewards; they never write to
-the learner's histories. Choice where the source is silent: during an evaluation problem-try, its
-own records (a failed transition's -10) are kept in a scratch copy of the histories for the rest
-of that try only, so the greedy policy does not repeat a failing transition until it times out.
+shuffled problems greedily (eq. 8.1 and 8.5); an evaluation's summed reward (ch. 8.3.1, 8.3.3)
+counts the reaches' rewards and the -10 of every failed transition (each :class:`TryResult` keeps
+both). Evaluations never write to the learner's histories. Choice where the source is silent:
+during an evaluation problem-try, its own records (a failed transition's -10) are kept in a
+scratch copy of the histories for the rest of that try only, so the greedy policy does not
+repeat a failing transition until it times out.
 
 Beyond the source (ch. 9.4.1, ``learn_mdp``): the MDP is learned at the same time as the reaches,
 its outcome counts updated by the transitions (from the optimistic initialisation of ch. 6, or from
@@ -33,6 +35,10 @@ body), it is the problem's: -10 in its history and no model update; otherwise it
 and records 0. Choice where the source is silent: a transition that felt an object but did climb
 records 0 and does not update the model either (the object disturbed it, so its outcome says
 nothing about the robot alone).
+
+The greedy policy takes, among state-actions of equal value, the first in state-action order
+(a state's transitions, then its reach: an argmax), or with ``tie_break="random"`` one drawn from
+the try's generator (the source is silent).
 
 The learner draws from its own seeded generator and keeps a log of every action it took, from
 which its histories are rebuilt exactly (checkpoints, :meth:`ReachLearner.LoadArrays`).
@@ -56,6 +62,10 @@ from mobee_drake.reaching.predictors import (
 )
 from mobee_drake.reaching.strategies import REACH_STRATEGIES
 
+# How the greedy policy picks among state-actions of equal value: the first in state-action order
+# (the state's transitions by index, then its reach), or one drawn at random.
+TIE_BREAKS = ("first", "random")
+
 
 @dc.dataclass
 class ReachLearningConfig:
@@ -73,10 +83,17 @@ class ReachLearningConfig:
     learn_mdp: bool = False
     # The goal_babbling strategy's goal selection.
     goals: ReachGoalsConfig = dc.field(default_factory=ReachGoalsConfig)
+    # One of TIE_BREAKS (the source is silent; "first" is what an argmax over the state's
+    # state-actions does, transitions before the reach).
+    tie_break: str = "first"
 
     def Validate(self) -> None:
         self.predictor.Validate()
         self.goals.Validate()
+        if self.tie_break not in TIE_BREAKS:
+            raise ValueError(
+                f"unknown tie_break '{self.tie_break}'; tie breaks are " + ", ".join(TIE_BREAKS)
+            )
         if self.strategy not in REACH_STRATEGIES:
             raise ValueError(
                 f"unknown reach-learning strategy '{self.strategy}'; strategies "
@@ -227,9 +244,12 @@ class ReachLearner:
         return q, v
 
     def _Greedy(self, q: np.ndarray, state: int, rng) -> int:
+        """The greedy state-action of ``state``; among equal values (within 1e-12) the first
+        (``tie_break`` "first", no draw from ``rng``) or a random one."""
         actions = self.Actions(state)
         scores = q[actions]
-        return int(rng.choice(actions[scores >= scores.max() - 1e-12]))
+        best = actions[scores >= scores.max() - 1e-12]
+        return int(best[0] if self.config.tie_break == "first" else rng.choice(best))
 
     # ------------------------------------------------------------------------------------------
     # Acting.

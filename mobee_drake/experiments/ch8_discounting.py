@@ -1,0 +1,123 @@
+"""When a greedy reach planner moves (issue 23, point 5): the reward ratio one step and a path
+of steps need, in closed form (:mod:`mobee_drake.reaching.discounting`) against value iteration on
+a learned MDP, and what the ch. 8 runs' rewards and predictions give (docs/reaching.md).
+
+Run: ``mobee-drake experiment ch8-discounting --model BATTERY/runs/mdp_tries5/model [--runs
+BATTERY/runs/*/result.json]``.
+"""
+
+import json
+import pathlib
+
+import numpy as np
+
+from mobee_drake.experiments.arguments import CommandParser
+from mobee_drake.experiments.ch8_reaching import AGENT
+from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
+from mobee_drake.reaching.discounting import (
+    MoveThreshold,
+    PathRatio,
+    PredictedSpread,
+    RewardRatio,
+    StepRatio,
+    Steps,
+)
+from mobee_drake.reaching.learner import ReachLearner, ReachLearningConfig
+from mobee_drake.reaching.predictors import PredictorConfig
+from mobee_drake.reaching.targets import LoadTargetGrid
+
+
+def main(argv=None) -> None:
+    parser = CommandParser(prog="mobee-drake experiment ch8-discounting", description=__doc__)
+    parser.add_argument("--model", required=True, help="the MDP's folder (runs/mdp_tries5/model)")
+    parser.add_argument("--gamma", type=float, default=0.9, help="the discount factor")
+    parser.add_argument(
+        "--favourites",
+        type=int,
+        nargs="+",
+        default=[57, 77],
+        help="the favourite pre-reach states (the source's reaches 489 and 509)",
+    )
+    parser.add_argument(
+        "--misses", type=float, nargs=2, default=[0.01, 0.33], help="the misses' range in m"
+    )
+    parser.add_argument(
+        "--units", type=float, nargs="+", default=[1.0, 0.1, 0.03, 0.01], help="distance units (m)"
+    )
+    parser.add_argument(
+        "--runs",
+        nargs="*",
+        default=[],
+        help="result.json files of ch8 runs on this MDP: their reach rewards, and the spread of "
+        "eq. 8.5's predictions after the run (histories rebuilt from the log)",
+    )
+    args = parser.parse_args(argv)
+    model = LoadAgentModel(args.model, AGENT, ExplorerConfig())
+    space, counts = model.space, model.transitions.counts
+    learner = ReachLearner(
+        space, counts, np.zeros((1, 3)), ReachLearningConfig(gamma=args.gamma, delta=1e-10)
+    )
+    probabilities = model.transitions.Probabilities()
+    rows = np.arange(space.num_state_actions)
+    success = probabilities[rows, space.action_goal]
+    stay = probabilities[rows, space.action_state]
+    p = float(success.mean())
+    print(
+        f"learned MDP: P(goal) mean {p:.3f} (median {np.median(success):.3f}, "
+        f"{success.min():.3f}-{success.max():.3f}); P(stay) mean {stay.mean():.3f}"
+    )
+    print(
+        f"closed form, gamma {args.gamma}, p {p:.3f}: one step needs {StepRatio(args.gamma, p):.3f}"
+    )
+    steps = Steps(learner, args.favourites)
+    thresholds = np.array(
+        [
+            MoveThreshold(learner, s, args.favourites) if steps[s] > 0 else 1.0
+            for s in range(space.num_states)
+        ]
+    )
+    print(f"steps from the {space.num_states} states to the nearest of {args.favourites}:")
+    for d in range(1, steps.max() + 1):
+        at = thresholds[steps == d]
+        print(
+            f"  {d} steps ({len(at)} states): closed form {PathRatio(args.gamma, p, d):.3f}, "
+            f"value iteration on the learned T {at.min():.3f}-{at.max():.3f} (mean {at.mean():.3f})"
+        )
+    print(
+        f"from a random start (all {space.num_states} equally likely): mean steps "
+        f"{steps.mean():.2f}, needed ratio mean {thresholds.mean():.3f}, median "
+        f"{np.median(thresholds):.3f}; closed form at the mean steps "
+        f"{StepRatio(args.gamma, p) ** steps.mean():.3f}"
+    )
+    low, high = args.misses
+    for path in args.runs:
+        run = json.loads(pathlib.Path(path).read_text())
+        settings = run["settings"]
+        unit = settings.get("distance_unit", 1.0)
+        config = ReachLearningConfig(
+            gamma=args.gamma, predictor=PredictorConfig(settings["predictor"], distance_unit=unit)
+        )
+        replay = ReachLearner(space, counts, LoadTargetGrid().Centres(), config)
+        log = np.array(run["log"])
+        for row in log:
+            replay.histories.Record(int(row[2]), row[7:], row[5], row[6])
+        rewards = log[log[:, 2] >= replay.num_transitions, 6]
+        ratios, moving = PredictedSpread(replay)
+        print(
+            f"{path}: {len(log)} actions; reach rewards {rewards.min():.3f}-{rewards.max():.3f} "
+            f"(misses {unit * 100 * (1 / rewards.max() - 1):.1f}-"
+            f"{unit * 100 * (1 / rewards.min() - 1):.1f} cm); eq. 8.5's largest over smallest "
+            f"prediction per problem: median {np.median(ratios):.3f}, max {ratios.max():.3f}; "
+            f"start states from which the greedy policy moves: {100 * moving.mean():.1f} % "
+            f"(at most {100 * moving.max():.1f} % for a problem)"
+        )
+    for unit in args.units:
+        print(
+            f"misses {100 * low:g}-{100 * high:g} cm in units of {unit:g} m: rewards "
+            f"{1 / (1 + high / unit):.3f}-{1 / (1 + low / unit):.3f}, ratio at most "
+            f"{RewardRatio(low, high, unit):.2f}"
+        )
+
+
+if __name__ == "__main__":
+    main()
