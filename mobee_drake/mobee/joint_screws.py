@@ -13,8 +13,8 @@ projection of a direction n onto the joints (MoBeE's ``J^T f``, eq. 5.4, 5.10, 5
     n . dp_WP/dv_j = mask[b, j] ((P x n) . w_j + n . u_j).
 
 The screws of all of the robot's velocities come from one spatial Jacobian per chain end (a
-*leaf*: the iCub's hands and head): three Drake calls per configuration, however many points are
-projected. The columns are then carried onto the
+*leaf*: the iCub's hands and head, three calls; the Katana's arm and finger, two) per
+configuration, however many points are projected. The columns are then carried onto the
 controlled joints by the robot's velocity map (followers included: robots/couplings.py).
 """
 
