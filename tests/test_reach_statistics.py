@@ -5,7 +5,7 @@ import unittest
 
 import numpy as np
 
-from mobee_drake.reaching.statistics import CompareRuns, RunMeans
+from mobee_drake.experiments.statistics import CompareRuns, RunMeans
 
 
 class TestCompareRuns(unittest.TestCase):

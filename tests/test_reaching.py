@@ -559,7 +559,7 @@ class TestEvaluationSums(unittest.TestCase):
 
     def test_report_tests_runs_not_evaluations(self):
         from mobee_drake.experiments.ch8_reaching import Report
-        from mobee_drake.reaching.statistics import CompareRuns
+        from mobee_drake.experiments.statistics import CompareRuns
 
         log = [(0, 0, 4), (1, 1, 5)]
         results = []

@@ -31,7 +31,7 @@ plots and report of the finished runs in ``--output`` without running anything.
 
 The report sums every evaluation as the source does (the reaches' rewards and the -10 of every
 failed transition, ch. 8.3.1 and 8.3.3) and also without the penalties, and tests the source's
-claims at run level (:mod:`mobee_drake.reaching.statistics`: one value per run and stage, the
+claims at run level (:mod:`mobee_drake.experiments.statistics`: one value per run and stage, the
 mean of the run's evaluations, never a pool of them; effect sizes beside the p-values).
 
 Run: ``mobee-drake experiment ch8 --output results/ch8`` (the whole battery), or a reduced one:
@@ -69,6 +69,7 @@ from mobee_drake.experiments.battery import (
 )
 from mobee_drake.experiments.exploration import ExplorationScenario, Explore
 from mobee_drake.experiments.plots import Figure, SaveFigure, StackedBars, plt
+from mobee_drake.experiments.statistics import CompareRuns, RunMeans
 from mobee_drake.mobee.params import Dissertation
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig, LoadAgentModel
@@ -86,7 +87,6 @@ from mobee_drake.reaching.predictors import (
     PredictorConfig,
 )
 from mobee_drake.reaching.robot import SimulatedRobot
-from mobee_drake.reaching.statistics import CompareRuns, RunMeans
 from mobee_drake.reaching.strategies import REACH_STRATEGIES
 from mobee_drake.reaching.targets import LoadTargetGrid
 from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS, IcubConfig

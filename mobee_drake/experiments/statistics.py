@@ -1,4 +1,5 @@
-"""Run-level statistics for the reach-learning battery (issue 23, point 8).
+"""Run-level statistics for the experiments' reports (issue 23, point 8): first the reach-learning
+battery's (ch. 8); one module for every battery that compares learners over their runs.
 
 The evaluations of one run share one learner (its histories), so they are not independent: the
 five evaluations at a stage differ only in their start state and problem order. Every comparison
