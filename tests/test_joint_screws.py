@@ -31,7 +31,7 @@ class JointScrewsTest(unittest.TestCase):
             plant.SetPositions(plant_context, x)
             screws = dut.Calc(plant_context)
             points = rng.normal(size=(len(bodies), 3))
-            jacobians = dut.Jacobians(screws, indices, points)
+            jacobians = dut.Jacobians(screws, dut.Moves(indices), points)
             for body, p_WP, J in zip(bodies, points, jacobians):
                 p_BP = body.EvalPoseInWorld(plant_context).inverse().multiply(p_WP)
                 expected = (
@@ -56,7 +56,7 @@ class JointScrewsTest(unittest.TestCase):
             expected = np.einsum("ki,kij->kj", directions, jacobians) - np.einsum(
                 "ki,kij->kj",
                 directions,
-                dut.Jacobians(screws, indices[other], points - offsets),
+                dut.Jacobians(screws, dut.Moves(indices[other]), points - offsets),
             )
             np.testing.assert_allclose(relative, expected, atol=1e-12)
 

@@ -97,9 +97,9 @@ class JointScrews:
         p_x_n = np.einsum("ijk,aj,ak->ai", _EPS, points, directions)
         return ((p_x_n @ w + directions @ u) * moves) @ self._to_joints
 
-    def Jacobians(self, screws: np.ndarray, bodies: np.ndarray, points: np.ndarray) -> np.ndarray:
-        """(k, 3, n): the translational Jacobian ``dp_WP_i/dq`` of each point (world) of body
-        ``bodies[i]`` with respect to the controlled joints."""
+    def Jacobians(self, screws: np.ndarray, moves: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """(k, 3, n): the translational Jacobian ``dp_WP_i/dq`` of each point (world) of a body
+        moved by the velocities ``moves[i]`` (rows of :meth:`Moves`), over the controlled joints."""
         w, u = screws[:3], screws[3:]
         J = u[None] + np.einsum("ijk,jr,ak->air", _EPS, w, points)  # u_j + w_j x P
-        return (J * self._moves[bodies][:, None, :]) @ self._to_joints
+        return (J * moves[:, None, :]) @ self._to_joints

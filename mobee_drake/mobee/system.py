@@ -162,8 +162,9 @@ class Mobee(LeafSystem):
         moves = self._screws.Moves(np.array(field_bodies, dtype=int))
         self._field_moves = np.vstack([moves, np.zeros(moves.shape[1])])
         self._markers, self._marker_bodies = controlled.markers, controlled.marker_bodies
-        self._marker_body_rows = np.array([int(b.index()) for b in self._marker_bodies], dtype=int)
-        self._marker_moves = self._screws.Moves(self._marker_body_rows)
+        self._marker_moves = self._screws.Moves(
+            np.array([int(b.index()) for b in self._marker_bodies], dtype=int)
+        )
         self._marker_force_names = [f"{m.name}[{axis}]" for m in self._markers for axis in "xyz"]
         num_markers = len(self._markers)
 
@@ -501,7 +502,7 @@ class Mobee(LeafSystem):
     def _CalcMarkerJacobians(self, context, output) -> None:
         jacobians = self._screws.Jacobians(
             self._screws_entry.Eval(context),
-            self._marker_body_rows,
+            self._marker_moves,
             self._marker_pose_entry.Eval(context)[0],
         )
         output.SetFromVector(jacobians.ravel())
