@@ -17,7 +17,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from mobee_drake.goal_babbling.competence import Competence, ReachingCost
-from mobee_drake.goal_babbling.config import GoalBabblingConfig
+from mobee_drake.goal_babbling.config import CheckConfig, GoalBabblingConfig
 from mobee_drake.goal_babbling.planar_arm import PlanarArm
 
 
@@ -235,6 +235,7 @@ class Learner(abc.ABC):
             evaluator: Optional callable(memory, rest_position) -> dict of measures, run at step 0
                 and at config.evaluation.num_checkpoints equally spaced steps up to the budget.
         """
+        CheckConfig(config)
         self.config = config
         self.rng = np.random.default_rng(config.seed)
         self.arm = PlanarArm(config.arm, self.rng)
@@ -249,6 +250,11 @@ class Learner(abc.ABC):
         )
         self._next_checkpoint = 0
         self.curve = []
+        # Diagnostics (issue 23): micro-actions spent in exploration phases, reaching attempts
+        # made and those ended by the stall option.
+        self.exploration_steps = 0
+        self.num_attempts = 0
+        self.stalled_attempts = 0
 
     def _Evaluate(self) -> None:
         if self.evaluator is not None:
@@ -297,15 +303,19 @@ class Learner(abc.ABC):
         """
         centre = self.arm.joint_angles.copy()
         for _ in range(self.config.low_level.exploration_actions):
+            self.exploration_steps += 1
             self.Act(centre + self.RandomJointStep() - self.arm.joint_angles)
 
     def ReachGoal(self, goal: np.ndarray) -> float:
         """One reaching attempt with the SSA-like low level (Algorithm 1, Sec. III-D), learning.
 
-        Reaching phase: dtheta = J^+ dx_next; exploration phase when ||dx_performed - dx_next|| >
-            eps_max, or when
-        the memory holds fewer than k samples. Stops when C > eps_C (eq. 7) or after the timeout
-        (see LowLevelConfig.timeout_per_unit).
+        Reaching phase: dtheta = J^+ dx_next. An exploration phase follows a reaching micro-action
+        whose error exceeds eps_max (LowLevelConfig.exploration_trigger: the task error
+        ||dx_performed - dx_next||, the paper's, or the model error ||dx_performed - J
+        dtheta_performed||), and runs while the memory holds fewer than k samples. Stops when C >
+        eps_C (eq. 7), after the timeout (see LowLevelConfig.timeout_per_unit), or, with
+        LowLevelConfig.stall_steps > 0, once that many reaching micro-actions in a row have made no
+        progress.
 
         Args:
             goal: (2,) x_g.
@@ -314,6 +324,7 @@ class Learner(abc.ABC):
             The competence gamma of the attempt (Sec. II-D-1 with eq. 7).
         """
         low_level, interest = self.config.low_level, self.config.interest
+        model_trigger = low_level.exploration_trigger == "model"
         start = self.arm.position.copy()
         distance = float(np.linalg.norm(goal - start))
         timeout = (
@@ -321,6 +332,8 @@ class Learner(abc.ABC):
             + low_level.timeout_explorations * low_level.exploration_actions
         )
         started_at = self.time_steps
+        self.num_attempts += 1
+        closest, idle_steps = distance, 0
         while (
             ReachingCost(goal, self.arm.position, start, interest.min_competence)
             <= interest.competence_tolerance
@@ -335,7 +348,21 @@ class Learner(abc.ABC):
             )
             joint_step = ReachingJointSteps(jacobians, desired, low_level.max_joint_step)[0]
             performed = self.Act(joint_step)
-            if np.linalg.norm(performed - desired[0]) > low_level.error_threshold:
+            if model_trigger:
+                # What the local model predicted for the joint change actually made.
+                expected = jacobians[0] @ self.memory.joint_steps[self.memory.size - 1]
+            else:
+                expected = desired[0]
+            if low_level.stall_steps:
+                remaining = float(np.linalg.norm(goal - self.arm.position))
+                if remaining < closest - low_level.stall_progress:
+                    closest, idle_steps = remaining, 0
+                else:
+                    idle_steps += 1
+                    if idle_steps >= low_level.stall_steps:
+                        self.stalled_attempts += 1
+                        break
+            if np.linalg.norm(performed - expected) > low_level.error_threshold:
                 self.Explore()
         cost = ReachingCost(goal, self.arm.position, start, interest.min_competence)
         return Competence(cost, interest.competence_tolerance, interest.min_competence)

@@ -62,6 +62,17 @@ class PlanarArm:
         self.joint_angles = self.rest_angles.copy()
         self.position = self._Observe()
 
+    def SetJointAngles(self, joint_angles: np.ndarray) -> None:
+        """Puts the arm in a posture without any planning, as Reset does for the rest posture (the
+        "set" reading of the actuator baselines); angles are clipped to the joint limits.
+
+        Args:
+            joint_angles: (n,) relative joint angles in rad.
+        """
+        limit = self.config.joint_limit
+        self.joint_angles = np.clip(np.asarray(joint_angles, dtype=float), -limit, limit)
+        self.position = self._Observe()
+
     def Move(self, joint_step: np.ndarray) -> np.ndarray:
         """Performs one micro-action; joints are clipped to their limits.
 

@@ -52,19 +52,22 @@ class Region:
 
 
 def BestSplit(
-    points: np.ndarray, values: np.ndarray, window: int, min_child: int
+    points: np.ndarray, values: np.ndarray, window: int, min_child: int, weighted: bool = False
 ) -> tuple[int, float] | None:
     """The axis-aligned cut that maximises |interest(lower) - interest(upper)| (Sec. II-D-3).
 
     Candidate cuts are the midpoints between consecutive distinct coordinates, in every dimension,
     that leave at least min_child points on each side (our choice). Ties go to the most balanced
-    cut, then to the lowest dimension and coordinate.
+    cut, then to the lowest dimension and coordinate. With ``weighted`` (explauto's criterion,
+    InterestConfig.split_criterion = "weighted") the score is |L| |G| |interest(L) - interest(G)|,
+    |L| and |G| the numbers of points on each side.
 
     Args:
         points: (k, d) points in time order.
         values: (k,) their competences.
         window: zeta of eq. 2.
         min_child: Least number of points on either side.
+        weighted: Multiply the difference by the sizes of both sides.
 
     Returns:
         (dimension, cut value), or None when no cut is admissible.
@@ -92,6 +95,8 @@ def BestSplit(
             MaskedInterests(values, lower_masks, window)
             - MaskedInterests(values, ~lower_masks, window)
         )
+        if weighted:
+            differences = differences * lower_counts * (count - lower_counts)
         imbalance = np.abs(2 * lower_counts - count)
         index = np.lexsort((imbalance, -differences))[0]
         key = (-differences[index], imbalance[index])
@@ -191,7 +196,13 @@ class RegionTree:
 
     def _Split(self, region: Region) -> None:
         points, values = np.array(region.points), np.array(region.values)
-        split = BestSplit(points, values, self.config.window, self.config.min_child_goals)
+        split = BestSplit(
+            points,
+            values,
+            self.config.window,
+            self.config.min_child_goals,
+            weighted=self.config.split_criterion == "weighted",
+        )
         if split is None:
             return
         dimension, cut = split
@@ -226,10 +237,40 @@ class RegionTree:
         ]
 
 
+def SelectIndex(
+    interests: np.ndarray,
+    rng: np.random.Generator,
+    probabilities: tuple[float, float, float],
+    lowest_competence,
+) -> tuple[int, int | None]:
+    """Draws a selection mode and the index of the region it picks (Sec. II-D-3).
+
+    mode 1 (p_1): an index drawn with eq. 3 over ``interests``; mode 2 (p_2): None, meaning the
+    whole space; mode 3 (p_3): ``lowest_competence()``, the index of the region of lowest mean
+    competence (eq. 1; called only in mode 3).
+
+    Args:
+        interests: (m,) interests of the candidate regions.
+        rng: The learner's generator.
+        probabilities: (p_1, p_2, p_3).
+        lowest_competence: Callable returning the mode-3 index.
+
+    Returns:
+        (mode in {1, 2, 3}, index or None).
+    """
+    mode = int(rng.choice(3, p=np.asarray(probabilities) / np.sum(probabilities))) + 1
+    if mode == 1:
+        weights = InterestProbabilities(interests)
+        return mode, int(rng.choice(len(weights), p=weights))
+    if mode == 3:
+        return mode, int(lowest_competence())
+    return mode, None
+
+
 def SelectRegion(
     leaves: list[Region], rng: np.random.Generator, probabilities: tuple[float, float, float]
 ) -> tuple[int, Region | None]:
-    """Draws a selection mode and the region it picks (Sec. II-D-3).
+    """Draws a selection mode and the region it picks (Sec. II-D-3), see SelectIndex.
 
     mode 1 (p_1): a leaf drawn with eq. 3; mode 2 (p_2): None, meaning the whole space; mode 3
     (p_3): the leaf of lowest mean competence (eq. 1), ties to the first.
@@ -242,10 +283,10 @@ def SelectRegion(
     Returns:
         (mode in {1, 2, 3}, region or None).
     """
-    mode = int(rng.choice(3, p=np.asarray(probabilities) / np.sum(probabilities))) + 1
-    if mode == 1:
-        weights = InterestProbabilities([leaf.interest for leaf in leaves])
-        return mode, leaves[int(rng.choice(len(leaves), p=weights))]
-    if mode == 3:
-        return mode, leaves[int(np.argmin([leaf.MeanCompetence() for leaf in leaves]))]
-    return mode, None
+    mode, index = SelectIndex(
+        [leaf.interest for leaf in leaves],
+        rng,
+        probabilities,
+        lambda: np.argmin([leaf.MeanCompetence() for leaf in leaves]),
+    )
+    return mode, None if index is None else leaves[index]
