@@ -46,6 +46,7 @@ from mobee_drake.experiments.battery import (
     RunFolder,
 )
 from mobee_drake.experiments.plots import Figure, SaveFigure, plt
+from mobee_drake.experiments.statistics import CompareRuns
 from mobee_drake.goal_babbling.baselines import ActuatorRandom, ActuatorRiac, SaggRandom
 from mobee_drake.goal_babbling.config import (
     ConfigFromDict,
@@ -56,7 +57,6 @@ from mobee_drake.goal_babbling.config import (
 )
 from mobee_drake.goal_babbling.evaluation import MEASURES, Evaluator, MakeTestSet
 from mobee_drake.goal_babbling.sagg_riac import SaggRiac
-from mobee_drake.goal_babbling.statistics import Compare
 
 METHODS = {
     learner.name: learner for learner in (SaggRiac, SaggRandom, ActuatorRandom, ActuatorRiac)
@@ -333,7 +333,7 @@ def Pairs(groups: list[str]) -> list[tuple[str, str, str]]:
 def Statistics(runs: list[dict], groups: list[str]) -> list[dict]:
     """Run-level tests at the end of the runs, per measure: a one-way ANOVA over the paper's four
     methods, and each pair of Pairs() with effect sizes, intervals and power (see
-    :func:`mobee_drake.goal_babbling.statistics.Compare`).
+    :func:`mobee_drake.experiments.statistics.CompareRuns`).
 
     Args:
         runs: Results of one experiment.
@@ -341,7 +341,7 @@ def Statistics(runs: list[dict], groups: list[str]) -> list[dict]:
 
     Returns:
         Rows {measure, test, groups, claim, p_value, ...}; a pair's row carries every field of
-        :class:`mobee_drake.goal_babbling.statistics.Comparison`.
+        :class:`mobee_drake.experiments.statistics.Comparison`.
     """
     rows = []
     for measure in MEASURES:
@@ -363,14 +363,14 @@ def Statistics(runs: list[dict], groups: list[str]) -> list[dict]:
         for first, second, claim in Pairs(groups):
             if samples[first].size < 2 or samples[second].size < 2:
                 continue
-            comparison = dataclasses.asdict(Compare(samples[first], samples[second]))
+            comparison = dataclasses.asdict(CompareRuns(samples[first], samples[second]))
             rows.append(
                 {
                     "measure": measure,
                     "test": "pair",
                     "groups": f"{first} vs {second}",
                     "claim": claim,
-                    "p_value": comparison["p_anova"],
+                    "p_value": comparison["anova_p"],
                     **comparison,
                 }
             )
@@ -658,43 +658,62 @@ def _Diagnostic(runs: list[dict], name: str, scale: float = 1.0, digits: int = 1
     return f"{scale * np.mean(values):.{digits}f}" if values else "-"
 
 
-def ResultsTable(runs: list[dict], groups: list[str]) -> list[str]:
-    """Markdown rows: per group, the final measures as mean ± sd (median) over its runs."""
-    lines = [
-        "| group | runs | reaching error, mean over goals | reaching error, median over goals "
-        "| goals within 1 unit (%) | prediction error, reachable area | prediction error, near "
-        "rest | wall time per run (s) |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
+def _GroupTable(
+    runs: list[dict], groups: list[str], columns: list[str], Cells: Callable[..., list]
+) -> list[str]:
+    """Markdown rows: one per group with runs, its cells Cells(group, its runs)."""
+    lines = ["| group | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
     for group in groups:
         group_runs = [run for run in runs if Label(run["spec"]) == group]
-        if not group_runs:
-            continue
-        cells = [
+        if group_runs:
+            lines.append(f"| {group} | " + " | ".join(map(str, Cells(group, group_runs))) + " |")
+    return lines
+
+
+def ResultsTable(runs: list[dict], groups: list[str]) -> list[str]:
+    """Markdown rows: per group, the final measures as mean ± sd (median) over its runs."""
+    columns = [
+        "runs",
+        "reaching error, mean over goals",
+        "reaching error, median over goals",
+        "goals within 1 unit (%)",
+        "prediction error, reachable area",
+        "prediction error, near rest",
+        "wall time per run (s)",
+    ]
+    return _GroupTable(
+        runs,
+        groups,
+        columns,
+        lambda group, group_runs: [
+            len(group_runs),
             _Format(_Final(runs, group, "reaching_error")),
             _Format(_Final(runs, group, "reaching_error_median")),
             _Format(_Final(runs, group, "reached_share"), digits=1, scale=100.0),
             _Format(_Final(runs, group, "prediction_error")),
             _Format(_Final(runs, group, "prediction_error_near_rest")),
             f"{np.mean([run['wall_time_s'] for run in group_runs]):.0f}",
-        ]
-        lines.append(f"| {group} | {len(group_runs)} | " + " | ".join(cells) + " |")
-    return lines
+        ],
+    )
 
 
 def DiagnosticsTable(runs: list[dict], groups: list[str]) -> list[str]:
     """Markdown rows: per group, the means over its runs of the diagnostics (see Diagnostics)."""
-    lines = [
-        "| group | tip coverage (%) | tip spread | drift ratio | exploration (%) | on unreachable "
-        "(sub)goals (%) | attempts stalled (%) | regions | goals per run | goals in reach (%) |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+    columns = [
+        "tip coverage (%)",
+        "tip spread",
+        "drift ratio",
+        "exploration (%)",
+        "on unreachable (sub)goals (%)",
+        "attempts stalled (%)",
+        "regions",
+        "goals per run",
+        "goals in reach (%)",
     ]
-    for group in groups:
-        group_runs = [run for run in runs if Label(run["spec"]) == group]
-        if not group_runs:
-            continue
+
+    def Cells(group: str, group_runs: list[dict]) -> list[str]:
         regions = [run["num_regions"] for run in group_runs if "num_regions" in run]
-        cells = [
+        return [
             _Diagnostic(group_runs, "tip_coverage", 100.0),
             _Diagnostic(group_runs, "tip_spread"),
             _Diagnostic(group_runs, "drift_ratio", digits=2),
@@ -704,8 +723,8 @@ def DiagnosticsTable(runs: list[dict], groups: list[str]) -> list[str]:
             f"{np.mean(regions):.0f}" if regions else "-",
             _GoalStatistics(group_runs),
         ]
-        lines.append(f"| {group} | " + " | ".join(cells) + " |")
-    return lines
+
+    return _GroupTable(runs, groups, columns, Cells)
 
 
 def CheckpointTable(
@@ -791,7 +810,7 @@ def TestsTable(statistics: list[dict], measures: tuple[str, ...] = MEASURES) -> 
             f"{row['n_a']}, {row['n_b']} | "
             f"{_Number(row['mean_a'], 3)}, {_Number(row['mean_b'], 3)} | "
             f"{_Number(row['median_a'], 3)}, {_Number(row['median_b'], 3)} | "
-            f"{_P(row['p_anova'])} | {_P(row['p_welch'])} | {_P(row['p_mann_whitney'])} | "
+            f"{_P(row['anova_p'])} | {_P(row['welch_p'])} | {_P(row['mann_whitney_p'])} | "
             f"{_Number(row['cohens_d'])} [{_Number(row['d_low'])}, {_Number(row['d_high'])}] | "
             f"{_Number(row['power'])} | {runs_needed if runs_needed > 0 else '-'} | "
             f"{_Number(row['rank_biserial'])} [{_Number(row['r_low'])}, "

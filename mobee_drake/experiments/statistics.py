@@ -1,41 +1,59 @@
-"""Run-level statistics for the experiments' reports (issue 23, point 8): first the reach-learning
-battery's (ch. 8); one module for every battery that compares learners over their runs.
+"""Run-level statistics for the experiments' reports (issue 23, point 8): the one module with which
+every battery compares learners over their runs (the reach learner of ch. 8, SAGG-RIAC's methods).
 
-The evaluations of one run share one learner (its histories), so they are not independent: the
-five evaluations at a stage differ only in their start state and problem order. Every comparison
-here therefore takes one value per run and stage (the mean over that run's evaluations) and
-compares strategies over their runs. With the same number of evaluations in every run this is
-also what a random-intercept model (the run a random effect) tests for a between-strategy effect:
-in a balanced design its F-test of the fixed effect equals the pooled-variance t-test on the run
-means (unless the run variance's estimate is truncated at zero); we report Welch's version, which
-does not assume equal variances between strategies.
+Every sample is one value per independent run (one seed). The evaluations or test goals of one
+run share one learner, so they are not independent; a run's values are averaged first
+(:func:`RunMeans`), never pooled. With the same number of evaluations in every run this is also
+what a random-intercept model (the run a random effect) tests for a between-group effect: in a
+balanced design its F-test of the fixed effect equals the pooled-variance t-test on the run means
+(unless the run variance's estimate is truncated at zero).
 
-Beside the p-values, effect sizes: the difference of means, Hedges' g (Cohen's d with the
-pooled run-level standard deviation, corrected for small samples by ``1 - 3 / (4 (n_a + n_b) -
-9)``) and, from the Mann-Whitney U test, the probability of superiority ``U / (n_a n_b)`` (the
-chance that a run of the first strategy beats one of the second, ties counting half).
+:func:`CompareRuns` gives, for group a against group b:
+
+- the tests: Student's t (= the two-group one-way ANOVA, SAGG-RIAC's test), Welch's t (no equal
+  variances assumed) and Mann-Whitney's U (exact when small and without ties);
+- the effect sizes: Cohen's d with the pooled standard deviation and its exact interval (by
+  inverting the noncentral t), Hedges' g (d corrected by ``1 - 3 / (4 (n_a + n_b) - 9)``), the
+  probability of superiority ``U / (n_a n_b)`` and the rank-biserial correlation ``2 U / (n_a
+  n_b) - 1`` with a bootstrap interval;
+- the power of the t-test at the observed effect and the runs it would need for 80 %.
+
+Signs follow the first group: a positive d means a tends to be larger (for an error: worse).
 """
 
 import dataclasses as dc
 import math
 
 import numpy as np
-from scipy.stats import mannwhitneyu, ttest_ind
+from scipy import optimize, stats
+
+# Resamples of the rank-biserial correlation's bootstrap interval, and its seed.
+BOOTSTRAP_RESAMPLES = 10_000
+BOOTSTRAP_SEED = 0
 
 
 @dc.dataclass
 class Comparison:
-    """Strategy a against strategy b on one value per run."""
+    """Group a against group b on one value per run (the fields of :func:`CompareRuns`)."""
 
     n_a: int
     n_b: int
     mean_a: float
     mean_b: float
+    median_a: float
+    median_b: float
+    # Sample standard deviations (ddof 1).
+    sd_a: float
+    sd_b: float
     # mean_a - mean_b.
     difference: float
-    # Cohen's d (pooled standard deviation, ddof 1) and its small-sample correction.
+    # Cohen's d (pooled standard deviation) with its interval, and its small-sample correction.
     cohens_d: float
+    d_low: float
+    d_high: float
     hedges_g: float
+    # Student's t-test, the same p as the two-group one-way ANOVA.
+    anova_p: float
     welch_t: float
     welch_df: float
     welch_p: float
@@ -43,6 +61,13 @@ class Comparison:
     mann_whitney_p: float
     # P(a run of a beats a run of b) + P(tie) / 2 = U / (n_a n_b).
     superiority: float
+    # P(a > b) - P(a < b) = 2 superiority - 1, with its bootstrap interval.
+    rank_biserial: float
+    r_low: float
+    r_high: float
+    # Power of the t-test at |d| and these group sizes; runs per group for 80 % (-1: none).
+    power: float
+    runs_for_80_percent: int
 
     def Text(self) -> str:
         """One line for a report: difference, g, Welch's p, superiority and Mann-Whitney's p."""
@@ -58,50 +83,196 @@ def _Number(value: float, spec: str = ".2f") -> str:
     return "n/a" if math.isnan(value) else format(value, spec)
 
 
-def CompareRuns(a, b) -> Comparison:
-    """Welch's t-test, Mann-Whitney's U test (exact when small and without ties) and effect
-    sizes of ``a`` against ``b``, one finite value per run each (at least 2 runs a side)."""
+def _CheckAlpha(alpha: float) -> None:
+    if not 0.0 < alpha < 1.0:
+        raise ValueError(f"alpha must be in (0, 1), got {alpha}")
+
+
+def _CheckRuns(n_a: int, n_b: int) -> None:
+    if n_a < 2 or n_b < 2:
+        raise ValueError(f"compare at least 2 runs per side, got {n_a} and {n_b}")
+
+
+def _Samples(a, b) -> tuple[np.ndarray, np.ndarray]:
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    if a.ndim != 1 or b.ndim != 1 or len(a) < 2 or len(b) < 2:
-        raise ValueError(
-            f"compare at least 2 runs per side, one value each; got shapes {a.shape} and {b.shape}"
-        )
+    if a.ndim != 1 or b.ndim != 1:
+        raise ValueError(f"compare one value per run; got shapes {a.shape} and {b.shape}")
+    _CheckRuns(a.size, b.size)
     if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
         raise ValueError("run values must be finite")
-    n_a, n_b = len(a), len(b)
+    return a, b
+
+
+def CohensD(a, b) -> float:
+    """(mean(a) - mean(b)) / pooled standard deviation; 0 for identical constant groups and
+    +-inf for constant groups apart (separated without any overlap)."""
+    a, b = _Samples(a, b)
     difference = float(a.mean() - b.mean())
-    pooled = math.sqrt(((n_a - 1) * a.var(ddof=1) + (n_b - 1) * b.var(ddof=1)) / (n_a + n_b - 2))
+    pooled = math.sqrt(
+        ((a.size - 1) * a.var(ddof=1) + (b.size - 1) * b.var(ddof=1)) / (a.size + b.size - 2)
+    )
     if pooled > 0:
-        d = difference / pooled
-    else:  # No spread at all: identical groups, or separated without any overlap.
-        d = 0.0 if difference == 0 else math.copysign(math.inf, difference)
-    g = d * (1 - 3 / (4 * (n_a + n_b) - 9))
+        return difference / pooled
+    return 0.0 if difference == 0 else math.copysign(math.inf, difference)
+
+
+def _Scale(n_a: int, n_b: int) -> float:
+    """The noncentrality of a two-sample t statistic per unit of d: sqrt(n_a n_b / (n_a + n_b))."""
+    return math.sqrt(n_a * n_b / (n_a + n_b))
+
+
+def CohensDInterval(d: float, n_a: int, n_b: int, confidence: float = 0.95) -> tuple[float, float]:
+    """Confidence interval of Cohen's d by inverting the noncentral t distribution.
+
+    The two-sample t statistic is t = d sqrt(n_a n_b / (n_a + n_b)) with df = n_a + n_b - 2; the
+    bounds are the noncentrality parameters under which the observed t sits at the upper and
+    lower (1 - confidence) / 2 quantiles, scaled back to d (exact under normality and equal
+    variances). NaNs when d is not finite.
+    """
+    _CheckAlpha(1.0 - confidence)
+    _CheckRuns(n_a, n_b)
+    if not math.isfinite(d):
+        return math.nan, math.nan
+    df, scale = n_a + n_b - 2, _Scale(n_a, n_b)
+    t = d * scale
+    tail = (1.0 - confidence) / 2.0
+
+    def Bound(quantile: float) -> float:
+        def Gap(ncp: float) -> float:
+            return stats.nct.cdf(t, df, ncp) - quantile
+
+        # nct.cdf(t, df, ncp) falls from 1 to 0 as ncp grows; widen until the root is bracketed.
+        low, high, width = t - 1.0, t + 1.0, 1.0
+        while Gap(low) < 0.0:
+            width *= 2.0
+            low = t - width
+        while Gap(high) > 0.0:
+            width *= 2.0
+            high = t + width
+        return optimize.brentq(Gap, low, high, xtol=1e-10)
+
+    return Bound(1.0 - tail) / scale, Bound(tail) / scale
+
+
+def TwoSampleTPower(d: float, n_a: int, n_b: int, alpha: float = 0.05) -> float:
+    """Power of the two-sided two-sample Student t-test: P(|T| > t_crit) with T noncentral t,
+    df = n_a + n_b - 2, noncentrality d sqrt(n_a n_b / (n_a + n_b)); NaN when d is not finite."""
+    _CheckAlpha(alpha)
+    _CheckRuns(n_a, n_b)
+    if not math.isfinite(d):
+        return math.nan
+    df, ncp = n_a + n_b - 2, d * _Scale(n_a, n_b)
+    critical = stats.t.ppf(1.0 - alpha / 2.0, df)
+    power = stats.nct.sf(critical, df, ncp) + stats.nct.cdf(-critical, df, ncp)
+    if not math.isfinite(power):
+        # scipy's noncentral t fails far in its tails (large ncp); there the normal limit holds.
+        power = stats.norm.sf(critical - ncp) + stats.norm.cdf(-critical - ncp)
+    return float(min(1.0, max(0.0, power)))
+
+
+def RunsForPower(d: float, power: float = 0.8, alpha: float = 0.05, most: int = 100_000) -> int:
+    """The fewest runs per group (equal groups) with which the t-test reaches ``power`` at the
+    effect d; -1 when d is 0 or not finite, or more than ``most`` runs would be needed."""
+    _CheckAlpha(alpha)
+    if not alpha < power < 1.0:
+        raise ValueError(f"power must be in (alpha, 1), got {power}")
+    if not math.isfinite(d) or d == 0.0:
+        return -1
+    if TwoSampleTPower(d, 2, 2, alpha) >= power:
+        return 2
+    low, high = 2, 4  # power(low) < target; double high until power(high) >= target.
+    while TwoSampleTPower(d, high, high, alpha) < power:
+        if high >= most:
+            return -1
+        low, high = high, min(2 * high, most)
+    while high - low > 1:
+        middle = (low + high) // 2
+        if TwoSampleTPower(d, middle, middle, alpha) >= power:
+            high = middle
+        else:
+            low = middle
+    return high
+
+
+def _Superiority(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """P(a > b) + P(a = b) / 2 over all pairs of runs, along the last axis (resamples first)."""
+    signs = np.sign(a[..., :, None] - b[..., None, :])
+    return (np.mean(signs, axis=(-2, -1)) + 1.0) / 2.0
+
+
+def RankBiserialInterval(
+    a, b, confidence: float = 0.95, resamples: int = BOOTSTRAP_RESAMPLES, seed: int = BOOTSTRAP_SEED
+) -> tuple[float, float]:
+    """Percentile bootstrap interval of the rank-biserial correlation: runs resampled with
+    replacement within each group, with a fixed seed (the same data give the same interval)."""
+    _CheckAlpha(1.0 - confidence)
+    a, b = _Samples(a, b)
+    rng = np.random.default_rng(seed)
+    resampled_a = a[rng.integers(0, a.size, (resamples, a.size))]
+    resampled_b = b[rng.integers(0, b.size, (resamples, b.size))]
+    values = 2.0 * _Superiority(resampled_a, resampled_b) - 1.0
+    tail = 100.0 * (1.0 - confidence) / 2.0
+    lower, upper = np.percentile(values, [tail, 100.0 - tail])
+    return float(lower), float(upper)
+
+
+def CompareRuns(a, b, alpha: float = 0.05, confidence: float = 0.95) -> Comparison:
+    """Every run-level statistic of group a against group b (see the module's docstring).
+
+    Args:
+        a: One finite value per run of the first group (at least 2 runs).
+        b: One finite value per run of the second group (at least 2 runs).
+        alpha: Significance level of the power.
+        confidence: Coverage of the intervals.
+
+    Returns:
+        The comparison; the t-tests are NaN when both groups are constant, and Mann-Whitney's p is
+        1 when all runs are equal.
+    """
+    a, b = _Samples(a, b)
+    n_a, n_b = a.size, b.size
+    d = CohensD(a, b)
+    d_low, d_high = CohensDInterval(d, n_a, n_b, confidence)
     va, vb = a.var(ddof=1) / n_a, b.var(ddof=1) / n_b
     if va + vb > 0:
-        welch = ttest_ind(a, b, equal_var=False)
-        t, p = float(welch.statistic), float(welch.pvalue)
+        welch = stats.ttest_ind(a, b, equal_var=False)
+        t, welch_p = float(welch.statistic), float(welch.pvalue)
         df = (va + vb) ** 2 / (va**2 / (n_a - 1) + vb**2 / (n_b - 1))
+        anova_p = float(stats.ttest_ind(a, b).pvalue)
     else:
-        t, p, df = math.nan, math.nan, math.nan
+        t, welch_p, df, anova_p = math.nan, math.nan, math.nan, math.nan
     if np.all(a == a[0]) and np.all(b == a[0]):  # Mann-Whitney says nothing about equal groups.
-        u, mw_p = n_a * n_b / 2, 1.0
+        u, mann_whitney_p = n_a * n_b / 2, 1.0
     else:
-        test = mannwhitneyu(a, b, alternative="two-sided")
-        u, mw_p = float(test.statistic), float(test.pvalue)
+        test = stats.mannwhitneyu(a, b, alternative="two-sided")
+        u, mann_whitney_p = float(test.statistic), float(test.pvalue)
+    r_low, r_high = RankBiserialInterval(a, b, confidence)
     return Comparison(
-        n_a=n_a,
-        n_b=n_b,
+        n_a=int(n_a),
+        n_b=int(n_b),
         mean_a=float(a.mean()),
         mean_b=float(b.mean()),
-        difference=difference,
+        median_a=float(np.median(a)),
+        median_b=float(np.median(b)),
+        sd_a=float(a.std(ddof=1)),
+        sd_b=float(b.std(ddof=1)),
+        difference=float(a.mean() - b.mean()),
         cohens_d=d,
-        hedges_g=g,
+        d_low=d_low,
+        d_high=d_high,
+        hedges_g=d * (1 - 3 / (4 * (n_a + n_b) - 9)),
+        anova_p=anova_p,
         welch_t=t,
         welch_df=df,
-        welch_p=p,
+        welch_p=welch_p,
         mann_whitney_u=u,
-        mann_whitney_p=mw_p,
+        mann_whitney_p=mann_whitney_p,
         superiority=u / (n_a * n_b),
+        rank_biserial=2 * u / (n_a * n_b) - 1,
+        r_low=r_low,
+        r_high=r_high,
+        power=TwoSampleTPower(abs(d), n_a, n_b, alpha),
+        runs_for_80_percent=RunsForPower(abs(d), 0.8, alpha),
     )
 
 

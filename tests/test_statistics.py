@@ -1,0 +1,221 @@
+"""Run-level statistics of the experiments' reports (issue 23, point 8) against closed forms,
+textbook values, scipy and simulation."""
+
+import math
+import unittest
+
+import numpy as np
+from scipy import stats
+
+from mobee_drake.experiments.statistics import (
+    CohensD,
+    CohensDInterval,
+    CompareRuns,
+    RankBiserialInterval,
+    RunMeans,
+    RunsForPower,
+    TwoSampleTPower,
+)
+
+
+def RankBiserial(a, b) -> float:
+    """P(a > b) - P(a < b) over all pairs, by brute force (the definition)."""
+    return float(np.mean([np.sign(x - y) for x in a for y in b]))
+
+
+class TestCompareRuns(unittest.TestCase):
+    def test_two_runs_a_side_closed_form(self):
+        # Equal variances s^2 = 2 and n = 2: Welch's df is 2, t = -2 / sqrt(2 / 2 + 2 / 2), and
+        # Student's t with 2 degrees of freedom has the two-sided p = 1 - |t| / sqrt(2 + t^2).
+        c = CompareRuns([0.0, 2.0], [2.0, 4.0])
+        t = -2 / math.sqrt(2.0)
+        self.assertAlmostEqual(c.difference, -2.0)
+        self.assertAlmostEqual(c.welch_t, t)
+        self.assertAlmostEqual(c.welch_df, 2.0)
+        self.assertAlmostEqual(c.welch_p, 1 - abs(t) / math.sqrt(2 + t**2))
+        # d = -2 / sqrt(2); g corrects by 1 - 3 / (4 * 4 - 9).
+        self.assertAlmostEqual(c.cohens_d, -2 / math.sqrt(2))
+        self.assertAlmostEqual(c.hedges_g, c.cohens_d * (1 - 3 / 7))
+        # The pairs (0, 2), (0, 4), (2, 2), (2, 4): a wins none, ties one: U = 0.5.
+        self.assertAlmostEqual(c.mann_whitney_u, 0.5)
+        self.assertAlmostEqual(c.superiority, 0.5 / 4)
+
+    def test_complete_separation_exact_mann_whitney(self):
+        # Five runs a side, every a above every b: U = 25 and the exact two-sided p is 2 / C(10, 5).
+        a, b = [6.0, 7.0, 8.0, 9.0, 10.0], [1.0, 2.0, 3.0, 4.0, 5.0]
+        c = CompareRuns(a, b)
+        self.assertEqual(c.mann_whitney_u, 25.0)
+        self.assertAlmostEqual(c.mann_whitney_p, 2 / math.comb(10, 5))
+        self.assertEqual(c.superiority, 1.0)
+        # Variances 2.5 each: d = 5 / sqrt(2.5), t = 5 / sqrt(2.5 / 5 + 2.5 / 5) = 5, df = 8.
+        self.assertAlmostEqual(c.cohens_d, 5 / math.sqrt(2.5))
+        self.assertAlmostEqual(c.hedges_g, c.cohens_d * (1 - 3 / 31))
+        self.assertAlmostEqual(c.welch_t, 5.0)
+        self.assertAlmostEqual(c.welch_df, 8.0)
+
+    def test_welch_df_with_unequal_variances(self):
+        a, b = [0.0, 1.0, 2.0], [0.0, 10.0]
+        va, vb = 1.0 / 3, 50.0 / 2  # s^2 / n
+        c = CompareRuns(a, b)
+        self.assertAlmostEqual(c.welch_df, (va + vb) ** 2 / (va**2 / 2 + vb**2 / 1))
+
+    def test_run_means_not_pooled_evaluations(self):
+        # Two runs per strategy, five identical evaluations each: pooled, the evaluations would
+        # look like 10 independent values; at run level it is two against two.
+        a = [[1.0] * 5, [3.0] * 5]
+        b = [[2.0] * 5, [4.0] * 5]
+        means_a, means_b = RunMeans(a), RunMeans(b)
+        np.testing.assert_array_equal(means_a, [1.0, 3.0])
+        c = CompareRuns(means_a, means_b)
+        t = -1 / math.sqrt(2 / 2 + 2 / 2)
+        self.assertAlmostEqual(c.welch_p, 1 - abs(t) / math.sqrt(2 + t**2))
+        self.assertEqual((c.n_a, c.n_b), (2, 2))
+
+    def test_degenerate_groups(self):
+        same = CompareRuns([1.0, 1.0], [1.0, 1.0])
+        self.assertEqual((same.difference, same.cohens_d, same.mann_whitney_p), (0.0, 0.0, 1.0))
+        self.assertTrue(math.isnan(same.welch_p))
+        apart = CompareRuns([2.0, 2.0], [1.0, 1.0])
+        self.assertEqual(apart.cohens_d, math.inf)
+        self.assertEqual(apart.superiority, 1.0)
+        self.assertIn("Welch p = n/a", apart.Text())
+
+    def test_bad_input(self):
+        with self.assertRaisesRegex(ValueError, "at least 2 runs per side"):
+            CompareRuns([1.0], [1.0, 2.0])
+        with self.assertRaisesRegex(ValueError, "must be finite"):
+            CompareRuns([1.0, np.nan], [1.0, 2.0])
+        with self.assertRaisesRegex(ValueError, "run 1 has no values"):
+            RunMeans([[1.0], []])
+
+
+class TestEffectSizes(unittest.TestCase):
+    def test_cohens_d_by_hand(self):
+        # Means 2 and 3, both variances 1: d = -1; the sign follows the first group.
+        self.assertAlmostEqual(CohensD([1, 2, 3], [2, 3, 4]), -1.0)
+        self.assertAlmostEqual(CohensD([2, 3, 4], [1, 2, 3]), 1.0)
+        # Unequal sizes: pooled variance ((3 - 1) 1 + (2 - 1) 0.5) / 3 = 2.5 / 3.
+        self.assertAlmostEqual(CohensD([1, 2, 3], [5, 6]), (2 - 5.5) / math.sqrt(2.5 / 3))
+        self.assertEqual(CohensD([1, 1], [1, 1]), 0.0)
+        self.assertEqual(CohensD([1, 1], [0, 0]), math.inf)
+
+    def test_rank_biserial_against_mann_whitney(self):
+        rng = np.random.default_rng(3)
+        a, b = rng.normal(0, 1, 17), rng.normal(0.5, 1, 23)
+        u = stats.mannwhitneyu(a, b).statistic
+        self.assertAlmostEqual(CompareRuns(a, b).rank_biserial, 2 * u / (17 * 23) - 1)
+        self.assertAlmostEqual(CompareRuns(a, b).rank_biserial, RankBiserial(a, b))
+        self.assertEqual(CompareRuns([5, 6, 7], [1, 2]).rank_biserial, 1.0)
+        self.assertEqual(CompareRuns([1, 2], [1, 2]).rank_biserial, 0.0)  # ties count zero
+
+    def test_rank_biserial_interval_holds_the_estimate_and_repeats(self):
+        rng = np.random.default_rng(4)
+        a, b = rng.normal(0, 1, 30), rng.normal(0.8, 1, 30)
+        low, high = RankBiserialInterval(a, b)
+        self.assertLess(low, RankBiserial(a, b))
+        self.assertLess(RankBiserial(a, b), high)
+        self.assertTrue(-1 <= low < high <= 1)
+        self.assertEqual((low, high), RankBiserialInterval(a, b))
+        self.assertEqual(RankBiserialInterval([5, 6, 7], [1, 2]), (1.0, 1.0))
+
+    def test_d_interval_inverts_the_noncentral_t(self):
+        d, n_a, n_b = 0.5, 30, 30
+        low, high = CohensDInterval(d, n_a, n_b)
+        scale = math.sqrt(n_a * n_b / (n_a + n_b))
+        t, df = d * scale, n_a + n_b - 2
+        self.assertAlmostEqual(stats.nct.cdf(t, df, low * scale), 0.975, places=6)
+        self.assertAlmostEqual(stats.nct.cdf(t, df, high * scale), 0.025, places=6)
+        # Close to the large-sample interval d ± 1.96 sqrt(1/n_a + 1/n_b + d^2 / (2 (n_a + n_b))).
+        half = 1.96 * math.sqrt(1 / n_a + 1 / n_b + d**2 / (2 * (n_a + n_b)))
+        self.assertAlmostEqual(low, d - half, delta=0.03)
+        self.assertAlmostEqual(high, d + half, delta=0.03)
+        # Symmetric in the sign of d, and defined far out.
+        mirrored = CohensDInterval(-d, n_a, n_b)
+        self.assertAlmostEqual(mirrored[0], -high)
+        self.assertAlmostEqual(mirrored[1], -low)
+        low, high = CohensDInterval(6.0, 30, 30)
+        self.assertTrue(4.0 < low < 6.0 < high < 8.0)
+
+    def test_d_interval_covers_the_true_effect(self):
+        rng = np.random.default_rng(5)
+        covered = 0
+        for _ in range(300):
+            a, b = rng.normal(0.7, 1, 15), rng.normal(0, 1, 15)
+            low, high = CohensDInterval(CohensD(a, b), 15, 15)
+            covered += low <= 0.7 <= high
+        self.assertAlmostEqual(covered / 300, 0.95, delta=0.04)
+
+
+class TestPower(unittest.TestCase):
+    def test_textbook_values(self):
+        # Cohen (1988): 64 runs per group give 80 % power at d = 0.5, 26 at d = 0.8.
+        self.assertAlmostEqual(TwoSampleTPower(0.5, 64, 64), 0.80, delta=0.005)
+        self.assertAlmostEqual(TwoSampleTPower(0.8, 26, 26), 0.81, delta=0.005)
+        self.assertEqual(RunsForPower(0.5), 64)
+        self.assertEqual(RunsForPower(0.8), 26)
+        self.assertIn(RunsForPower(0.2), (393, 394))
+        # No effect: the power is the level.
+        self.assertAlmostEqual(TwoSampleTPower(0.0, 15, 15), 0.05, places=9)
+        self.assertEqual(RunsForPower(0.0), -1)
+        # Far in the tails, where scipy's noncentral t gives up: the normal limit.
+        self.assertEqual(TwoSampleTPower(0.5, 5000, 5000), 1.0)
+
+    def test_the_issues_example_by_simulation(self):
+        # d = 0.7 at 15 runs per group: about 45 % power (issue 23); simulated t tests agree.
+        power = TwoSampleTPower(0.7, 15, 15)
+        self.assertAlmostEqual(power, 0.45, delta=0.02)
+        rng = np.random.default_rng(6)
+        a, b = rng.normal(0.7, 1, (4000, 15)), rng.normal(0, 1, (4000, 15))
+        simulated = np.mean(stats.ttest_ind(a, b, axis=1).pvalue < 0.05)
+        self.assertAlmostEqual(simulated, power, delta=0.025)
+
+    def test_runs_for_power_is_the_smallest(self):
+        for d in (0.3, 0.7, 1.5):
+            n = RunsForPower(d, 0.9, 0.01)
+            self.assertGreaterEqual(TwoSampleTPower(d, n, n, 0.01), 0.9)
+            self.assertLess(TwoSampleTPower(d, n - 1, n - 1, 0.01), 0.9)
+
+    def test_bad_input_is_refused(self):
+        with self.assertRaisesRegex(ValueError, "at least 2 runs"):
+            CohensD([1.0], [1.0, 2.0])
+        with self.assertRaisesRegex(ValueError, "alpha"):
+            TwoSampleTPower(0.5, 10, 10, alpha=1.5)
+        with self.assertRaisesRegex(ValueError, "power"):
+            RunsForPower(0.5, power=0.01)
+        with self.assertRaisesRegex(ValueError, "finite"):
+            CompareRuns([1.0, math.nan], [1.0, 2.0])
+
+
+class TestCompareRunsAgainstScipy(unittest.TestCase):
+    def test_fields_agree_with_scipy(self):
+        rng = np.random.default_rng(7)
+        a, b = rng.normal(1, 1, 30), rng.normal(0, 2, 25)
+        result = CompareRuns(a, b)
+        self.assertEqual((result.n_a, result.n_b), (30, 25))
+        self.assertAlmostEqual(result.anova_p, stats.f_oneway(a, b).pvalue)
+        self.assertAlmostEqual(result.anova_p, stats.ttest_ind(a, b).pvalue)
+        self.assertAlmostEqual(result.welch_p, stats.ttest_ind(a, b, equal_var=False).pvalue)
+        self.assertAlmostEqual(result.median_b, np.median(b))
+        self.assertAlmostEqual(result.power, TwoSampleTPower(abs(result.cohens_d), 30, 25))
+        self.assertLess(result.d_low, result.cohens_d)
+        self.assertLess(result.cohens_d, result.d_high)
+
+    def test_constant_groups_give_no_test_not_an_error(self):
+        result = CompareRuns([1.0, 1.0], [1.0, 1.0])
+        self.assertEqual((result.cohens_d, result.rank_biserial), (0.0, 0.0))
+        self.assertTrue(math.isnan(result.anova_p))
+        self.assertEqual(result.runs_for_80_percent, -1)
+        apart = CompareRuns([2.0, 2.0], [1.0, 1.0])
+        self.assertTrue(math.isnan(apart.d_low) and math.isnan(apart.power))
+        self.assertEqual(apart.runs_for_80_percent, -1)
+
+    def test_rank_biserial_is_twice_superiority_less_one(self):
+        rng = np.random.default_rng(8)
+        a, b = rng.integers(0, 4, 9).astype(float), rng.integers(0, 4, 7).astype(float)  # ties
+        result = CompareRuns(a, b)
+        self.assertAlmostEqual(result.rank_biserial, RankBiserial(a, b))
+        self.assertAlmostEqual(result.rank_biserial, 2 * result.superiority - 1)
+
+
+if __name__ == "__main__":
+    unittest.main()
