@@ -779,13 +779,16 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
     ):
         tries, contacts = np.array(tries), np.array(contacts)
         top = np.argsort(tries)[::-1][:20]
+        # Undefined when either is constant (e.g. no contact at all in a short run).
+        constant = np.ptp(tries) == 0 or np.ptp(contacts) == 0
+        correlation = "n/a" if constant else f"{spearmanr(tries, contacts).statistic:.2f}"
         lines.append(
             f"- {name}: hand-table contact (samples every 0.1 s with a hand inside a field with "
             f"the table) during {contacts.sum()} samples; the 20 most-tried state-actions "
             f"({100 * tries[top].sum() / tries.sum():.0f} % of the tries) hold "
             f"{100 * contacts[top].sum() / max(contacts.sum(), 1):.0f} % of them; rank "
             f"correlation of tries and contact samples per state-action: "
-            f"{spearmanr(tries, contacts).statistic:.2f}; state-actions with contact: "
+            f"{correlation}; state-actions with contact: "
             f"{int((contacts > 0).sum())} of {len(tries)}"
         )
     for name, tries, misses, goals in zip(
