@@ -474,6 +474,30 @@ class TestDiscounting(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "need 0 < gamma < 1 and 0 < p <= 1"):
             StepRatio(0.9, 0.0)
 
+    def test_best_over_own(self):
+        from mobee_drake.reaching.discounting import BestOverOwn
+
+        # Problem 0: misses 0.1 and 0.3 m; in metres rewards 1/1.1 and 1/1.3, in units of
+        # 0.1 m 1/2 and 1/4. Problem 1: the second state was not reached.
+        misses = np.array([[0.1, 0.2], [0.3, np.nan]])
+        np.testing.assert_allclose(BestOverOwn(misses, 1.0), [[1.0, 1.0], [1.3 / 1.1, np.nan]])
+        np.testing.assert_allclose(BestOverOwn(misses, 0.1), [[1.0, 1.0], [2.0, np.nan]])
+        with self.assertRaisesRegex(ValueError, "need misses >= 0"):
+            BestOverOwn([[-0.1]], 1.0)
+
+    def test_reach_misses_on_the_robot(self):
+        from mobee_drake.experiments.ch8_discounting import ReachMisses
+        from mobee_drake.planning.state_space import Lattice
+        from mobee_drake.reaching.targets import LoadTargetGrid
+
+        # From the lattice's centre state, for the grid's first target: the full reach (300 N)
+        # ends nearer than one whose force (10 N) the state's attractor mostly holds back.
+        space = Lattice([0.25, 0.5, 0.75], 4)
+        target = LoadTargetGrid().Centres()[:1]
+        strong, weak = (ReachMisses(space, force, [40], target)[0, 0] for force in (300.0, 10.0))
+        self.assertLess(strong, 0.3)
+        self.assertLess(strong, weak)
+
 
 class TestTieBreak(unittest.TestCase):
     def test_first_takes_the_lowest_state_action(self):

@@ -2,8 +2,13 @@
 of steps need, in closed form (:mod:`mobee_drake.reaching.discounting`) against value iteration on
 a learned MDP, and what the ch. 8 runs' rewards and predictions give (docs/reaching.md).
 
+With ``--reach-force``, it also measures what moving could gain (issue 23, point 6): reaches for a
+sample of the problems from a sample of start states, on the reach learner's robot with each
+force, and per distance unit the ratio of the best start state's reward to each state's, against
+the ratio one step and a random start need.
+
 Run: ``mobee-drake experiment ch8-discounting --model BATTERY/runs/mdp_tries5/model [--runs
-BATTERY/runs/*/result.json]``.
+BATTERY/runs/*/result.json] [--reach-force 300 30]``.
 """
 
 import json
@@ -11,10 +16,11 @@ import pathlib
 
 import numpy as np
 
-from mobee_drake.experiments.arguments import CommandParser
-from mobee_drake.experiments.ch8_reaching import AGENT
+from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
+from mobee_drake.experiments.ch8_reaching import AGENT, ReachRobot
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
 from mobee_drake.reaching.discounting import (
+    BestOverOwn,
     MoveThreshold,
     PathRatio,
     PredictedSpread,
@@ -25,6 +31,20 @@ from mobee_drake.reaching.discounting import (
 from mobee_drake.reaching.learner import ReachLearner, ReachLearningConfig
 from mobee_drake.reaching.predictors import PredictorConfig
 from mobee_drake.reaching.targets import LoadTargetGrid
+
+
+def ReachMisses(space, force: float, states, problems: np.ndarray) -> np.ndarray:
+    """The misses (m) of reaches for ``problems`` (targets, k x 3) from each of ``states``, with
+    ``force`` on the palm; NaN where the transition to the state failed."""
+    grid = LoadTargetGrid()
+    robot = ReachRobot(space, grid.radius, force)
+    misses = np.full((len(states), len(problems)), np.nan)
+    for i, state in enumerate(states):
+        for j, target in enumerate(problems):
+            robot.SetProblem(target)
+            if robot.Transition(int(state)) == state:
+                misses[i, j] = np.linalg.norm(robot.Reach(target) - target)
+    return misses
 
 
 def main(argv=None) -> None:
@@ -51,6 +71,17 @@ def main(argv=None) -> None:
         help="result.json files of ch8 runs on this MDP: their reach rewards, and the spread of "
         "eq. 8.5's predictions after the run (histories rebuilt from the log)",
     )
+    parser.add_argument(
+        "--reach-force",
+        type=PositiveFloat,
+        nargs="*",
+        default=[],
+        help="measure reaches with these forces on the palm (N) from --probe-states start states "
+        "for --probe-problems problems, drawn with --seed",
+    )
+    parser.add_argument("--probe-states", type=PositiveInt, default=12, help="start states drawn")
+    parser.add_argument("--probe-problems", type=PositiveInt, default=9, help="problems drawn")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the draws")
     args = parser.parse_args(argv)
     model = LoadAgentModel(args.model, AGENT, ExplorerConfig())
     space, counts = model.space, model.transitions.counts
@@ -117,6 +148,31 @@ def main(argv=None) -> None:
             f"{1 / (1 + high / unit):.3f}-{1 / (1 + low / unit):.3f}, ratio at most "
             f"{RewardRatio(low, high, unit):.2f}"
         )
+    step, start = StepRatio(args.gamma, p), float(thresholds.mean())
+    rng = np.random.default_rng(args.seed)
+    targets = LoadTargetGrid().Centres()
+    states = rng.choice(space.num_states, min(args.probe_states, space.num_states), replace=False)
+    problems = targets[rng.choice(len(targets), min(args.probe_problems, len(targets)), False)]
+    for force in args.reach_force:
+        misses = ReachMisses(space, force, states, problems)
+        measured = misses[~np.isnan(misses)]
+        if measured.size == 0:
+            print(f"reach force {force:g} N: no start state reached")
+            continue
+        print(
+            f"reach force {force:g} N, {len(states)} start states x {len(problems)} problems: "
+            f"misses {100 * measured.min():.1f}-{100 * measured.max():.1f} cm (median "
+            f"{100 * np.median(measured):.1f}; {np.isnan(misses).sum()} transitions failed)"
+        )
+        for unit in args.units:
+            gain = BestOverOwn(misses, unit)
+            gain = gain[~np.isnan(gain)]
+            print(
+                f"  unit {unit:g} m: best state's reward over this state's median "
+                f"{np.median(gain):.2f}; above one step's {step:.2f}: "
+                f"{100 * np.mean(gain > step):.0f} %; above a random start's {start:.2f}: "
+                f"{100 * np.mean(gain > start):.0f} %"
+            )
 
 
 if __name__ == "__main__":

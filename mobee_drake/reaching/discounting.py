@@ -116,3 +116,19 @@ def PredictedSpread(learner: ReachLearner) -> tuple[np.ndarray, np.ndarray]:
             np.mean([q[learner.space.Actions(s)].max() > q[learner.Reach(s)] for s in states])
         )
     return np.array(ratios), np.array(moving)
+
+
+def BestOverOwn(misses, unit: float) -> np.ndarray:
+    """What moving could gain, from measured reaches: ``misses[s, j]`` is the miss (m) of a reach
+    from start state s for problem j (NaN where the state was not reached); per entry, the ratio
+    of the best state's eq. 8.4 reward for that problem to this state's, distances counted in
+    ``unit`` (m). An evaluation that starts in s can only profit from moving where the ratio beats
+    :func:`PathRatio` for the steps to the best state."""
+    misses = np.asarray(misses, dtype=float)
+    if misses.ndim != 2 or not np.all(np.isnan(misses) | (misses >= 0)) or unit <= 0:
+        raise ValueError(
+            f"need misses >= 0 (states x problems, NaN where unmeasured) and unit > 0, got "
+            f"shape {misses.shape} and unit {unit}"
+        )
+    rewards = 1.0 / (1.0 + misses / unit)
+    return np.nanmax(rewards, axis=0, keepdims=True) / rewards
