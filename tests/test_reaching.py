@@ -679,6 +679,37 @@ class TestEvaluationSums(unittest.TestCase):
         self.assertEqual(units, [0.01, 0.03, 0.1])
         self.assertTrue(all(s.tie_break == "random" for s in captured["settings"]))
 
+    def test_command_line_presets(self):
+        from mobee_drake.experiments import ch8_reaching as ch8
+
+        def Settings(*argv):
+            captured = {}
+
+            def Fake(output, strategies, seeds, settings, mdp_tries, backend):
+                captured["settings"] = settings
+                raise SystemExit(0)
+
+            with (
+                tempfile.TemporaryDirectory() as folder,
+                mock.patch.object(ch8, "RunReachBattery", Fake),
+                self.assertRaises(SystemExit),
+            ):
+                ch8.main(["--output", folder, *argv])
+            return captured["settings"]
+
+        # The default is the calibrated preset; the first reading is named; flags override.
+        calibrated, metres = ch8.REACH_PRESETS["calibrated"], ch8.REACH_PRESETS["metres"]
+        default = Settings()
+        self.assertEqual(
+            (default.distance_unit, default.reach_force),
+            (calibrated.distance_unit, calibrated.reach_force),
+        )
+        first = Settings("--preset", "metres")
+        self.assertEqual((first.distance_unit, first.reach_force), (1.0, 300.0))
+        self.assertEqual((metres.distance_unit, metres.reach_force), (1.0, 300.0))
+        mixed = Settings("--preset", "metres", "--reach-force", "30")
+        self.assertEqual((mixed.distance_unit, mixed.reach_force), (1.0, 30.0))
+
     def test_report_only(self):
         import contextlib
         import io

@@ -21,8 +21,10 @@ Beyond the source (ch. 9.4.1), ``--mdp simultaneous``: no MDP is learned first; 
 from the optimistic initialisation of ch. 6 and learns the MDP with the reaches, telling a model
 update from a penalty by whether MoBeE's fields felt the target (see
 :mod:`mobee_drake.reaching.learner`); each run keeps its final counts in ``mdp.npz``.
-``--reach-force`` sets the reach's force on the palm (the source gives none; 300 N by default),
-``--distance-unit`` the unit of eq. 8.1-8.7's distances (none given; metres by default); several
+The source gives neither the reach's force on the palm nor the unit of eq. 8.1-8.7's distances;
+``--preset`` names a pair (:data:`REACH_PRESETS`): ``calibrated`` (the default, chosen in issue 23
+by the source's behavioural fingerprints) or ``metres`` (the first reading, in which exploitation
+never moves). ``--reach-force`` and ``--distance-unit`` override the preset's; several
 values of either make a sweep: one battery on one MDP, a run of every strategy and seed per
 combination, and a report that scores each combination against the source's behavioural
 fingerprints (:func:`Fingerprints`). ``--tie-break`` chooses how the greedy policy breaks ties
@@ -151,6 +153,25 @@ class RunSettings:
     distance_unit: float = PredictorConfig().distance_unit
     # How the greedy policy breaks ties of value (one of TIE_BREAKS; the source is silent).
     tie_break: str = ReachLearningConfig().tie_break
+
+
+@dc.dataclass(frozen=True)
+class ReachPreset:
+    """The reach learner's two constants that the source does not give (ch. 8.2, eq. 8.1-8.7)."""
+
+    # The length (m) that counts as 1 in eq. 8.1-8.7.
+    distance_unit: float
+    # The reach's force on the palm (N).
+    reach_force: float
+
+
+REACH_PRESETS = {
+    # Issue 23, point 6: the setting of the sweep whose behaviour matches the source's
+    # fingerprints best (docs/reaching.md, "Calibration against the source's behaviour").
+    "calibrated": ReachPreset(distance_unit=0.03, reach_force=300.0),
+    # The first reading: SI units and the full reach, in which exploitation never moves.
+    "metres": ReachPreset(PredictorConfig().distance_unit, ReachForcing().force),
+}
 
 
 def ReachScenario(reach_force: float = ReachForcing().force) -> Scenario:
@@ -920,21 +941,28 @@ def main(argv=None) -> None:
         "reaches (ch. 9.4.1; use another --output)",
     )
     parser.add_argument(
+        "--preset",
+        choices=list(REACH_PRESETS),
+        default="calibrated",
+        help="the distance unit and reach force: calibrated against the source's behaviour "
+        "(issue 23) or metres with the full reach (the first reading; use another --output)",
+    )
+    parser.add_argument(
         "--reach-force",
         type=PositiveFloat,
         nargs="+",
-        default=[ReachForcing().force],
-        help="the reach's force on the palm in N (use another --output); several values "
-        "sweep them (with every --distance-unit)",
+        default=None,
+        help="the reach's force on the palm in N (default: the preset's; use another "
+        "--output); several values sweep them (with every --distance-unit)",
     )
     parser.add_argument(
         "--distance-unit",
         type=PositiveFloat,
         nargs="+",
-        default=[PredictorConfig().distance_unit],
-        help="the length in m that counts as 1 in the rewards and predictions "
-        "of eq. 8.1-8.7, e.g. 0.01 for centimetres (use another --output); several values "
-        "sweep them: one battery, one MDP, the runs named <strategy>_unit<u>_force<F>_seed<k>",
+        default=None,
+        help="the length in m that counts as 1 in the rewards and predictions of eq. 8.1-8.7 "
+        "(default: the preset's; use another --output); several values sweep them: one "
+        "battery, one MDP, the runs named <strategy>_unit<u>_force<F>_seed<k>",
     )
     parser.add_argument(
         "--tie-break",
@@ -957,6 +985,7 @@ def main(argv=None) -> None:
         parser.error(f"--stages must lie in 0..{args.problem_tries}")
     output = pathlib.Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
+    preset = REACH_PRESETS[args.preset]
     variants = [
         RunSettings(
             args.strategies[0],
@@ -971,8 +1000,8 @@ def main(argv=None) -> None:
             unit,
             args.tie_break,
         )
-        for unit in dict.fromkeys(args.distance_unit)
-        for force in dict.fromkeys(args.reach_force)
+        for unit in dict.fromkeys(args.distance_unit or [preset.distance_unit])
+        for force in dict.fromkeys(args.reach_force or [preset.reach_force])
     ]
     settings = variants[0]
     if args.watch:  # In the battery's folder, beside its runs.
