@@ -621,14 +621,16 @@ class TestEvaluationSums(unittest.TestCase):
         ]
         jobs = []
         with mock.patch.object(ch8, "RunBattery", lambda j, *a, **k: jobs.extend(j) or {}):
-            ch8.RunReachBattery(pathlib.Path("unused"), ["random", "greedy"], 2, settings, 5, None)
+            ch8.RunReachBattery(
+                pathlib.Path("unused"), ["random", "greedy"], range(2), settings, 5, None
+            )
         names = [j.name for j in jobs]
         self.assertIn("mdp_tries5", names)
         self.assertIn("greedy_unit0.01_force300_seed1", names)
         self.assertIn("random_unit0.1_force300_seed0", names)
         self.assertEqual(len(names), 1 + 2 * 2 * 2)
         with self.assertRaisesRegex(ValueError, "settings repeat"):
-            ch8.RunReachBattery(pathlib.Path("unused"), ["random"], 1, settings * 2, 5, None)
+            ch8.RunReachBattery(pathlib.Path("unused"), ["random"], range(1), settings * 2, 5, None)
         # A report of two settings: a fingerprint row each, figures in a folder each.
         log = [(0, 0, 4), (1, 1, 5)]
         results = [
@@ -655,7 +657,7 @@ class TestEvaluationSums(unittest.TestCase):
         captured = {}
 
         def Fake(output, strategies, seeds, settings, mdp_tries, backend):
-            captured["settings"] = settings
+            captured["settings"], captured["seeds"] = settings, seeds
             raise SystemExit(0)
 
         with (
@@ -667,6 +669,10 @@ class TestEvaluationSums(unittest.TestCase):
                     [
                         "--output",
                         folder,
+                        "--first-seed",
+                        "100",
+                        "--seeds",
+                        "2",
                         "--distance-unit",
                         "0.01",
                         "0.03",
@@ -677,6 +683,7 @@ class TestEvaluationSums(unittest.TestCase):
                 )
         units = [s.distance_unit for s in captured["settings"]]
         self.assertEqual(units, [0.01, 0.03, 0.1])
+        self.assertEqual(list(captured["seeds"]), [100, 101])
         self.assertTrue(all(s.tie_break == "random" for s in captured["settings"]))
 
     def test_command_line_presets(self):

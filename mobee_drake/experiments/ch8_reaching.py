@@ -331,7 +331,7 @@ def SettingLabel(settings: RunSettings) -> str:
 def RunReachBattery(
     output: pathlib.Path,
     strategies,
-    seeds: int,
+    seeds: range,
     settings: RunSettings | list[RunSettings],
     mdp_tries: int,
     backend: Backend,
@@ -369,7 +369,7 @@ def RunReachBattery(
         )
         for variant in variants
         for strategy in strategies
-        for seed in range(seeds)
+        for seed in seeds
     ]
     return list(RunBattery(jobs, output, backend=backend, description="reach learning").values())
 
@@ -896,6 +896,12 @@ def main(argv=None) -> None:
     )
     parser.add_argument("--seeds", type=PositiveInt, default=5, help="seeds per strategy")
     parser.add_argument(
+        "--first-seed",
+        type=NonNegativeInt,
+        default=0,
+        help="the first seed (fresh seeds test a setting chosen on others)",
+    )
+    parser.add_argument(
         "--problem-tries", type=PositiveInt, default=6400, help="exploratory problem-tries per run"
     )
     parser.add_argument(
@@ -1021,7 +1027,7 @@ def main(argv=None) -> None:
         results = RunReachBattery(
             output,
             args.strategies,
-            args.seeds,
+            range(args.first_seed, args.first_seed + args.seeds),
             variants if len(variants) > 1 else settings,
             args.mdp_tries,
             BackendOf(args),
