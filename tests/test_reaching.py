@@ -613,6 +613,37 @@ class TestEvaluationSums(unittest.TestCase):
         self.assertIn("| intrinsic | 2 | -8.00 ± 1.41 |", report)
         self.assertIn("1.00 times the robot time", report)
 
+    def test_report_tests_each_runs_trend(self):
+        from mobee_drake.experiments.ch8_reaching import Report
+        from mobee_drake.experiments.statistics import CompareRuns, CompareToZero
+
+        log = [(0, 0, 4), (1, 1, 5)]
+        # A run's reach rewards at 2 and 4 problem-tries: its trend is their difference (one
+        # doubling). Intrinsic runs: 1 and 3; the others': 0 and 1.
+        rewards = {"intrinsic": ((0.0, 1.0), (0.0, 3.0)), "random": ((0.0, 0.0), (0.0, 1.0))}
+        rewards["greedy"] = rewards["random"]
+        results = [
+            _SyntheticRun(
+                strategy,
+                seed,
+                log,
+                {
+                    str(stage): [[_Try(0, r, 4, 0), _Try(1, 0.0, 4, 0), _Try(2, 0.0, 5, 0)]]
+                    for stage, r in zip((2, 4), pair)
+                },
+            )
+            for strategy, pairs in rewards.items()
+            for seed, pair in enumerate(pairs)
+        ]
+        with tempfile.TemporaryDirectory() as folder:
+            report = Report(pathlib.Path(folder), results)
+        self.assertIn(
+            "reaches only, change per doubling of the problem-tries (per run, the slope of its "
+            f"stage means over log2 of 2...4): intrinsic {CompareToZero([1.0, 3.0]).Text()}; "
+            f"intrinsic minus random {CompareRuns([1.0, 3.0], [0.0, 1.0]).Text()}",
+            report,
+        )
+
     def test_sweep_names_and_report(self):
         from mobee_drake.experiments import ch8_reaching as ch8
 

@@ -11,9 +11,11 @@ from mobee_drake.experiments.statistics import (
     CohensD,
     CohensDInterval,
     CompareRuns,
+    CompareToZero,
     RankBiserialInterval,
     RunMeans,
     RunsForPower,
+    Trend,
     TwoSampleTPower,
 )
 
@@ -215,6 +217,34 @@ class TestCompareRunsAgainstScipy(unittest.TestCase):
         result = CompareRuns(a, b)
         self.assertAlmostEqual(result.rank_biserial, RankBiserial(a, b))
         self.assertAlmostEqual(result.rank_biserial, 2 * result.superiority - 1)
+
+
+class TestTrends(unittest.TestCase):
+    def test_trend_is_the_change_per_doubling(self):
+        # Values 1, 2, 3 at 100, 200, 400: one more per doubling; a constant has none.
+        self.assertAlmostEqual(Trend([100, 200, 400], [1.0, 2.0, 3.0]), 1.0)
+        self.assertAlmostEqual(Trend([100, 200, 400, 800], [5.0] * 4), 0.0)
+        # Least squares over log2: values 0, 0, 3 at 1, 2, 4 give (3 * 1) / 2 = 1.5.
+        self.assertAlmostEqual(Trend([1, 2, 4], [0.0, 0.0, 3.0]), 1.5)
+        with self.assertRaisesRegex(ValueError, "2 or more positive stages"):
+            Trend([0, 100], [1.0, 2.0])
+
+    def test_against_zero(self):
+        # Values -1, 1, 3: mean 1, sd 2, t = 1 / (2 / sqrt(3)); two-sided p with 2 df is
+        # 1 - |t| / sqrt(2 + t^2).
+        result = CompareToZero([-1.0, 1.0, 3.0])
+        t = 1 / (2 / math.sqrt(3))
+        self.assertEqual((result.n, result.positive), (3, 2))
+        self.assertAlmostEqual(result.mean, 1.0)
+        self.assertAlmostEqual(result.sd, 2.0)
+        self.assertAlmostEqual(result.t_p, 1 - t / math.sqrt(2 + t**2))
+        # Five runs all above 0: the exact signed-rank p is 2 / 2^5.
+        self.assertAlmostEqual(CompareToZero([1.0, 2.0, 3.0, 4.0, 5.0]).wilcoxon_p, 2 / 32)
+        same = CompareToZero([0.0, 0.0])
+        self.assertTrue(math.isnan(same.t_p) and math.isnan(same.wilcoxon_p))
+        self.assertIn("0 of 2 runs above 0", same.Text())
+        with self.assertRaisesRegex(ValueError, "at least 2 finite"):
+            CompareToZero([1.0])
 
 
 if __name__ == "__main__":

@@ -71,7 +71,7 @@ from mobee_drake.experiments.battery import (
 )
 from mobee_drake.experiments.exploration import ExplorationScenario, Explore
 from mobee_drake.experiments.plots import Figure, SaveFigure, StackedBars, plt
-from mobee_drake.experiments.statistics import CompareRuns, RunMeans
+from mobee_drake.experiments.statistics import CompareRuns, CompareToZero, RunMeans, Trend
 from mobee_drake.mobee.params import Dissertation
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig, LoadAgentModel
@@ -608,6 +608,13 @@ def _RunSums(runs: list[dict], stage: int, penalties: bool) -> np.ndarray:
     )
 
 
+def _RunTrends(runs: list[dict], stages: list[int], penalties: bool) -> list[float]:
+    """One value per run: the trend (:func:`Trend`) of its evaluations' mean sums over
+    ``stages``."""
+    sums = np.array([_RunSums(runs, stage, penalties) for stage in stages])  # stages x runs
+    return [Trend(stages, sums[:, i]) for i in range(len(runs))]
+
+
 def _RobotTimeRatio(by_strategy: dict[str, list[dict]]) -> float:
     """Random's mean robot time over that of greedy and intrinsic (the source: 1.86)."""
     hours = {s: np.mean([r["simulated_seconds"] for r in by_strategy[s]]) for s in by_strategy}
@@ -865,6 +872,21 @@ def _SettingReport(output: pathlib.Path, results: list[dict]) -> str:
                 lines.append(
                     f"- {title}, after {stage} problem-tries, intrinsic minus "
                     + "; ".join(comparisons)
+                )
+        trended = [s for s in stages if s > 0]
+        if len(trended) >= 2:
+            for penalties, title in ((True, "the source's sum"), (False, "reaches only")):
+                trends = {s: _RunTrends(by_strategy[s], trended, penalties) for s in strategies}
+                lines.append(
+                    f"- {title}, change per doubling of the problem-tries (per run, the slope of "
+                    f"its stage means over log2 of {trended[0]}...{trended[-1]}): intrinsic "
+                    + CompareToZero(trends["intrinsic"]).Text()
+                    + "; intrinsic minus "
+                    + "; ".join(
+                        f"{other} {_Compare(trends['intrinsic'], trends[other])}"
+                        for other in strategies
+                        if other != "intrinsic"
+                    )
                 )
         hours = {s: [f["robot_hours"] for f in prints[s]] for s in strategies}
         lines += [

@@ -276,6 +276,55 @@ def CompareRuns(a, b, alpha: float = 0.05, confidence: float = 0.95) -> Comparis
     )
 
 
+@dc.dataclass
+class ZeroComparison:
+    """One value per run (a run's trend, say) tested against 0."""
+
+    n: int
+    mean: float
+    sd: float
+    # Runs above 0.
+    positive: int
+    # Student's one-sample t-test and Wilcoxon's signed-rank test, two-sided.
+    t_p: float
+    wilcoxon_p: float
+
+    def Text(self) -> str:
+        return (
+            f"{self.mean:+.3f} ± {self.sd:.3f} ({self.positive} of {self.n} runs above 0; "
+            f"t-test p = {_Number(self.t_p, '.2g')}, "
+            f"Wilcoxon p = {_Number(self.wilcoxon_p, '.2g')})"
+        )
+
+
+def CompareToZero(values) -> ZeroComparison:
+    """Whether runs' values differ from 0 (at least 2 finite values): NaN p-values when they
+    are all equal."""
+    values = np.asarray(values, dtype=float)
+    if values.ndim != 1 or values.size < 2 or not np.all(np.isfinite(values)):
+        raise ValueError(f"test at least 2 finite run values, got {values}")
+    constant = np.all(values == values[0])
+    return ZeroComparison(
+        n=int(values.size),
+        mean=float(values.mean()),
+        sd=float(values.std(ddof=1)),
+        positive=int(np.sum(values > 0)),
+        t_p=math.nan if constant else float(stats.ttest_1samp(values, 0.0).pvalue),
+        wilcoxon_p=math.nan if np.all(values == 0) else float(stats.wilcoxon(values).pvalue),
+    )
+
+
+def Trend(stages, values) -> float:
+    """A run's trend: the least-squares slope of its values at ``stages`` (problem-tries, say)
+    over log2 of the stages, that is the change per doubling."""
+    stages, values = np.asarray(stages, dtype=float), np.asarray(values, dtype=float)
+    if stages.shape != values.shape or stages.size < 2 or np.any(stages <= 0):
+        raise ValueError(
+            f"a trend needs 2 or more positive stages and one value each, got {stages}"
+        )
+    return float(np.polyfit(np.log2(stages), values, 1)[0])
+
+
 def RunMeans(values_per_run) -> np.ndarray:
     """One value per run: the mean of each run's own values (its evaluations at a stage),
     never a pool of them; runs may have different numbers of values, but none may be empty."""
