@@ -485,6 +485,20 @@ class TestDiscounting(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "need misses >= 0"):
             BestOverOwn([[-0.1]], 1.0)
 
+    def test_discounting_command_names_a_missing_model(self):
+        import contextlib
+        import io
+
+        from mobee_drake.experiments.ch8_discounting import main
+
+        stderr = io.StringIO()
+        with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit) as exit:
+            main(["--model", "/nonexistent/model"])
+        self.assertEqual(exit.exception.code, 2)
+        self.assertIn(
+            "--model: /nonexistent/model/right_arm.npz: no saved model", stderr.getvalue()
+        )
+
     def test_reach_misses_on_the_robot(self):
         from mobee_drake.experiments.ch8_discounting import ReachMisses
         from mobee_drake.planning.state_space import Lattice

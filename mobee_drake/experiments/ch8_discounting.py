@@ -16,7 +16,12 @@ import pathlib
 
 import numpy as np
 
-from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
+from mobee_drake.experiments.arguments import (
+    CommandParser,
+    NonNegativeInt,
+    PositiveFloat,
+    PositiveInt,
+)
 from mobee_drake.experiments.ch8_reaching import AGENT, ReachRobot
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
 from mobee_drake.reaching.discounting import (
@@ -81,9 +86,12 @@ def main(argv=None) -> None:
     )
     parser.add_argument("--probe-states", type=PositiveInt, default=12, help="start states drawn")
     parser.add_argument("--probe-problems", type=PositiveInt, default=9, help="problems drawn")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the draws")
+    parser.add_argument("--seed", type=NonNegativeInt, default=0, help="seed of the draws")
     args = parser.parse_args(argv)
-    model = LoadAgentModel(args.model, AGENT, ExplorerConfig())
+    try:
+        model = LoadAgentModel(args.model, AGENT, ExplorerConfig())
+    except (OSError, ValueError) as error:
+        parser.error(f"--model: {error}")
     space, counts = model.space, model.transitions.counts
     learner = ReachLearner(
         space, counts, np.zeros((1, 3)), ReachLearningConfig(gamma=args.gamma, delta=1e-10)

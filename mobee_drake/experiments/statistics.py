@@ -18,6 +18,10 @@ balanced design its F-test of the fixed effect equals the pooled-variance t-test
   n_b) - 1`` with a bootstrap interval;
 - the power of the t-test at the observed effect and the runs it would need for 80 %.
 
+A claim about a change over a run (ch. 8's "improves steadily") takes one value per run too:
+:func:`Trend`, the run's change per doubling, tested against 0 by :func:`CompareToZero` and
+between groups by :func:`CompareRuns`.
+
 Signs follow the first group: a positive d means a tends to be larger (for an error: worse).
 """
 
