@@ -1,5 +1,6 @@
 """Reward predictors of ch. 8 against their closed forms (eq. 8.1-8.7)."""
 
+import contextlib
 import pathlib
 import tempfile
 import unittest
@@ -486,7 +487,6 @@ class TestDiscounting(unittest.TestCase):
             BestOverOwn([[-0.1]], 1.0)
 
     def test_discounting_command_names_a_missing_model(self):
-        import contextlib
         import io
 
         from mobee_drake.experiments.ch8_discounting import main
@@ -565,6 +565,25 @@ def _SyntheticRun(strategy, seed, log, evaluations, hours=1.0, problems=3):
         num_transitions=4,
         num_states=2,
     )
+
+
+def _BatteryArguments(*argv):
+    """The settings and seeds ``mobee-drake experiment ch8 ARGV`` would run (nothing runs)."""
+    from mobee_drake.experiments import ch8_reaching as ch8
+
+    captured = {}
+
+    def Fake(output, strategies, seeds, settings, mdp_tries, backend):
+        captured["settings"], captured["seeds"] = settings, seeds
+        raise SystemExit(0)
+
+    with (
+        tempfile.TemporaryDirectory() as folder,
+        mock.patch.object(ch8, "RunReachBattery", Fake),
+        contextlib.suppress(SystemExit),
+    ):
+        ch8.main(["--output", folder, *argv])
+    return captured["settings"], captured["seeds"]
 
 
 class TestEvaluationSums(unittest.TestCase):
@@ -698,73 +717,28 @@ class TestEvaluationSums(unittest.TestCase):
         self.assertIn("# unit0.1_force300", report)
 
     def test_command_line_sweep(self):
-        from mobee_drake.experiments import ch8_reaching as ch8
-
-        captured = {}
-
-        def Fake(output, strategies, seeds, settings, mdp_tries, backend):
-            captured["settings"], captured["seeds"] = settings, seeds
-            raise SystemExit(0)
-
-        with (
-            tempfile.TemporaryDirectory() as folder,
-            mock.patch.object(ch8, "RunReachBattery", Fake),
-        ):
-            with self.assertRaises(SystemExit):
-                ch8.main(
-                    [
-                        "--output",
-                        folder,
-                        "--first-seed",
-                        "100",
-                        "--seeds",
-                        "2",
-                        "--distance-unit",
-                        "0.01",
-                        "0.03",
-                        "0.1",
-                        "--tie-break",
-                        "random",
-                    ]
-                )
-        units = [s.distance_unit for s in captured["settings"]]
-        self.assertEqual(units, [0.01, 0.03, 0.1])
-        self.assertEqual(list(captured["seeds"]), [100, 101])
-        self.assertTrue(all(s.tie_break == "random" for s in captured["settings"]))
+        settings, seeds = _BatteryArguments(
+            "--first-seed", "100", "--seeds", "2", "--distance-unit", "0.01", "0.03", "0.1",
+            "--tie-break", "random",
+        )  # fmt: skip
+        self.assertEqual([s.distance_unit for s in settings], [0.01, 0.03, 0.1])
+        self.assertEqual(list(seeds), [100, 101])
+        self.assertTrue(all(s.tie_break == "random" for s in settings))
 
     def test_command_line_presets(self):
-        from mobee_drake.experiments import ch8_reaching as ch8
+        from mobee_drake.experiments.ch8_reaching import REACH_PRESETS
 
-        def Settings(*argv):
-            captured = {}
-
-            def Fake(output, strategies, seeds, settings, mdp_tries, backend):
-                captured["settings"] = settings
-                raise SystemExit(0)
-
-            with (
-                tempfile.TemporaryDirectory() as folder,
-                mock.patch.object(ch8, "RunReachBattery", Fake),
-                self.assertRaises(SystemExit),
-            ):
-                ch8.main(["--output", folder, *argv])
-            return captured["settings"]
+        def UnitAndForce(*argv):
+            settings, _ = _BatteryArguments(*argv)
+            return settings.distance_unit, settings.reach_force
 
         # The default is the calibrated preset; the first reading is named; flags override.
-        calibrated, metres = ch8.REACH_PRESETS["calibrated"], ch8.REACH_PRESETS["metres"]
-        default = Settings()
-        self.assertEqual(
-            (default.distance_unit, default.reach_force),
-            (calibrated.distance_unit, calibrated.reach_force),
-        )
-        first = Settings("--preset", "metres")
-        self.assertEqual((first.distance_unit, first.reach_force), (1.0, 300.0))
-        self.assertEqual((metres.distance_unit, metres.reach_force), (1.0, 300.0))
-        mixed = Settings("--preset", "metres", "--reach-force", "30")
-        self.assertEqual((mixed.distance_unit, mixed.reach_force), (1.0, 30.0))
+        calibrated = REACH_PRESETS["calibrated"]
+        self.assertEqual(UnitAndForce(), (calibrated.distance_unit, calibrated.reach_force))
+        self.assertEqual(UnitAndForce("--preset", "metres"), (1.0, 300.0))
+        self.assertEqual(UnitAndForce("--preset", "metres", "--reach-force", "30"), (1.0, 30.0))
 
     def test_report_only(self):
-        import contextlib
         import io
         import json
 
