@@ -508,7 +508,8 @@ class TestDiscounting(unittest.TestCase):
         # state and from its corner: the attractor holds the arm at each state's centre while
         # the palm is pulled, so the misses differ (4 and 12 cm when this was written).
         space = Lattice([0.25, 0.5, 0.75], 4)
-        misses = ReachMisses(space, 300.0, [40, 0], LoadTargetGrid().Centres()[:1])
+        grid = LoadTargetGrid()
+        misses = ReachMisses(space, 300.0, [40, 0], grid.Centres()[:1], grid.radius)
         self.assertEqual(misses.shape, (2, 1))
         self.assertTrue(np.all(np.isfinite(misses)))
         self.assertGreater(abs(misses[0, 0] - misses[1, 0]), 0.03)

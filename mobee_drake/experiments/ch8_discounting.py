@@ -38,11 +38,10 @@ from mobee_drake.reaching.predictors import PredictorConfig
 from mobee_drake.reaching.targets import LoadTargetGrid
 
 
-def ReachMisses(space, force: float, states, problems: np.ndarray) -> np.ndarray:
-    """The misses (m) of reaches for ``problems`` (targets, k x 3) from each of ``states``, with
-    ``force`` on the palm; NaN where the transition to the state failed."""
-    grid = LoadTargetGrid()
-    robot = ReachRobot(space, grid.radius, force)
+def ReachMisses(space, force: float, states, problems: np.ndarray, radius: float) -> np.ndarray:
+    """The misses (m) of reaches for ``problems`` (targets of ``radius``, k x 3) from each of
+    ``states``, with ``force`` on the palm; NaN where the transition to the state failed."""
+    robot = ReachRobot(space, radius, force)
     misses = np.full((len(states), len(problems)), np.nan)
     for i, state in enumerate(states):
         for j, target in enumerate(problems):
@@ -158,11 +157,12 @@ def main(argv=None) -> None:
         )
     step, start = StepRatio(args.gamma, p), float(thresholds.mean())
     rng = np.random.default_rng(args.seed)
-    targets = LoadTargetGrid().Centres()
+    grid = LoadTargetGrid()
+    targets = grid.Centres()
     states = rng.choice(space.num_states, min(args.probe_states, space.num_states), replace=False)
     problems = targets[rng.choice(len(targets), min(args.probe_problems, len(targets)), False)]
     for force in args.reach_force:
-        misses = ReachMisses(space, force, states, problems)
+        misses = ReachMisses(space, force, states, problems, grid.radius)
         measured = misses[~np.isnan(misses)]
         if measured.size == 0:
             print(f"reach force {force:g} N: no start state reached")

@@ -80,12 +80,12 @@ class Mobee(LeafSystem):
     ``M q'' = total``):
 
     - ``spring`` = -L(K(q - q*)), ``damping`` = -C q', ``f_lim``, ``f_cst``, ``f_coll``,
-      ``f_config``, ``f_work``, the obstacle-aware flow ``f_flow`` (ours, off unless
-      ``params.flow`` is on: the goal-directed forces bent around the fields they push into,
-      :mod:`mobee_drake.mobee.flow`), the safety barrier ``f_barrier`` (ours: zero unless the
-      others would close a gap between solids too fast in the next period; needs ``step``, see
-      :mod:`mobee_drake.mobee.barrier`), and ``total``, their sum; ``forces`` (10n) all ten, in
-      that order (the evaluation: the other ports read it).
+      ``f_config``, ``f_work``, the obstacle-aware flow ``f_flow`` (ours, ``params.flow``: on by
+      default, off in the dissertation's preset; the goal-directed forces bent around the fields
+      they push into, :mod:`mobee_drake.mobee.flow`), the safety barrier ``f_barrier`` (ours:
+      zero unless the others would close a gap between solids too fast in the next period; needs
+      ``step``, see :mod:`mobee_drake.mobee.barrier`), and ``total``, their sum; ``forces``
+      (10n) all ten, in that order (the evaluation: the other ports read it).
     - ``marker_positions`` (3m) and ``marker_directions`` (3m): in world, marker after marker.
     - ``marker_jacobians`` (3mn): the translational Jacobians dp_WM/dq, marker after marker, each
       3 x n in row-major order (reshape with ``(m, 3, n)``).
