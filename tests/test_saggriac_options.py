@@ -10,6 +10,7 @@ import tempfile
 import unittest
 
 import numpy as np
+from scipy import stats
 from test_figures import FigureTest
 
 from mobee_drake.experiments import saggriac as experiments
@@ -366,6 +367,37 @@ class TestVariants(unittest.TestCase):
                 self.assertIn(text, report)
             for name in ("exp2_effects.png", "exp2_tips.png", "exp2_goals.png"):
                 self.assertGreater((output / name).stat().st_size, 1000, name)
+
+
+class TestCheckpointTable(unittest.TestCase):
+    def test_rows_give_each_checkpoint_difference_and_welch_p(self):
+        # Two groups of three runs whose values at checkpoint k are k * (1, 2, 4) and k * (2, 3, 7):
+        # the difference of the means is -k * 5 / 3, and Welch's t on the same values gives p.
+        first, second = (1.0, 2.0, 4.0), (2.0, 3.0, 7.0)
+        runs = [
+            {
+                "spec": {"method": method, "seed": seed},
+                "curve": [
+                    {"time_step": 100 * k, "a": k * value, "b": -k * value} for k in range(3)
+                ],
+            }
+            for method, values in (("SAGG-RIAC", first), ("SAGG-Random", second))
+            for seed, value in enumerate(values)
+        ]
+        lines = experiments.CheckpointTable(runs, "SAGG-RIAC", "SAGG-Random", ("a", "b"))
+        self.assertEqual(len(lines), 2 + 2)  # header, rule, checkpoints 100 and 200
+        self.assertIn("a: SAGG-RIAC - SAGG-Random (Welch p)", lines[0])
+        p_value = stats.ttest_ind(first, second, equal_var=False).pvalue
+        for k, line in ((1, lines[2]), (2, lines[3])):
+            cells = [cell.strip() for cell in line.strip("|").split("|")]
+            self.assertEqual(cells[0], str(100 * k))
+            self.assertEqual(cells[1], f"{-k * 5 / 3:+.2f} ({p_value:.2g})")
+            self.assertEqual(cells[2], f"{k * 5 / 3:+.2f} ({p_value:.2g})")
+
+    def test_no_rows_with_fewer_than_two_runs_per_group(self):
+        runs = [{"spec": {"method": "SAGG-RIAC"}, "curve": [{"time_step": 0, "a": 1.0}]}]
+        runs += [{"spec": {"method": "SAGG-Random"}, "curve": [{"time_step": 0, "a": 2.0}]}] * 2
+        self.assertEqual(experiments.CheckpointTable(runs, "SAGG-RIAC", "SAGG-Random", ("a",)), [])
 
 
 class TestFigures(FigureTest):

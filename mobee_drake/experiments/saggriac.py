@@ -865,14 +865,17 @@ def WriteReport(
             "",
             *TestsTable(statistics[experiment]),
             "",
-            *CheckpointTable(
-                runs, "SAGG-RIAC", "SAGG-Random", ("reaching_error", "prediction_error")
-            ),
-            "",
             "Tests at run level (one value per run). d and the rank-biserial r are positive "
             "when the first group's values are larger. Power: of the two-sided ANOVA at alpha "
             "0.05 for the observed |d| and these group sizes; runs for 80 %: per group, at the "
             "observed d. Rank-biserial interval: percentile bootstrap, 10,000 resamples.",
+            "",
+            *CheckpointTable(
+                runs,
+                "SAGG-RIAC",
+                "SAGG-Random",
+                ("reaching_error", "prediction_error", "prediction_error_near_rest"),
+            ),
             "",
             f"Plots: `exp{experiment}_curves.png`, `exp{experiment}_effects.png`, "
             f"`exp{experiment}_tips.png`"
