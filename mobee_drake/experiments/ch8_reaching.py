@@ -594,6 +594,15 @@ def _Compare(a, b) -> str:
     return CompareRuns(a, b).Text()
 
 
+def _IntrinsicMinusOthers(run_values: dict[str, list[float]]) -> str:
+    """Report text: :func:`_Compare` of the intrinsic runs' values with each other strategy's."""
+    return "; ".join(
+        f"{other} {_Compare(run_values['intrinsic'], values)}"
+        for other, values in run_values.items()
+        if other != "intrinsic"
+    )
+
+
 def _MeanSd(values) -> str:
     values = [v for v in values if not math.isnan(v)]
     if not values:
@@ -861,32 +870,22 @@ def _SettingReport(output: pathlib.Path, results: list[dict]) -> str:
         "",
     ]
     if {"intrinsic", "random", "greedy"} <= set(strategies):
+        trended = [s for s in stages if s > 0]
         for penalties, title in ((True, "the source's sum"), (False, "reaches only")):
             for stage in stages:
-                mine = _RunSums(by_strategy["intrinsic"], stage, penalties)
-                comparisons = [
-                    f"{other} {_Compare(mine, _RunSums(by_strategy[other], stage, penalties))}"
-                    for other in strategies
-                    if other != "intrinsic"
-                ]
+                sums = {s: _RunSums(by_strategy[s], stage, penalties) for s in strategies}
                 lines.append(
                     f"- {title}, after {stage} problem-tries, intrinsic minus "
-                    + "; ".join(comparisons)
+                    + _IntrinsicMinusOthers(sums)
                 )
-        trended = [s for s in stages if s > 0]
-        if len(trended) >= 2:
-            for penalties, title in ((True, "the source's sum"), (False, "reaches only")):
+            if len(trended) >= 2:
                 trends = {s: _RunTrends(by_strategy[s], trended, penalties) for s in strategies}
                 lines.append(
                     f"- {title}, change per doubling of the problem-tries (per run, the slope of "
                     f"its stage means over log2 of {trended[0]}...{trended[-1]}): intrinsic "
                     + CompareToZero(trends["intrinsic"]).Text()
                     + "; intrinsic minus "
-                    + "; ".join(
-                        f"{other} {_Compare(trends['intrinsic'], trends[other])}"
-                        for other in strategies
-                        if other != "intrinsic"
-                    )
+                    + _IntrinsicMinusOthers(trends)
                 )
         hours = {s: [f["robot_hours"] for f in prints[s]] for s in strategies}
         lines += [
