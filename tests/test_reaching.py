@@ -1,6 +1,7 @@
 """Reward predictors of ch. 8 against their closed forms (eq. 8.1-8.7)."""
 
 import contextlib
+import io
 import pathlib
 import tempfile
 import unittest
@@ -487,8 +488,6 @@ class TestDiscounting(unittest.TestCase):
             BestOverOwn([[-0.1]], 1.0)
 
     def test_discounting_command_names_a_missing_model(self):
-        import io
-
         from mobee_drake.experiments.ch8_discounting import main
 
         stderr = io.StringIO()
@@ -740,7 +739,6 @@ class TestEvaluationSums(unittest.TestCase):
         self.assertEqual(UnitAndForce("--preset", "metres", "--reach-force", "30"), (1.0, 30.0))
 
     def test_report_only(self):
-        import io
         import json
 
         from mobee_drake.experiments import ch8_reaching as ch8
