@@ -23,6 +23,7 @@ from mobee_drake.robots.model_cache import IcubModelNames
 from mobee_drake.scenario import BuildScenario, LoadScenario, ResumableConfiguration
 from mobee_drake.station.checkpoint import CheckpointError
 from mobee_drake.station.runner import RunStation
+from mobee_drake.station.safety import StartsInPenetrationError
 from mobee_drake.station.viewer import RecordingMeshcat
 
 # Whether a user's mistake shows its traceback (``--debug``).
@@ -131,7 +132,7 @@ def _Run(args: list[str]) -> None:
             configuration=ResumableConfiguration(scenario),
             data_log=data_log,
         )
-    except (FolderError, CheckpointError) as e:  # Raised before anything is simulated.
+    except (FolderError, CheckpointError, StartsInPenetrationError) as e:  # Before any step.
         _Fail(str(e))
     if summary.finished_before is not None and summary.finished_before > scenario.duration:
         _Fail(

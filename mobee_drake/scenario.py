@@ -16,7 +16,7 @@ import dataclasses as dc
 import math
 import pathlib
 
-from pydrake.common.yaml import yaml_dump_typed, yaml_load_typed
+from pydrake.common.yaml import yaml_dump_typed
 from pydrake.geometry import Meshcat
 from pydrake.systems.analysis import SimulatorConfig
 import yaml
@@ -30,7 +30,7 @@ from mobee_drake.station.config import DataLog, StationConfig, StationConfigErro
 from mobee_drake.station.executor import StateActionAttractor
 from mobee_drake.station.runner import RunStation, RunSummary
 from mobee_drake.station.viewer import RecordingMeshcat
-from mobee_drake.yaml_io import CheckYamlStructure, LoadYamlFile, YamlFileError
+from mobee_drake.yaml_io import CheckYamlStructure, LoadYamlFile, LoadYamlOverride, YamlFileError
 
 # The longest run a scenario may ask for (s; our choice: about 116 simulated days, far beyond any
 # experiment of the sources, and short enough that a typo like 1e308 is caught, not simulated).
@@ -89,7 +89,7 @@ def LoadScenario(
         source = f"overrides '{_OneLine(text)}'"
         try:
             CheckYamlStructure(text, source)  # (alias bombs, absurd nesting)
-            scenario = yaml_load_typed(schema=Scenario, data=text, defaults=scenario)
+            scenario = LoadYamlOverride(schema=Scenario, text=text, defaults=scenario)
         except YamlFileError:
             raise
         except yaml.YAMLError as e:

@@ -13,8 +13,10 @@ than :data:`MAX_ALIAS_NODES` nodes in all (a "billion laughs" file: a few lines 
 aliases expand to billions of nodes, which Drake's reader would walk for hours).
 """
 
+import dataclasses as dc
 import pathlib
 import re
+import typing
 
 from pydrake.common.yaml import yaml_load_typed
 import yaml
@@ -175,3 +177,25 @@ def YamlDifferences(before: str, after: str) -> list[str]:
         for key in sorted(old.keys() | new.keys())
         if old.get(key, "-") != new.get(key, "-")
     ]
+
+
+def LoadYamlOverride(*, schema, text: str, defaults):
+    """``defaults`` with the YAML ``text`` merged in, as Drake's ``yaml_load_typed``, except
+    that a top-level field whose tag names another class than its value's is made anew: Drake
+    keeps a default that is an instance of the tagged class, so ``{mobee: !MobeeParams {}}``
+    over a ``Dissertation`` (its subclass) would silently stay a ``Dissertation``."""
+    data = TaggedData(text)
+    if isinstance(data, dict):
+        hints = typing.get_type_hints(schema)
+        fresh = {}
+        for key, value in data.items():
+            if not (isinstance(value, dict) and len(value) == 1 and key in hints):
+                continue
+            tag = next(iter(value))
+            if not str(tag).startswith("!") or type(getattr(defaults, key)).__name__ == tag[1:]:
+                continue
+            for member in typing.get_args(hints[key]):
+                if getattr(member, "__name__", None) == tag[1:]:
+                    fresh[key] = member()
+        defaults = dc.replace(defaults, **fresh)
+    return yaml_load_typed(schema=schema, data=text, defaults=defaults)

@@ -76,6 +76,18 @@ class TestMistakes(unittest.TestCase):
                 ],
                 "",
             ),  # fmt: skip
+            (
+                [
+                    "run",
+                    "reach_around_ball",
+                    "--no-meshcat",
+                    "--no-log",
+                    "--set",
+                    "{objects: [{name: ball, shape: !Sphere {radius: 0.04}, "
+                    "position: [-0.31, 0.14, 0.0]}]}",
+                ],
+                "the robot starts in penetration: the robot: 'r_hand'",
+            ),  # fmt: skip
         ):
             with self.subTest(args):
                 code, _, err = _Call(*args)

@@ -47,6 +47,8 @@ class TestStateActionExecutor(unittest.TestCase):
             nhat_BA_W=np.zeros((k, 3)),
             row_A=np.zeros(k, dtype=int),
             row_B=np.where(b_is_robot, 1, -1),
+            X_WA=np.zeros((k, 3, 4)),
+            X_WB=np.zeros((k, 3, 4)),
         )
         self.dut.GetInputPort("field_pairs").FixValue(self.context, AbstractValue.Make(pairs))
 

@@ -23,6 +23,8 @@ ONE_PAIR = FieldPairs(
     nhat_BA_W=np.zeros((1, 3)),
     row_A=np.zeros(1, dtype=int),
     row_B=np.ones(1, dtype=int),
+    X_WA=np.zeros((1, 3, 4)),
+    X_WB=np.zeros((1, 3, 4)),
 )
 
 

@@ -13,6 +13,7 @@ from pydrake.systems.framework import LeafSystem
 from mobee_drake import cli
 from mobee_drake.atomic_files import CurrentGeneration
 from mobee_drake.mobee.fields import FieldPairs
+from mobee_drake.mobee.params import Dissertation, MobeeParams
 from mobee_drake.mobee.system import FORCE_TERMS
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.scenario import BuildScenario, LoadScenario, ResumableConfiguration, RunScenario
@@ -118,6 +119,19 @@ class TestScenarioFiles(unittest.TestCase):
         self.assertEqual(scenario.mover.control, "force")
         with self.assertRaisesRegex(YamlFileError, "overrides"):
             LoadScenario(REACH, "{mver: !Dynamic {}}")
+
+    def test_an_override_switches_the_mobee_preset_both_ways(self):
+        """``Dissertation`` subclasses ``MobeeParams``: Drake's loader alone would keep it."""
+        scenario = LoadScenario("motor_babbling", "{mobee: !MobeeParams {}}")
+        self.assertIs(type(scenario.mobee), MobeeParams)
+        self.assertEqual(scenario.mobee.damping, MobeeParams().damping)
+        scenario = LoadScenario(REACH, "{mobee: !Dissertation {damping: 30}}")
+        self.assertIs(type(scenario.mobee), Dissertation)
+        self.assertEqual(scenario.mobee.stiffness, Dissertation().stiffness)
+        self.assertEqual(scenario.mobee.damping, 30)
+        # The same tag merges, as Drake's loader does.
+        scenario = LoadScenario("motor_babbling", "{mobee: !Dissertation {damping: 30}}")
+        self.assertEqual((type(scenario.mobee), scenario.mobee.damping), (Dissertation, 30))
 
 
 def Forces(total, damping) -> np.ndarray:
@@ -275,6 +289,8 @@ class TestSafetyMonitor(unittest.TestCase):
                 nhat_BA_W=np.zeros((k, 3)),
                 row_A=np.zeros(k, dtype=int),
                 row_B=np.array([1 if i == chest else -1 for i in ids]),
+                X_WA=np.zeros((k, 3, 4)),
+                X_WB=np.zeros((k, 3, 4)),
             )
             dut.GetInputPort("field_pairs").FixValue(context, pairs)
             context.SetDiscreteState(dut.EvalUniquePeriodicDiscreteUpdate(context).value())

@@ -5,24 +5,36 @@ A client's channels all push one marker along a direction, far beyond MoBeE's sq
 the attractor (the scenario's), a configuration-space force ``c J^T u`` (eq. 5.9) and a workspace
 force ``f u`` on the marker (eq. 5.10), with c = f = 1000.
 
-- ``scenes``: fixed pushes into a table, a ball and the robot's own body, for the kinematic robot
-  and the dynamic robot's three control modalities, with MoBeE's safety barrier on and off;
-- ``babbling``: ``motor_babbling`` (random attractors every 4 s above a table) with the push's
-  direction drawn anew every second, for ``--seconds`` (600: ten simulated minutes), beside the
-  same run without client forces.
+- ``scenes``: fixed pushes into a table (the hand, a box, slides and turns on the table top), a
+  ball (the table close below it) and the robot's own body, for ``--push-seconds`` each, for the
+  kinematic robot and the dynamic robot's three control modalities, with MoBeE's safety barrier
+  on and off;
+- ``babbling``: ``motor_babbling`` (the kinematic robot, random attractors every 4 s above a
+  table) with the push's direction drawn anew every second, for ``--babbling-seconds``, beside
+  the same run without client forces;
 
-Each row: the closest approach of the robot's solids to the obstacle and to itself, and the
-control periods in which solid geometry penetrated, with the deepest penetration.
+each with MoBeE's constants of every ``--preset``. Each run: the closest approach of the
+robot's solids to the obstacle and to itself, and the control periods in which solid geometry
+penetrated, with the deepest penetration. The runs are printed as they end; with ``--output``
+they are written to ``safety.json`` there (typed rows, :class:`SceneResult` and
+:class:`BabblingResult`) with the tables in ``safety.md``, and with ``--doc`` the tables in
+docs/mobee.md are rewritten from them (``--report-only``: from an earlier ``--output``).
 
-Run: ``mobee-drake bench safety [--seconds 600] [--part scenes babbling]``.
+Run: ``mobee-drake bench safety --output results/safety --doc docs/mobee.md``.
 """
 
+import contextlib
 import dataclasses as dc
+import json
+import pathlib
 
 import numpy as np
 from pydrake.systems.framework import BasicVector, LeafSystem
 
+from mobee_drake.atomic_files import StrictJson, WriteTextAtomically
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat
+from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.scenario import LoadScenario, Scenario
 from mobee_drake.station.builder import MakeMobeeStation
 from mobee_drake.station.parts import ClientPorts, StationParts
@@ -116,7 +128,7 @@ SCENES = (
     Scene("table", "{objects: [{name: table, shape: !Box {size: [0.5, 0.9, 0.04]}, "
           "position: [-0.38, 0.0, -0.17]}]}", "r_palm", (0.0, 0.0, -1.0), "table"),
     Scene("ball", "{}", "r_palm", (-0.02, -0.06, -0.06), "ball"),
-    Scene("self", "{objects: []}", "r_palm", (0.5, -1.0, -0.5), "(self)"),
+    Scene("self", "{objects: []}", "r_palm", (0.5, -1.0, 0.0), "(self)"),
 )  # fmt: skip
 MOVERS = {
     "kinematic": "!Kinematic {}",
@@ -170,6 +182,10 @@ def PushedRun(
 PRESETS = {"defaults": "!MobeeParams", "dissertation": "!Dissertation"}
 
 
+def _MobeeOverride(preset: str, barrier: bool = True) -> str:
+    return f"mobee: {PRESETS[preset]} {{barrier: {{enabled: {str(barrier).lower()}}}}}"
+
+
 def SceneRun(
     scene: Scene,
     mover: str,
@@ -185,66 +201,262 @@ def SceneRun(
         [
             scene.overrides,
             f"{{mover: {MOVERS[mover]}, duration: {seconds}, data_log: {{enabled: false}}, "
-            f"mobee: {PRESETS[preset]} {{barrier: {{enabled: {str(barrier).lower()}}}}}}}",
+            f"{_MobeeOverride(preset, barrier)}}}",
         ],
     )
     return PushedRun(scenario, marker=scene.marker, direction=scene.direction)
 
 
-def _Row(label: str, summary: RunSummary, obstacle: str) -> str:
-    safety = summary.safety
+def BabblingRun(*, preset: str, seconds: float, push: bool) -> RunSummary:
+    """``motor_babbling`` for ``seconds`` with MoBeE's constants ``preset``, with or without
+    random saturated pushes on the right palm (redrawn every second)."""
+    scenario = LoadScenario(
+        "motor_babbling",
+        f"{{duration: {seconds}, data_log: {{enabled: false}}, {_MobeeOverride(preset)}}}",
+    )
+    return PushedRun(scenario, marker="r_palm", direction=(0, 0, -1), every=1.0, push=push)
 
-    def Closest(name: str) -> str:
-        value = safety.closest_approach.get(name)
-        return "-" if value is None else f"{1000 * value:+.1f}"
 
+@dc.dataclass
+class Safety:
+    """What one run did to safety (m; the closest approaches are signed distances, None where
+    the pair never came inside a field)."""
+
+    closest_to_obstacle: float | None
+    closest_to_itself: float | None
+    penetrating_periods: int
+    deepest_penetration: float
+
+    @staticmethod
+    def Of(summary: RunSummary, obstacle: str) -> "Safety":
+        report = summary.safety
+        return Safety(
+            report.closest_approach.get(obstacle),
+            report.closest_approach.get("(self)"),
+            report.penetrating_steps,
+            report.deepest_penetration,
+        )
+
+
+@dc.dataclass
+class SceneResult:
+    """One fixed push (a row of the scenes' table: a scene, preset, length and barrier; a
+    column: the mover)."""
+
+    scene: str
+    preset: str
+    seconds: float
+    barrier: bool
+    mover: str
+    safety: Safety
+
+
+@dc.dataclass
+class BabblingResult:
+    """One run of motor babbling."""
+
+    preset: str
+    seconds: float
+    pushed: bool
+    safety: Safety
+
+
+def _Millimetres(value: float | None) -> str:
+    return "-" if value is None else f"{1000 * value:+.1f}"
+
+
+def ScenesTable(results: list[SceneResult]) -> str:
+    """The scenes as a table: per scene, preset, push length and barrier, each mover's closest
+    approach to the obstacle (mm, negative: inside it) and its penetrating periods."""
+    rows: dict[tuple, dict[str, SceneResult]] = {}
+    for r in results:
+        rows.setdefault((r.scene, r.preset, r.seconds, r.barrier), {})[r.mover] = r
+    lines = [
+        "| push into | MoBeE | s | barrier | " + " | ".join(MOVERS) + " |",
+        "|---|---|---:|---|" + "---:|" * len(MOVERS),
+    ]
+    for (scene, preset, seconds, barrier), by_mover in rows.items():
+        cells = [
+            "n/a"
+            if mover not in by_mover
+            else f"{_Millimetres(by_mover[mover].safety.closest_to_obstacle)} "
+            f"({by_mover[mover].safety.penetrating_periods})"
+            for mover in MOVERS
+        ]
+        lines.append(
+            f"| {scene} | {preset} | {seconds:g} | {'on' if barrier else 'off'} | "
+            + " | ".join(cells)
+            + " |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def BabblingTable(results: list[BabblingResult]) -> str:
+    lines = [
+        "| MoBeE | s | client | closest to the table (mm) | closest to itself (mm) | "
+        "penetrating periods | deepest (mm) |",
+        "|---|---:|---|---:|---:|---:|---:|",
+    ]
+    for r in results:
+        s = r.safety
+        lines.append(
+            f"| {r.preset} | {r.seconds:g} | "
+            f"{'random saturated pushes' if r.pushed else 'none'} | "
+            f"{_Millimetres(s.closest_to_obstacle)} | {_Millimetres(s.closest_to_itself)} | "
+            f"{s.penetrating_periods} | {1000 * s.deepest_penetration:.1f} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def _RunScenes(args, record) -> None:
+    print(f"Saturated pushes (c = f = {PUSH:g}), barrier off and on:", flush=True)
+    for preset in args.preset:
+        for seconds in args.push_seconds:
+            for scene in SCENES:
+                for barrier in (False, True):
+                    for mover in MOVERS:
+                        summary = SceneRun(
+                            scene, mover, barrier=barrier, seconds=seconds, preset=preset
+                        )
+                        result = SceneResult(
+                            scene.name, preset, seconds, barrier, mover,
+                            Safety.Of(summary, scene.obstacle),
+                        )  # fmt: skip
+                        record(result)
+                        print(f"  {_Label(result)}: {_Line(result.safety)}", flush=True)
+
+
+def _RunBabbling(args, record) -> None:
+    print("motor_babbling (kinematic robot, barrier on):", flush=True)
+    for preset in args.preset:
+        for push in (False, True):
+            summary = BabblingRun(preset=preset, seconds=args.babbling_seconds, push=push)
+            result = BabblingResult(
+                preset, args.babbling_seconds, push, Safety.Of(summary, "table")
+            )
+            record(result)
+            print(f"  {preset}, pushed {push}: {_Line(result.safety)}", flush=True)
+
+
+def _Label(r: SceneResult) -> str:
+    barrier = "on" if r.barrier else "off"
+    return f"{r.scene}, {r.preset}, {r.seconds:g} s, barrier {barrier}, {r.mover}"
+
+
+def _Line(s: Safety) -> str:
     return (
-        f"| {label} | {Closest(obstacle)} | {Closest('(self)')} | {safety.penetrating_steps} | "
-        f"{1000 * safety.deepest_penetration:.1f} |"
+        f"closest {_Millimetres(s.closest_to_obstacle)} mm (itself "
+        f"{_Millimetres(s.closest_to_itself)}), {s.penetrating_periods} penetrating periods, "
+        f"deepest {1000 * s.deepest_penetration:.1f} mm"
     )
 
 
-def main(argv=None) -> None:
+@dc.dataclass
+class SafetyResults:
+    """The benchmark's results file: the command that ran it and every run."""
+
+    command: str
+    scenes: list[SceneResult] = dc.field(default_factory=list)
+    babbling: list[BabblingResult] = dc.field(default_factory=list)
+
+    def Record(self, result: SceneResult | BabblingResult) -> None:
+        (self.scenes if isinstance(result, SceneResult) else self.babbling).append(result)
+
+    def Save(self, path: pathlib.Path) -> None:
+        WriteTextAtomically(path, StrictJson(dc.asdict(self), indent=1))
+
+    @staticmethod
+    def Load(path: pathlib.Path) -> "SafetyResults":
+        data = json.loads(path.read_text())
+        return SafetyResults(
+            command=data["command"],
+            scenes=[SceneResult(**{**r, "safety": Safety(**r["safety"])}) for r in data["scenes"]],
+            babbling=[
+                BabblingResult(**{**r, "safety": Safety(**r["safety"])}) for r in data["babbling"]
+            ],
+        )
+
+    def Tables(self) -> dict[str, str]:
+        """The generated tables by name (those with results)."""
+        tables = {}
+        if self.scenes:
+            tables["safety scenes"] = ScenesTable(self.scenes)
+        if self.babbling:
+            tables["safety babbling"] = BabblingTable(self.babbling)
+        return tables
+
+
+def _Parser() -> CommandParser:
     parser = CommandParser(prog="mobee-drake bench safety", description=__doc__)
     parser.add_argument(
-        "--seconds", type=PositiveFloat, default=600.0, help="simulated time of the babbling runs"
-    )
-    parser.add_argument(
         "--part",
-        nargs="*",
+        nargs="+",
         choices=["scenes", "babbling"],
         default=["scenes", "babbling"],
         help="which parts to run",
     )
     parser.add_argument(
-        "--preset", choices=sorted(PRESETS), default="defaults", help="MoBeE's constants (scenes)"
+        "--preset", nargs="+", choices=sorted(PRESETS), default=sorted(PRESETS),
+        help="MoBeE's constants",
+    )  # fmt: skip
+    parser.add_argument(
+        "--push-seconds", nargs="+", type=PositiveFloat, default=[4.0, 30.0],
+        help="simulated time of each fixed push (scenes)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--babbling-seconds", type=PositiveFloat, default=1800.0,
+        help="simulated time of each babbling run",
+    )  # fmt: skip
+    parser.add_argument(
+        "--output", help="a folder (new, empty or an earlier output) for safety.json and .md"
     )
+    parser.add_argument("--doc", help="a doc whose generated safety tables to rewrite")
+    parser.add_argument(
+        "--report-only", action="store_true",
+        help="run nothing: write the tables (and --doc) from --output's safety.json",
+    )  # fmt: skip
+    return parser
+
+
+def main(argv=None) -> None:
+    parser = _Parser()
     args = parser.parse_args(argv)
-    header = (
-        "| run | closest to the obstacle (mm) | closest to itself (mm) | penetrating periods "
-        "| deepest (mm) |\n|---|---:|---:|---:|---:|"
-    )
-    if "scenes" in args.part:
-        print(
-            f"Saturated pushes (c = f = {PUSH:g}) for 4 s, MoBeE's {args.preset}, barrier off "
-            f"and on:\n{header}"
-        )
-        for scene in SCENES:
-            for mover in MOVERS:
-                for barrier in (False, True):
-                    summary = SceneRun(scene, mover, barrier=barrier, preset=args.preset)
-                    label = f"{scene.name}, {mover}, barrier {'on' if barrier else 'off'}"
-                    print(_Row(label, summary, scene.obstacle), flush=True)
-    if "babbling" in args.part:
-        print(f"\nmotor_babbling for {args.seconds:g} s, kinematic robot:\n{header}")
-        scenario = LoadScenario(
-            "motor_babbling", f"{{duration: {args.seconds}, data_log: {{enabled: false}}}}"
-        )
-        for label, push in (("no client forces", False), ("random saturated pushes", True)):
-            summary = PushedRun(
-                scenario, marker="r_palm", direction=(0, 0, -1), every=1.0, push=push
-            )
-            print(_Row(label, summary, "table"), flush=True)
+    if args.report_only and not args.output:
+        parser.error("--report-only needs --output, the folder of an earlier run")
+    command = "mobee-drake bench safety " + " ".join(argv if argv is not None else [])
+    if args.doc:  # Checked before anything runs.
+        try:
+            for name in ("safety scenes", "safety babbling"):
+                GeneratedTable(args.doc, name)
+        except (OSError, ValueError) as error:
+            parser.error(f"--doc: {error}")
+    folder = pathlib.Path(args.output) if args.output else None
+    with OwnedFolder(folder, "safety benchmark") if folder else contextlib.nullcontext():
+        if args.report_only:
+            path = folder / "safety.json"
+            if not path.is_file():
+                parser.error(f"--output {folder}: holds no safety.json to report")
+            results = SafetyResults.Load(path)
+        else:
+            results = SafetyResults(command.strip())
+
+            def Record(result) -> None:  # Saved after every run: an interrupt loses one run.
+                results.Record(result)
+                if folder:
+                    results.Save(folder / "safety.json")
+
+            if "scenes" in args.part:
+                _RunScenes(args, Record)
+            if "babbling" in args.part:
+                _RunBabbling(args, Record)
+        tables = results.Tables()
+        text = "\n".join(tables.values())
+        print("\n" + text)
+        if folder:
+            WriteTextAtomically(folder / "safety.md", text)
+    if args.doc:
+        for name, table in tables.items():
+            WriteGeneratedTable(args.doc, name, results.command, table)
 
 
 if __name__ == "__main__":

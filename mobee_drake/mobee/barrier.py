@@ -7,28 +7,31 @@ collision force (40) whatever the maxima are, as soon as several of them push to
 barrier does not weigh forces against each other: it looks at what the next period will do.
 
 For a pair k of solids inside its field, with signed distance d_k and generalized normal n_k (the
-gradient of d_k with respect to the controlled joints' velocities: ``d_k' = n_k . v``), the next
-period (length h) moves with ``v+ = v + S total`` for a diagonal S given by how the period
-integrates MoBeE's total (:class:`StepModel`). The barrier asks
+gradient of d_k with respect to the controlled joints: ``d_k' = n_k . v``), the next period
+(length h) moves the measured joints by ``dq = offset + G total``, affine in the total with a
+diagonal G given by how the period integrates MoBeE's total and how the robot follows it
+(:class:`StepModel`). The barrier asks, with ``g_k = d_k - clearance``,
 
-    n_k . v+ >= -rate max(d_k - clearance, 0) / h      (for every pair k in a field)
+    n_k . dq >= -rate g_k      (for every pair k in a field)
 
-so that, to first order, the period closes at most the fraction ``rate`` of what is left of each
-gap beyond the ``clearance``: the gap shrinks geometrically towards the clearance and never
-below it, and a pair closer than that (one that started there) may not close further; MoBeE's
-field force opens it. The clearance absorbs what the first-order
-prediction misses (the solids' curvature, a robot sliding along a surface): without it, gaps
-shrank to micrometres and then closed by a fraction of a millimetre.
-Among the totals that satisfy it, the barrier takes the one closest to MoBeE's, in the metric of
-the virtual mass (Gauss's least constraint: ``min (dT)^T M^-1 dT``); that is a least-distance
-program, solved exactly by non-negative least squares (Lawson and Hanson, ch. 23). The barrier
-force ``f_barrier = dT`` is zero whenever MoBeE's own forces keep every gap from closing that
-fast, which is every period of ordinary operation.
+a discrete-time barrier: to first order the next gap is ``g_k+ >= (1 - rate) g_k``. Above the
+clearance the gap shrinks at most geometrically towards it; below it (g_k < 0) the row asks the
+pair to *open* by the fraction ``rate`` of its deficit. That makes the clearance attracting:
+if the first-order prediction errs by at most ``e`` per period (the solids' curvature, a robot
+sliding or turning on a surface, another witness point taking over), the gap obeys
+``g+ >= (1 - rate) g - e`` and never falls below ``clearance - e / rate``; the solids do not
+touch while ``e < rate * clearance`` (1 mm per period with the defaults).
+Among the totals that satisfy the rows, the barrier takes the one closest to MoBeE's, in the
+metric of the virtual mass (Gauss's least constraint: ``min (dT)^T M^-1 dT``); that is a
+least-distance program, solved exactly by non-negative least squares (Lawson and Hanson, ch. 23).
+The barrier force ``f_barrier = dT`` is zero whenever MoBeE's own forces keep every gap from
+closing that fast, which is every period of ordinary operation.
 """
 
 import dataclasses as dc
 
 import numpy as np
+from scipy.linalg import expm
 from scipy.optimize import nnls
 
 # A pair whose gap the controlled joints move by less than this (m per rad, the normal's norm)
@@ -41,7 +44,8 @@ class BarrierParams:
     """The safety barrier's settings."""
 
     enabled: bool = True
-    # The largest fraction of a pair's gap beyond the clearance the next period may close.
+    # The largest fraction of a pair's gap beyond the clearance the next period may close (and
+    # the fraction of its deficit it must open, below the clearance).
     rate: float = 0.2
     # The gap (m) the barrier keeps between solids (less than every field's margin).
     clearance: float = 0.005
@@ -56,54 +60,109 @@ class BarrierParams:
 
 
 @dc.dataclass(frozen=True)
+class JointTracking:
+    """The dynamic robot's joint controller in the position and velocity modes: inertia and
+    gravity compensated, the joints accelerate as ``q'' = kp (q_r - q) + kd (v_r - v)`` towards
+    the reference (q_r, v_r), MoBeE's virtual trajectory, held over each period."""
+
+    position_gain: float  # kp (1/s^2; 0 in the velocity mode)
+    velocity_gain: float  # kd (1/s)
+
+    def Response(self, period: float) -> tuple[float, float, float]:
+        """(a, b, c) with the period's displacement ``dq = a (q_r - q) + b v + c v_r`` of a
+        joint starting at (q, v) and tracking a held reference (q_r, v_r): the exact solution
+        of the linear closed loop (a matrix exponential, with the inputs' integral by Van
+        Loan's block)."""
+        kp, kd = self.position_gain, self.velocity_gain
+        block = np.zeros((4, 4))
+        block[:2, :2] = [[0.0, 1.0], [-kp, -kd]]
+        block[1, 2:] = [kp, kd]  # how q_r and v_r drive the acceleration
+        flow = expm(block * period)
+        # dq = (Phi_qq - 1) q + Phi_qv v + Gamma_r q_r + Gamma_v v_r, and Phi_qq - 1 = -Gamma_r.
+        return flow[0, 2], flow[0, 1], flow[0, 3]
+
+
+@dc.dataclass(frozen=True)
+class Displacement:
+    """The next period's displacement of the measured joints, affine in MoBeE's total T:
+    ``dq = gain T + velocity v + reference_velocity v_r + lag (q_r - q)`` (each an n-vector or
+    a scalar), where (q, v) is the measured state and (q_r, v_r) the reference the robot follows
+    (its own state where it is its own reference)."""
+
+    gain: np.ndarray
+    velocity: np.ndarray | float
+    reference_velocity: np.ndarray | float = 0.0
+    lag: float = 0.0
+
+    def Offset(self, q, v, q_r, v_r) -> np.ndarray:
+        """The part of dq that does not depend on T."""
+        return self.velocity * v + self.reference_velocity * v_r + self.lag * (q_r - q)
+
+
+@dc.dataclass(frozen=True)
 class StepModel:
-    """How the next period (``period`` s) integrates MoBeE's total T into the velocity.
+    """How the next period (``period`` s) moves the measured joints under MoBeE's total T.
 
-    - ``implicit_damping`` (the virtual dynamics of the kinematic robot and of the dynamic
-      robot's position and velocity modes): ``v+ = (v + h (T + C v) / M) / (1 + h C / M)``;
-    - explicit (the force-controlled plant, which accelerates by T / M for the period):
-      ``v+ = v + h T / M``.
+    - The kinematic robot (``implicit_damping``, no ``tracking``): the virtual dynamics integrate
+      ``v+ = (v + h (T + C v) / M) / (1 + h C / M)`` and move by ``dq = h v+``.
+    - The force-controlled plant (explicit): it accelerates by T / M for the period. The rows
+      hold the period's end velocity, ``dq = h (v + h T / M)``, which bounds the period's mean
+      velocity too, since the velocity it starts with was held by the period before.
+    - The position and velocity modes (``tracking``): the virtual dynamics move the reference as
+      they move the kinematic robot (with the damping of the measured velocity v), and the plant
+      follows it through the joint controller's lag (:class:`JointTracking`).
 
-    Both are ``v+ = v + S T`` with a diagonal S (for the implicit one because T contains the
-    damping term ``-C v``).
+    Each is affine in T with a diagonal gain, because T contains the damping term ``-C v``.
     """
 
     period: float
     implicit_damping: bool = True
+    tracking: JointTracking | None = None
 
-    def Gain(self, mass: np.ndarray, damping: np.ndarray) -> np.ndarray:
-        """The diagonal of S."""
+    def Displacement(self, mass: np.ndarray, damping: np.ndarray) -> Displacement:
         h = self.period
-        if self.implicit_damping:
-            return h / mass / (1.0 + h * damping / mass)
-        return h / mass
+        if not self.implicit_damping:
+            return Displacement(gain=h * h / mass, velocity=h)
+        keep = 1.0 / (1.0 + h * damping / mass)
+        velocity_gain = h * keep / mass  # S of v+ = keep v + S (T + C v)
+        if self.tracking is None:  # keep v + S C v = v
+            return Displacement(gain=h * velocity_gain, velocity=h)
+        a, b, c = self.tracking.Response(h)
+        # dq = a (q_r+ - q) + b v + c v_r+ with q_r+ = q_r + h v_r+, v_r+ = keep v_r + S (T + C v).
+        reference_gain = a * h + c
+        return Displacement(
+            gain=reference_gain * velocity_gain,
+            velocity=b + reference_gain * velocity_gain * damping,
+            reference_velocity=reference_gain * keep,
+            lag=a,
+        )
 
 
 def BarrierForce(
     normals: np.ndarray,
     distances: np.ndarray,
-    velocity: np.ndarray,
+    offset: np.ndarray,
     total: np.ndarray,
     mass: np.ndarray,
     gain: np.ndarray,
-    period: float,
     params: BarrierParams,
 ) -> np.ndarray:
-    """The barrier force dT (n) for the pairs' ``normals`` (k, n) and ``distances`` (k) at
-    ``velocity`` (n), given MoBeE's ``total`` (n) without it, the virtual ``mass`` (n) and the
-    step's ``gain`` S (n), with the barrier's ``params`` (see the module).
+    """The barrier force dT (n) for the pairs' ``normals`` (k, n) and ``distances`` (k), given
+    MoBeE's ``total`` (n) without it and the next period's displacement ``offset + gain T``
+    (:class:`Displacement`), in the metric of the virtual ``mass`` (n), with the barrier's
+    ``params`` (see the module).
 
     Pairs whose normal nearly vanishes (shorter than :data:`MIN_LEVER`: the controlled joints
     hardly move them, e.g. a base link resting in a table) cannot be helped and are left out. If
     the barriers contradict each other (solids pinched from two sides), the least-squares change
     that meets them as nearly as possible is taken instead.
     """
-    # Row k: n_k . S (T + dT) >= -rate max(d_k - clearance, 0) / h - n_k . v; with
-    # u = dT / sqrt(M): G u >= r.
+    # Row k: n_k . (offset + gain (T + dT)) >= -rate g_k; with u = dT / sqrt(M): G u >= r.
     root_mass = np.sqrt(mass)
     G = normals * (gain * root_mass)
-    closing = params.rate * np.maximum(distances - params.clearance, 0.0) / period
-    r = -closing - normals @ velocity - (normals * gain) @ total
+    # (A penetrating pair is asked to open by at most rate * clearance a period.)
+    gaps = np.maximum(distances - params.clearance, -params.clearance)
+    r = -params.rate * gaps - normals @ (offset + gain * total)
     if not np.any(r > 0):  # MoBeE's total already keeps every barrier.
         return np.zeros_like(total)
     # Every barrier takes part (one that holds now may not once another is met), but for those

@@ -57,6 +57,10 @@ class FieldPairs:
     nhat_BA_W: np.ndarray  # (k, 3)
     row_A: np.ndarray  # (k,) int
     row_B: np.ndarray  # (k,) int, -1 when B is not the robot's
+    # (k, 3, 4): the pose in world of A's geometry frame, and of B's where B is the robot's
+    # (zeros for an obstacle).
+    X_WA: np.ndarray
+    X_WB: np.ndarray
 
     def __len__(self) -> int:
         return len(self.geometry_A)
@@ -86,7 +90,12 @@ NO_FIELD_PAIRS = FieldPairs(
     np.zeros((0, 3)),
     np.zeros(0, dtype=int),
     np.zeros(0, dtype=int),
+    np.zeros((0, 3, 4)),
+    np.zeros((0, 3, 4)),
 )
+
+
+_NO_POSE = np.zeros((3, 4))
 
 
 class RobotFields:
@@ -96,15 +105,39 @@ class RobotFields:
     def __init__(self, margins: Mapping[GeometryId, float]):
         self.geometries = list(margins)
         self.max_margin = max(margins.values(), default=0.0)  # no pair farther can be inside
+        self.min_margin = min(margins.values(), default=0.0)  # every pair's is at least this
         self._rows = {g: (row, margin) for row, (g, margin) in enumerate(margins.items())}
 
     def FindPairs(self, query: QueryObject) -> FieldPairs:
         """Every pair with a robot geometry inside its field, at the pose of ``query``."""
         if self.max_margin <= 0:
             return NO_FIELD_PAIRS
+        return self._Pairs(query, self.max_margin, lambda d, margin, a, b: d < margin)
+
+    def FindApproaching(self, query: QueryObject, reach: np.ndarray, gap: float) -> FieldPairs:
+        """The pairs outside their fields whose distance the robot's geometries could close to
+        less than ``gap`` if each moved by its ``reach`` (m, per row)."""
+        if self.max_margin <= 0:
+            return NO_FIELD_PAIRS
+
+        def Approaching(d, margin, a, b) -> bool:
+            return margin <= d < gap + (reach[a[0]] if a else 0.0) + (reach[b[0]] if b else 0.0)
+
+        return self._Pairs(query, gap + 2 * reach.max(), Approaching)
+
+    def _Pairs(self, query: QueryObject, max_distance: float, keep) -> FieldPairs:
+        """The pairs with a robot geometry closer than ``max_distance`` that ``keep(distance,
+        margin, (row, margin) of A or None, of B or None)``."""
         rows, lookup = [], self._rows.get
-        poses = {}  # X_WA of each robot geometry met (several pairs often share one)
-        for pair in query.ComputeSignedDistancePairwiseClosestPoints(self.max_margin):
+        poses = {}  # X_WG of each robot geometry met (several pairs often share one)
+
+        def Pose(row: int, geometry: GeometryId) -> np.ndarray:
+            X_WG = poses.get(row)
+            if X_WG is None:
+                X_WG = poses[row] = query.GetPoseInWorld(geometry).GetAsMatrix34()
+            return X_WG
+
+        for pair in query.ComputeSignedDistancePairwiseClosestPoints(max_distance):
             id_A, id_B = pair.id_A, pair.id_B
             a, b = lookup(id_A), lookup(id_B)
             if a is None:
@@ -114,22 +147,21 @@ class RobotFields:
             else:
                 margin = a[1] if b is None or a[1] > b[1] else b[1]
             distance = pair.distance
-            if distance >= margin:
+            if not keep(distance, margin, a, b):
                 continue
             if a is None:  # Make A the robot's geometry.
                 id_A, id_B, a, b = id_B, id_A, b, None
                 p_ACa, nhat = pair.p_BCb, -pair.nhat_BA_W
             else:
                 p_ACa, nhat = pair.p_ACa, pair.nhat_BA_W
-            X_WA = poses.get(a[0])
-            if X_WA is None:
-                X_WA = poses[a[0]] = query.GetPoseInWorld(id_A).GetAsMatrix34()
+            X_WB = _NO_POSE if b is None else Pose(b[0], id_B)
             rows.append(
-                (id_A, id_B, distance, margin, X_WA, p_ACa, nhat, a[0], -1 if b is None else b[0])
-            )
+                (id_A, id_B, distance, margin, Pose(a[0], id_A), X_WB, p_ACa, nhat, a[0],
+                 -1 if b is None else b[0])
+            )  # fmt: skip
         if not rows:
             return NO_FIELD_PAIRS
-        ids_A, ids_B, distance, margin, X_WA, p_ACa, nhat, row_A, row_B = zip(*rows)
+        ids_A, ids_B, distance, margin, X_WA, X_WB, p_ACa, nhat, row_A, row_B = zip(*rows)
         X_WA = np.array(X_WA)
         return FieldPairs(
             list(ids_A),
@@ -140,6 +172,8 @@ class RobotFields:
             np.array(nhat),
             np.array(row_A),
             np.array(row_B),
+            X_WA,
+            np.array(X_WB),
         )
 
 

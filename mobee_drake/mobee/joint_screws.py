@@ -65,6 +65,16 @@ class JointScrews:
             self._leaf_frames.append(plant.get_body(BodyIndex(body)).body_frame())
             uncovered[columns] = False
 
+    @property
+    def velocities(self) -> np.ndarray:
+        """(r,): the plant velocities the controlled joints drive, in the screws' order."""
+        return self._velocities
+
+    @property
+    def to_joints(self) -> np.ndarray:
+        """(r, n): ``v_driven = to_joints @ v`` of the controlled joints."""
+        return self._to_joints
+
     def Calc(self, plant_context) -> np.ndarray:
         """(6, r): the screws of the r driven velocities, column by column: ``w`` in rows 0-2,
         ``u`` in rows 3-5.

@@ -17,6 +17,7 @@ from mobee_drake.mobee.joint_limits import JointLimits
 from mobee_drake.mobee.joint_screws import JointScrews
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.mobee.squash import Squash
+from mobee_drake.mobee.support_points import SupportPoints
 from mobee_drake.robots.controlled_robot import ControlledRobot
 from mobee_drake.robots.couplings import JointCoupling
 from mobee_drake.robots.overlay import MarkerStates, RobotOverlay
@@ -50,6 +51,7 @@ class Mobee(LeafSystem):
         - config_force
         - marker_forces
         - geometry_query
+        - reference_state
         output_ports:
         - spring
         - damping
@@ -75,6 +77,9 @@ class Mobee(LeafSystem):
     - ``config_force`` (n): the client's configuration-space force f_qRPC (eq. 5.9). Optional.
     - ``marker_forces`` (3m): a workspace force (world frame) on each marker (eq. 5.10). Optional.
     - ``geometry_query``: SceneGraph's query object, posed at the same configuration.
+    - ``reference_state`` (2n): the virtual trajectory (q_r, v_r) a dynamic robot's joint
+      controller tracks, for the safety barrier's prediction of the plant's lag (``step``'s
+      ``tracking``). Unconnected: the measured state.
 
     Outputs (each n, the terms of eq. 5.7 moved to the right-hand side, so that
     ``M q'' = total``):
@@ -110,7 +115,6 @@ class Mobee(LeafSystem):
     ):
         super().__init__()
         self._plant = plant
-        self._step = step
         self._params = params = params or MobeeParams()
         self._joints = list(joints)
         n = len(self._joints)
@@ -127,7 +131,7 @@ class Mobee(LeafSystem):
         self._squash = per_joint.squash  # eq. 5.8's (m_i, k_i) of each sigmoid
         self._barrier = params.barrier.enabled and step is not None
         if self._barrier:
-            self._step_gain = step.Gain(mass, damping)
+            self._displacement = step.Displacement(mass, damping)
         self._limits = JointLimits(
             self._q_min, self._q_max, per_joint.limit_delta, per_joint.limit_force
         )
@@ -161,6 +165,20 @@ class Mobee(LeafSystem):
         ]
         moves = self._screws.Moves(np.array(field_bodies, dtype=int))
         self._field_moves = np.vstack([moves, np.zeros(moves.shape[1])])
+        # The barrier also watches the support points of each robot solid with a field, and
+        # watches pairs as far beyond their fields as the next period may move them.
+        primitives = {p.name: p for p in robot.overlay.primitives}
+        geometry_frames = [
+            plant.get_frame(robot.geometry_frames[g]) for g in self._fields.geometries
+        ]
+        self._support = SupportPoints(
+            plant,
+            [primitives[self._geometry_names[g]] for g in self._fields.geometries],
+            field_bodies,
+            [f.GetFixedPoseInBodyFrame().GetAsMatrix4() for f in geometry_frames],
+            self._screws,
+            self._field_moves,
+        )
         self._markers, self._marker_bodies = controlled.markers, controlled.marker_bodies
         self._marker_moves = self._screws.Moves(
             np.array([int(b.index()) for b in self._marker_bodies], dtype=int)
@@ -175,6 +193,7 @@ class Mobee(LeafSystem):
         self._query_port = self.DeclareAbstractInputPort(
             "geometry_query", AbstractValue.Make(QueryObject())
         )
+        self._reference_port = self.DeclareVectorInputPort("reference_state", 2 * n)
 
         # The attractor changes rarely: it is checked once per change, not once per evaluation.
         self._attractor_entry = self.DeclareCacheEntry(
@@ -224,6 +243,7 @@ class Mobee(LeafSystem):
             self._attractor_entry.ticket(),
             self._config_force_port.ticket(),
             self._marker_forces_port.ticket(),
+            self._reference_port.ticket(),
         }
         for row, term in enumerate(FORCE_TERMS):
             self.DeclareVectorOutputPort(
@@ -478,18 +498,58 @@ class Mobee(LeafSystem):
                 - goal_directed
             )
 
-        if self._barrier and normals is not None:
-            terms[8] = BarrierForce(
-                normals,
-                pairs.distance,
-                v,
-                terms[:8].sum(axis=0),
-                self._mass,
-                self._step_gain,
-                self._step.period,
-                p.barrier,
-            )
+        if self._barrier:
+            terms[8] = self._Barrier(context, q, v, terms[:8].sum(axis=0), pairs, normals)
         np.sum(terms[:-1], axis=0, out=terms[-1])
+
+    def _Barrier(self, context, q, v, total, pairs: FieldPairs, normals) -> np.ndarray:
+        """The safety barrier's force (:mod:`mobee_drake.mobee.barrier`) for the pairs inside
+        their fields and, if the period could move two solids from beyond their field to within
+        the clearance, for those pairs too (docs/mobee.md, "The safety guarantee", condition 1).
+        """
+        params, gain = self._params.barrier, self._displacement.gain
+        offset = self._NextOffset(context, q, v)
+        change = np.zeros_like(total)
+        rows, gaps = self._BarrierRows(context, pairs, normals, offset + gain * total)
+        if rows is not None:
+            change = BarrierForce(rows, gaps, offset, total, self._mass, gain, params)
+        # How far each solid may move (the largest lever of any of its points, any posture).
+        reach = self._support.Lookahead(np.abs(offset + gain * (total + change)))
+        if params.clearance + 2 * reach.max() <= self._fields.min_margin:
+            return change  # No solid can cross its field in the period.
+        query = self._query_port.Eval(context)
+        far = self._fields.FindApproaching(query, reach, params.clearance)
+        if not len(far):
+            return change
+        far_rows, far_gaps = self._BarrierRows(
+            context, far, self._FieldNormals(context, far), offset + gain * (total + change)
+        )
+        if rows is not None:
+            far_rows, far_gaps = np.vstack([rows, far_rows]), np.concatenate([gaps, far_gaps])
+        return BarrierForce(far_rows, far_gaps, offset, total, self._mass, gain, params)
+
+    def _BarrierRows(self, context, pairs: FieldPairs, normals, displacement: np.ndarray):
+        """(normals (r, n), gaps (r,)) of the barrier's rows for ``pairs``, or (None, None) if
+        there are none: each pair's witness point and the support points of its robot solids
+        (:mod:`mobee_drake.mobee.support_points`) that the joints' ``displacement`` could bring
+        into the pair's field."""
+        if not len(pairs):
+            return None, None
+        lookahead = self._support.Lookahead(np.abs(displacement))
+        rows, gaps = self._support.BarrierRows(self._screws_entry.Eval(context), pairs, lookahead)
+        if rows is None:
+            return normals, pairs.distance
+        return np.vstack([normals, rows]), np.concatenate([pairs.distance, gaps])
+
+    def _NextOffset(self, context, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """The next period's displacement without force (:class:`Displacement`), from the
+        reference state where one is connected."""
+        q_r, v_r = q, v
+        if self._reference_port.HasValue(context):
+            x_r = self._reference_port.Eval(context)
+            self._CheckFinite("reference_state", x_r, self._state_names)
+            q_r, v_r = x_r[: len(q)], x_r[len(q) :]
+        return self._displacement.Offset(q, v, q_r, v_r)
 
     def _CalcMarkerPoses(self, context, value) -> None:
         MarkerStates(

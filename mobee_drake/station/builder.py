@@ -43,7 +43,7 @@ from pydrake.systems.primitives import (
 )
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
-from mobee_drake.mobee.barrier import StepModel
+from mobee_drake.mobee.barrier import JointTracking, StepModel
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.mobee.reflex import ReflexController
 from mobee_drake.mobee.system import Mobee
@@ -98,6 +98,20 @@ class Station:
     data_log: DataLogger | None = None
 
 
+def _JointTracking(control: str) -> JointTracking:
+    """The gains of the dynamic robot's joint controller in the position or velocity mode."""
+    return JointTracking(POSITION_GAIN if control == "position" else 0.0, VELOCITY_GAIN)
+
+
+def _StepModel(mover_config: Kinematic | Dynamic, time_step: float) -> StepModel:
+    """How the next period moves the robot under MoBeE's total, for its safety barrier."""
+    if not isinstance(mover_config, Dynamic):
+        return StepModel(period=time_step)
+    if mover_config.control == "force":
+        return StepModel(period=time_step, implicit_damping=False)
+    return StepModel(period=time_step, tracking=_JointTracking(mover_config.control))
+
+
 def _AddMobee(
     builder: DiagramBuilder,
     plant: MultibodyPlant,
@@ -117,8 +131,7 @@ def _AddMobee(
     # moves the robot by itself, without MoBeE 2.0's total).
     step = None
     if not isinstance(mover_config, Reflex):
-        force_controlled = isinstance(mover_config, Dynamic) and mover_config.control == "force"
-        step = StepModel(period=time_step, implicit_damping=not force_controlled)
+        step = _StepModel(mover_config, time_step)
     mobee = builder.AddNamedSystem(
         f"{prefix}mobee", Mobee(plant, robot, joints=joints, params=params, step=step)
     )
@@ -178,10 +191,16 @@ def _AddJointController(
             acceleration.get_output_port(), controller.get_input_port_desired_acceleration()
         )
     else:
-        kp = np.full(n, POSITION_GAIN if dynamic.control == "position" else 0.0)
+        gains = _JointTracking(dynamic.control)
         controller = builder.AddNamedSystem(
             "joint_controller",
-            InverseDynamicsController(plant, kp, np.zeros(n), np.full(n, VELOCITY_GAIN), False),
+            InverseDynamicsController(
+                plant,
+                np.full(n, gains.position_gain),
+                np.zeros(n),
+                np.full(n, gains.velocity_gain),
+                False,
+            ),
         )
         builder.Connect(to_plant.get_output_port(), controller.get_input_port_desired_state())
     builder.Connect(plant.get_state_output_port(), controller.get_input_port_estimated_state())
@@ -336,6 +355,9 @@ def MakeMobeeStation(
         _AddJointController(
             builder, plant, mobee, state_map, to_plant, mover_config, config.time_step
         )
+        if mover_config.control != "force":
+            # The barrier predicts the plant's lag behind the virtual trajectory it tracks.
+            builder.Connect(mover.GetOutputPort("state"), mobee.GetInputPort("reference_state"))
     else:
         _PoseKinematicRobots(
             builder, plant, scene_graph, [to_plant.get_output_port()] + companion_positions

@@ -14,7 +14,7 @@ from mobee_drake.progress import ProgressBar
 from mobee_drake.station.builder import Station
 from mobee_drake.station.checkpoint import HasCheckpoint, LoadCheckpoint, SaveCheckpoint
 from mobee_drake.station.outcome import RunOutcome
-from mobee_drake.station.safety import SafetyReport
+from mobee_drake.station.safety import CheckStart, SafetyReport
 from mobee_drake.station.world_events import MakeSimulator
 
 
@@ -182,6 +182,8 @@ def RunStation(
         if resumed is not None and resumed >= duration:
             report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
             return RunSummary(0.0, 0.0, report, finished_before=resumed)
+        if resumed is None:
+            CheckStart(station.diagram, context)
         if record:  # (Before the initialization's drawing, which the recording keeps.)
             _StartRecording(station, duration - (resumed or 0.0))
         simulator.Initialize(InitializeParams(suppress_initialization_events=resumed is not None))

@@ -1,6 +1,8 @@
-"""Watches a run for what matters to safety: closest approaches and penetrations of solids."""
+"""Watches a run for what matters to safety: closest approaches and penetrations of solids, and
+solids that penetrate where no motion brought them (at the start, or by a world event)."""
 
 import dataclasses as dc
+import logging
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -8,6 +10,7 @@ from pydrake.geometry import QueryObject
 from pydrake.systems.framework import BasicVector, LeafSystem
 
 from mobee_drake.mobee.fields import NO_FIELD_PAIRS
+from mobee_drake.mobee.system import Mobee
 
 SELF = "(self)"
 OTHERS = "(other objects)"
@@ -86,3 +89,45 @@ class SafetyMonitor(LeafSystem):
             penetrating_steps=int(x[n]),
             deepest_penetration=float(x[n + 1]),
         )
+
+
+class StartsInPenetrationError(ValueError):
+    """A run whose robot starts inside an object or itself (the message names the pairs)."""
+
+
+def Penetrations(diagram, root_context) -> list[str]:
+    """Each pair of solids that penetrates at ``root_context``, for every MoBeE in ``diagram``:
+    ``the robot: 'r_hand' 12.3 mm inside 'table'``, deepest first."""
+    found = []
+    for system in diagram.GetSystems():
+        if isinstance(system, Mobee):
+            # A companion's MoBeE is named after it ("katana_mobee"), the robot's "mobee".
+            robot = system.get_name().removesuffix("mobee").removesuffix("_") or "the robot"
+            context = system.GetMyContextFromRoot(root_context)
+            for contact in system.GetOutputPort("field_contacts").Eval(context):
+                if contact.distance < 0:
+                    found.append((contact.distance, robot, contact.name_A, contact.name_B))
+    return [f"{r}: '{a}' {-1000 * d:.1f} mm inside '{b}'" for d, r, a, b in sorted(found)]
+
+
+def CheckStart(diagram, root_context) -> None:
+    """Raises :class:`StartsInPenetrationError` if the robot starts in penetration: MoBeE's
+    safety barrier keeps solids apart, it cannot make a run that starts inside an object
+    faithful (move the object, or the robot's home)."""
+    found = Penetrations(diagram, root_context)
+    if found:
+        raise StartsInPenetrationError(
+            f"the robot starts in penetration: {', '.join(found[:3])}"
+            + (f" and {len(found) - 3} more" if len(found) > 3 else "")
+            + "; move the object or the robot"
+        )
+
+
+def WarnOfPenetrations(diagram, root_context, what: str) -> None:
+    """Logs a warning naming the pairs that ``what`` (a world event) left in penetration."""
+    found = Penetrations(diagram, root_context)
+    if found:
+        logging.getLogger(__name__).warning(
+            "%s put solids in penetration at t = %.3f s: %s (MoBeE's fields push them apart)",
+            what, root_context.get_time(), ", ".join(found[:3]),
+        )  # fmt: skip

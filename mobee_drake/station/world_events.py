@@ -18,6 +18,8 @@ import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
 from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem, OutputPort
 
+from mobee_drake.station.safety import WarnOfPenetrations
+
 WORLD_EVENTS_PORT = "world_events"
 
 
@@ -71,6 +73,7 @@ def ApplyWorldEvents(station, root_context) -> None:
         counts[i] = len(issued)
     if np.any(counts != before):  # (Most steps change nothing: no mutable context then.)
         ledger.SetCounts(ledger.GetMyMutableContextFromRoot(root_context), counts)
+        WarnOfPenetrations(station.diagram, root_context, "a world event")
 
 
 def MakeSimulator(station, config: SimulatorConfig | None = None) -> Simulator:

@@ -1,0 +1,56 @@
+"""Tables in docs/ that a command writes: each sits between two marker lines naming it and the
+command that generates it, so that a table and its benchmark cannot disagree.
+
+    <!-- generated: NAME, by COMMAND -->
+    | ... the table ... |
+    <!-- end generated: NAME -->
+"""
+
+import pathlib
+import re
+
+from mobee_drake.atomic_files import WriteTextAtomically
+
+
+def _Block(name: str) -> re.Pattern:
+    return re.compile(
+        rf"^<!-- generated: {re.escape(name)}, by (?P<command>.*?) -->\n"
+        rf"(?P<table>.*?)^<!-- end generated: {re.escape(name)} -->$",
+        flags=re.MULTILINE | re.DOTALL,
+    )
+
+
+def GeneratedTable(doc: str | pathlib.Path, name: str) -> str:
+    """The text of the generated block ``name`` in ``doc``; ValueError naming the file if the
+    block is missing."""
+    match = _Block(name).search(pathlib.Path(doc).read_text())
+    if match is None:
+        raise ValueError(f"{doc}: no generated block '{name}'")
+    return match["table"]
+
+
+def WriteGeneratedTable(doc: str | pathlib.Path, name: str, command: str, table: str) -> None:
+    """Replaces the generated block ``name`` of ``doc`` with ``table`` (and names ``command``
+    in its opening marker); ValueError naming the file if the block is missing."""
+    doc = pathlib.Path(doc)
+    text = doc.read_text()
+    block = _Block(name)
+    if block.search(text) is None:
+        raise ValueError(f"{doc}: no generated block '{name}' to write")
+    replacement = (
+        f"<!-- generated: {name}, by {command} -->\n{table.rstrip()}\n"
+        f"<!-- end generated: {name} -->"
+    )
+    WriteTextAtomically(doc, block.sub(lambda _: replacement, text, count=1))
+
+
+def TableLayout(table: str) -> list[list[str]]:
+    """A markdown table's layout: per row its label cells (those that hold no figure), so that
+    two tables of the same rows and columns compare equal whatever their figures."""
+    rows = []
+    for line in table.strip().splitlines():
+        if not line.startswith("|"):
+            continue
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        rows.append(["#" if re.search(r"\d", c) else c for c in cells])
+    return rows
