@@ -88,6 +88,8 @@ class TestMistakes(unittest.TestCase):
                 ],
                 "the robot starts in penetration: the robot: 'r_hand'",
             ),  # fmt: skip
+            (["bench", "safety", "--doc", "README.md"], "no generated block 'safety scenes'"),
+            (["bench", "safety", "--report-only"], "--report-only needs --output"),
         ):
             with self.subTest(args):
                 code, _, err = _Call(*args)

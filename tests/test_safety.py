@@ -2,12 +2,19 @@
 that would break the guarantee refused, and saturated client pushes into a table, a ball and the
 robot itself that penetrate without the barrier and never with it, on both robots."""
 
+import contextlib
+import io
+import pathlib
 import re
+import shutil
+import tempfile
 import unittest
 
 import numpy as np
 
+from mobee_drake.experiments import bench_safety
 from mobee_drake.experiments.bench_safety import MOVERS, PRESETS, SCENES, BabblingRun, SceneRun
+from mobee_drake.experiments.doc_tables import GeneratedTable, TableLayout
 from mobee_drake.mobee.barrier import BarrierForce, BarrierParams, JointTracking, StepModel
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario
@@ -16,6 +23,7 @@ from mobee_drake.station.safety import StartsInPenetrationError
 from mobee_drake.station.world_events import MakeSimulator
 
 PARAMS = BarrierParams(rate=0.2, clearance=0.005)
+DOC = pathlib.Path(__file__).resolve().parents[1] / "docs" / "mobee.md"
 
 
 class TestBarrierForce(unittest.TestCase):
@@ -250,6 +258,41 @@ class TestSolidsPlacedInPenetration(unittest.TestCase):
         self.assertRegex(
             logs.output[0], r"a world event put solids in penetration at t = 0.1.*'ball'"
         )
+
+
+class TestSafetyTables(unittest.TestCase):
+    """docs/mobee.md's safety tables are the benchmark's: regenerated here at smoke size (pushes
+    of 0.05 and 0.1 s, 0.5 s of babbling) into a copy of the doc, they have its layout."""
+
+    def test_the_benchmark_writes_the_docs_tables(self):
+        with tempfile.TemporaryDirectory() as folder:
+            doc = pathlib.Path(folder) / "mobee.md"
+            shutil.copy(DOC, doc)
+            output = io.StringIO()
+            with contextlib.redirect_stdout(output):
+                bench_safety.main(
+                    ["--push-seconds", "0.05", "0.1", "--babbling-seconds", "0.5",
+                     "--output", f"{folder}/results", "--doc", str(doc)]
+                )  # fmt: skip
+            for name in ("safety scenes", "safety babbling"):
+                with self.subTest(name):
+                    written = GeneratedTable(doc, name)
+                    self.assertIn(written, output.getvalue())  # as printed
+                    self.assertEqual(TableLayout(written), TableLayout(GeneratedTable(DOC, name)))
+            results = bench_safety.SafetyResults.Load(
+                pathlib.Path(folder, "results", "safety.json")
+            )
+            self.assertEqual(len(results.scenes), 2 * 2 * len(SCENES) * 2 * len(MOVERS))
+            self.assertEqual(len(results.babbling), 2 * 2)
+            # The doc's tables are the results' (--report-only rewrites them from the file).
+            shutil.copy(DOC, doc)
+            with contextlib.redirect_stdout(io.StringIO()):
+                bench_safety.main(
+                    ["--report-only", "--output", f"{folder}/results", "--doc", str(doc)]
+                )
+            self.assertEqual(
+                GeneratedTable(doc, "safety scenes"), results.Tables()["safety scenes"]
+            )
 
 
 if __name__ == "__main__":

@@ -274,11 +274,12 @@ class TestSafetyMonitor(unittest.TestCase):
             for name in ("ball", "table", "thing", "arm", "chest")
         )
         query = scene_graph.get_query_output_port().Eval(scene_graph.CreateDefaultContext())
-        dut = SafetyMonitor(names=["ball", "table"], period=0.01)
+        dut = SafetyMonitor(names=["ball", "table"], period=0.01, num_joints=2)
         context = dut.CreateDefaultContext()
         dut.GetInputPort("geometry_query").FixValue(context, query)
 
-        def Step(ids, distances):
+        def Step(ids, distances, barrier=(0.0, 0.0)):
+            dut.GetInputPort("f_barrier").FixValue(context, np.array(barrier))
             k = len(ids)
             pairs = FieldPairs(
                 [arm] * k,
@@ -296,8 +297,9 @@ class TestSafetyMonitor(unittest.TestCase):
             context.SetDiscreteState(dut.EvalUniquePeriodicDiscreteUpdate(context).value())
 
         Step([ball], [0.02])
-        Step([ball, chest, thing], [0.01, -0.002, 0.025])
+        Step([ball, chest, thing], [0.01, -0.002, 0.025], barrier=(0.0, 3.0))
         Step([ball], [0.015])
+        Step([], [], barrier=(-1.0, 0.0))  # (the barrier may act on pairs beyond the fields)
         report = dut.Report(context)
         self.assertEqual(
             report.closest_approach,
@@ -305,6 +307,7 @@ class TestSafetyMonitor(unittest.TestCase):
         )
         self.assertEqual(report.penetrating_steps, 1)
         self.assertAlmostEqual(report.deepest_penetration, 0.002)
+        self.assertEqual(report.barrier_periods, 2)
 
 
 class TestKinematicRobot(unittest.TestCase):

@@ -29,6 +29,7 @@ from pydrake.systems.framework import Diagram, DiagramBuilder
 
 from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
 from mobee_drake.experiments.plots import Figure, SaveFigure, plt
+from mobee_drake.mobee.barrier import StepModel
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.icub import IcubConfig
 from mobee_drake.robots.scenario_robot import AddScenarioRobot
@@ -96,8 +97,9 @@ class PosedScene:
         return [self.plant.GetJointByName(j).position_start() for j in self.mobee.joints]
 
 
-def BuildPosedScene(robot_config, objects) -> PosedScene:
-    """The robot of ``robot_config`` among ``objects`` (SceneObjects), with MoBeE."""
+def BuildPosedScene(robot_config, objects, period: float = 0.0) -> PosedScene:
+    """The robot of ``robot_config`` among ``objects`` (SceneObjects), with MoBeE; with a
+    ``period`` (s), MoBeE's safety barrier as the kinematic robot runs it at that period."""
     builder = DiagramBuilder()
     plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
     overlay, joints = AddScenarioRobot(plant, scene_graph, robot_config)
@@ -106,7 +108,12 @@ def BuildPosedScene(robot_config, objects) -> PosedScene:
         world.Register(obj)
     plant.Finalize()
     mobee = Mobee.AddToBuilder(
-        builder, plant=plant, scene_graph=scene_graph, robot=overlay, joints=joints
+        builder,
+        plant=plant,
+        scene_graph=scene_graph,
+        robot=overlay,
+        joints=joints,
+        step=StepModel(period) if period > 0 else None,
     )
     return PosedScene(builder.Build(), plant, mobee, world, max(overlay.field_margins.values()))
 
@@ -146,12 +153,14 @@ def MeasureForceEvaluations(
     amplitude: float = 1.0,
     churn: bool = False,
     seed: int = 0,
+    period: float = 0.0,
 ) -> ForceBenchmarkResult:
     """Times ``repeats`` sweeps of ``num_poses`` total-force evaluations among boxes; with
-    ``churn``, each evaluation follows the removal of one box and the insertion of another."""
+    ``churn``, each evaluation follows the removal of one box and the insertion of another; with
+    a ``period``, MoBeE's safety barrier runs as at that period."""
     rng = np.random.default_rng(seed)
     objects = [_RandomBox(f"box{i}", robot, rng) for i in range(num_obstacles)]
-    scene = BuildPosedScene(ROBOTS[robot](), objects)
+    scene = BuildPosedScene(ROBOTS[robot](), objects, period)
     plant, mobee, world = scene.plant, scene.mobee, scene.world
     context, plant_context, mobee_context = scene.Contexts()
     boxes = [obj.name for obj in objects]
@@ -306,6 +315,13 @@ def main(argv=None) -> None:
         "--seed", type=NonNegativeInt, default=0, help="seed of the boxes and the oscillators"
     )
     parser.add_argument(
+        "--barrier-period",
+        type=float,
+        default=0.0,
+        help="with a period (s, > 0), evaluate MoBeE's safety barrier too, as the kinematic "
+        "robot runs it at that period (the poses are at rest)",
+    )
+    parser.add_argument(
         "--stages",
         action="store_true",
         help="instead, time each stage of one evaluation: " + ", ".join(STAGES),
@@ -338,6 +354,7 @@ def main(argv=None) -> None:
                 amplitude=args.amplitude,
                 churn=args.churn,
                 seed=args.seed,
+                period=args.barrier_period,
             )
             curves.setdefault(robot, []).append((n, r.best_per_second, r.median_per_second))
             print(

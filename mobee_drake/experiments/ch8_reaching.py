@@ -296,18 +296,28 @@ def RunOne(
                 success_probability=float(success.mean()) if len(updated) else None,
             )
         )
+    safety = robot.Safety()
     result = dict(
         settings=dc.asdict(settings),
         evaluations=data["evaluations"],
         log=arrays["log"].tolist(),
         simulated_seconds=robot.simulated_seconds,
         wall_seconds=data["wall_seconds"],
-        penetrating_steps=robot.PenetratingSteps(),
+        penetrating_steps=safety.penetrating_steps,
+        barrier_periods=safety.barrier_periods,
         num_transitions=learner.num_transitions,
         num_states=learner.space.num_states,
         **extra,
     )
     return result
+
+
+def _BarrierPeriods(results: list[dict]) -> str:
+    """The periods the safety barrier acted in ``results`` (n/a for runs from before it was
+    counted)."""
+    if not all("barrier_periods" in r for r in results):
+        return "n/a"
+    return str(sum(r["barrier_periods"] for r in results))
 
 
 def ReachJob(run: RunFolder, mdp: str, settings: dict) -> dict:
@@ -775,8 +785,9 @@ def _SettingReport(output: pathlib.Path, results: list[dict]) -> str:
         "",
         "| strategy | runs | robot hours (all runs) | source's robot hours (5 runs of 6400) "
         "| actions per problem-try | failed transitions per problem-try | timed-out "
-        "problem-tries | wall hours (all runs) | penetrating control periods |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "problem-tries | wall hours (all runs) | penetrating control periods | periods the "
+        "safety barrier acted |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for strategy in strategies:
         actions, failed, timeouts, tries = 0, 0, 0, 0
@@ -792,7 +803,8 @@ def _SettingReport(output: pathlib.Path, results: list[dict]) -> str:
             f"| {strategy} | {len(by_strategy[strategy])} | {hours:.1f} | "
             f"{SOURCE_HOURS.get(strategy, '-')} | {actions / tries:.2f} | {failed / tries:.2f} | "
             f"{timeouts} | {sum(r['wall_seconds'] for r in by_strategy[strategy]) / 3600:.2f} | "
-            f"{sum(r['penetrating_steps'] for r in by_strategy[strategy])} |"
+            f"{sum(r['penetrating_steps'] for r in by_strategy[strategy])} | "
+            f"{_BarrierPeriods(by_strategy[strategy])} |"
         )
 
     if all("mdp" in r for r in results):

@@ -44,13 +44,18 @@ def WriteGeneratedTable(doc: str | pathlib.Path, name: str, command: str, table:
     WriteTextAtomically(doc, block.sub(lambda _: replacement, text, count=1))
 
 
+# What a table shows where a figure is missing (never measured, not applicable).
+_NO_FIGURE = ("-", "n/a")
+
+
 def TableLayout(table: str) -> list[list[str]]:
-    """A markdown table's layout: per row its label cells (those that hold no figure), so that
-    two tables of the same rows and columns compare equal whatever their figures."""
+    """A markdown table's layout: per row its label cells (those that hold no figure nor stand
+    for a missing one), so that two tables of the same rows and columns compare equal whatever
+    their figures."""
     rows = []
     for line in table.strip().splitlines():
         if not line.startswith("|"):
             continue
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        rows.append(["#" if re.search(r"\d", c) else c for c in cells])
+        rows.append(["#" if re.search(r"\d", c) or c in _NO_FIGURE else c for c in cells])
     return rows

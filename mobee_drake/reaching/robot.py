@@ -17,6 +17,7 @@ from mobee_drake.reaching.targets import TARGET_NAME, TargetObject
 from mobee_drake.station.builder import Station
 from mobee_drake.station.checkpoint import ReadCheckpointFiles, WriteCheckpointFiles
 from mobee_drake.station.executor import StateActionExecutor
+from mobee_drake.station.safety import SafetyReport
 from mobee_drake.station.world_events import MakeSimulator
 
 
@@ -140,6 +141,7 @@ class SimulatedRobot:
         ReadCheckpointFiles(self.station, self.context, folder)
         self.simulator.Initialize(InitializeParams(suppress_initialization_events=True))
 
-    def PenetratingSteps(self) -> int:
+    def Safety(self) -> SafetyReport:
+        """The station's safety monitor so far (penetrations, the barrier's periods)."""
         monitor = self.station.monitor
-        return monitor.Report(monitor.GetMyContextFromRoot(self.context)).penetrating_steps
+        return monitor.Report(monitor.GetMyContextFromRoot(self.context))

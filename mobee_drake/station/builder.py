@@ -366,8 +366,10 @@ def MakeMobeeStation(
     builder.Connect(robot_state, mobee.GetInputPort("state"))
 
     monitor = builder.AddNamedSystem(
-        "safety_monitor", SafetyMonitor(names=world.names, period=config.time_step)
+        "safety_monitor",
+        SafetyMonitor(names=world.names, period=config.time_step, num_joints=len(mobee.joints)),
     )
+    builder.Connect(mobee.GetOutputPort("f_barrier"), monitor.GetInputPort("f_barrier"))
     builder.Connect(mobee.GetOutputPort("field_pairs"), monitor.GetInputPort("field_pairs"))
     builder.Connect(scene_graph.get_query_output_port(), monitor.GetInputPort("geometry_query"))
 

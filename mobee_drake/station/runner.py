@@ -57,7 +57,8 @@ class RunSummary:
             lines.append(f"  {name:20s} {'-' if distance is None else f'{distance:+.4f}'}")
         lines.append(
             f"penetrations of solid geometry: {self.safety.penetrating_steps} control "
-            f"periods, deepest {1000 * self.safety.deepest_penetration:.2f} mm"
+            f"periods, deepest {1000 * self.safety.deepest_penetration:.2f} mm; the safety "
+            f"barrier acted in {self.safety.barrier_periods}"
         )
         for group, figures in self.outcome.items():
             lines.append(f"outcome, {group}:")

@@ -24,10 +24,13 @@ class SafetyReport:
     # Control periods in which some solid pair penetrated, and the deepest penetration (m, >= 0).
     penetrating_steps: int
     deepest_penetration: float
+    # Control periods in which MoBeE's safety barrier changed the total force (f_barrier != 0).
+    barrier_periods: int = 0
 
 
 class SafetyMonitor(LeafSystem):
-    """Reads MoBeE's field pairs every ``period`` and keeps the worst case in its state.
+    """Reads MoBeE's field pairs and safety barrier every ``period`` and keeps the worst case in
+    its state.
 
     .. pydrake_system::
 
@@ -35,13 +38,16 @@ class SafetyMonitor(LeafSystem):
         input_ports:
         - field_pairs
         - geometry_query
+        - f_barrier
 
     State: per watched object (by its geometry's name, so it survives the live world's changes)
     the closest distance seen (inf until inside a field), the same for the robot's own pairs and
-    for objects added later, the number of periods with a penetration, and the deepest one.
+    for objects added later, the number of periods with a penetration, the deepest one, and the
+    number of periods in which the barrier acted (``f_barrier``, n: MoBeE's port; unconnected,
+    none).
     """
 
-    def __init__(self, *, names: list[str], period: float):
+    def __init__(self, *, names: list[str], period: float, num_joints: int):
         super().__init__()
         self._names = list(names) + [SELF, OTHERS]
         self._index = {name: i for i, name in enumerate(names)}
@@ -52,7 +58,8 @@ class SafetyMonitor(LeafSystem):
         self._query_port = self.DeclareAbstractInputPort(
             "geometry_query", AbstractValue.Make(QueryObject())
         )
-        initial = np.concatenate([np.full(len(self._names), np.inf), [0.0, 0.0]])
+        self._barrier_port = self.DeclareVectorInputPort("f_barrier", num_joints)
+        initial = np.concatenate([np.full(len(self._names), np.inf), [0.0, 0.0, 0.0]])
         self._state = self.DeclareDiscreteState(BasicVector(initial))
         self.DeclarePeriodicDiscreteUpdateEvent(
             period_sec=period, offset_sec=0.0, update=self._Update
@@ -60,10 +67,15 @@ class SafetyMonitor(LeafSystem):
 
     def _Update(self, context, discrete_state) -> None:
         pairs = self._pairs_port.Eval(context)
-        if not len(pairs):
-            return  # Nothing inside a field: the state (which Drake passes in) stays as it is.
-        x = context.get_discrete_state(self._state).value().copy()
         n = len(self._names)
+        barrier = self._barrier_port.HasValue(context) and self._barrier_port.Eval(context).any()
+        if not (len(pairs) or barrier):
+            return  # Nothing to record: the state (which Drake passes in) stays as it is.
+        x = context.get_discrete_state(self._state).value().copy()
+        x[n + 2] += barrier
+        if not len(pairs):
+            discrete_state.get_mutable_vector(self._state).SetFromVector(x)
+            return
         inspector = self._query_port.Eval(context).inspector()
         for geometry_id, distance, robot in zip(pairs.geometry_B, pairs.distance, pairs.b_is_robot):
             i = (
@@ -88,6 +100,7 @@ class SafetyMonitor(LeafSystem):
             },
             penetrating_steps=int(x[n]),
             deepest_penetration=float(x[n + 1]),
+            barrier_periods=int(x[n + 2]),
         )
 
 
