@@ -596,6 +596,14 @@ def Fingerprints(run: dict) -> dict:
     )
 
 
+def _CompareToZero(values) -> str:
+    """:func:`CompareToZero` of run values as report text (nan values dropped)."""
+    values = [v for v in values if not math.isnan(v)]
+    if len(values) < 2:
+        return f"n/a ({len(values)} run; at least 2)"
+    return CompareToZero(values).Text()
+
+
 def _Compare(a, b) -> str:
     """:func:`CompareRuns` of two lists of run values as report text (nan values dropped)."""
     a, b = [v for v in a if not math.isnan(v)], [v for v in b if not math.isnan(v)]
@@ -895,7 +903,7 @@ def _SettingReport(output: pathlib.Path, results: list[dict]) -> str:
                 lines.append(
                     f"- {title}, change per doubling of the problem-tries (per run, the slope of "
                     f"its stage means over log2 of {trended[0]}...{trended[-1]}): intrinsic "
-                    + CompareToZero(trends["intrinsic"]).Text()
+                    + _CompareToZero(trends["intrinsic"])
                     + "; intrinsic minus "
                     + _IntrinsicMinusOthers(trends)
                 )

@@ -179,6 +179,6 @@ def BarrierForce(
     residual = E @ weights - f
     if residual[-1] < -1e-12:
         u = -residual[:-1] / residual[-1]
-    else:  # Infeasible: meet the barriers in the least-squares sense.
-        u = np.linalg.lstsq(G, r, rcond=None)[0]
+    else:  # Infeasible: meet the barriers in the least-squares sense (normal equations: n x n).
+        u = np.linalg.lstsq(G.T @ G, G.T @ r, rcond=None)[0]
     return u * root_mass

@@ -513,17 +513,17 @@ class Mobee(LeafSystem):
         rows, gaps = self._BarrierRows(context, pairs, normals, offset + gain * total)
         if rows is not None:
             change = BarrierForce(rows, gaps, offset, total, self._mass, gain, params)
-        # How far each solid may move (the largest lever of any of its points, any posture).
+        # How far each solid may move (the largest lever of any of its points, any posture);
+        # two solids close by at most the two largest together.
         reach = self._support.Lookahead(np.abs(offset + gain * (total + change)))
-        if params.clearance + 2 * reach.max() <= self._fields.min_margin:
+        farthest = np.sort(reach)[-2:].sum() if len(reach) > 1 else reach.sum()
+        if params.clearance + farthest <= self._fields.min_margin:
             return change  # No solid can cross its field in the period.
-        query = self._query_port.Eval(context)
-        far = self._fields.FindApproaching(query, reach, params.clearance)
+        far = self._fields.FindApproaching(self._query_port.Eval(context), reach, params.clearance)
         if not len(far):
             return change
-        far_rows, far_gaps = self._BarrierRows(
-            context, far, self._FieldNormals(context, far), offset + gain * (total + change)
-        )
+        # Their witness points only: a turn is caught by the support points once in the field.
+        far_rows, far_gaps = self._FieldNormals(context, far), far.distance
         if rows is not None:
             far_rows, far_gaps = np.vstack([rows, far_rows]), np.concatenate([gaps, far_gaps])
         return BarrierForce(far_rows, far_gaps, offset, total, self._mass, gain, params)
