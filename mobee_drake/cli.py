@@ -4,7 +4,9 @@ import argparse
 import importlib
 import logging
 import pathlib
+import signal
 import sys
+import threading
 
 import numpy as np
 from pydrake.geometry import StartMeshcat
@@ -225,6 +227,10 @@ def _Info(args: list[str]) -> None:
 COMMANDS = {"bench": _Bench, "experiment": _Experiment, "info": _Info, "run": _Run}
 
 
+def _Terminated(signum, frame):
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> None:
     argv = sys.argv[1:] if argv is None else argv
     parser = CommandParser(
@@ -240,6 +246,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("command", choices=sorted(COMMANDS), help="what to do")
     parser.add_argument("args", nargs=argparse.REMAINDER, help="the command's own arguments")
     known = parser.parse_args(argv)
+    if threading.current_thread() is threading.main_thread():  # (signals reach only it)
+        signal.signal(signal.SIGTERM, _Terminated)  # one line and exit code 130, as Ctrl-C
     global _debug
     _debug = known.debug
     level = logging.DEBUG if known.verbose else logging.WARNING if known.quiet else logging.INFO

@@ -15,7 +15,7 @@ import os
 import pathlib
 import tempfile
 
-from mobee_drake.atomic_files import StrictJson
+from mobee_drake.atomic_files import StrictJson, WriteTextAtomically
 
 MARKER = ".mobee-drake"
 _LOCK = ".mobee-drake.lock"
@@ -35,13 +35,21 @@ def ClaimFolder(folder: str | pathlib.Path, kind: str) -> pathlib.Path:
         try:
             found = json.loads(marker.read_text())["kind"]
         except (OSError, ValueError, KeyError, TypeError):
-            raise FolderError(f"{marker}: not a marker that mobee-drake wrote") from None
+            raise FolderError(
+                f"{marker}: not a marker that mobee-drake wrote (empty or damaged); if "
+                f"{folder} holds only a run of yours, delete {marker} to claim it again"
+            ) from None
         if found != kind:
             raise FolderError(f"{folder}: holds a {found}, not a {kind}")
         return folder
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        others = [p.name for p in folder.iterdir() if p.name != _LOCK]
+        # (A staging file of the marker is a claim that a kill interrupted.)
+        others = [
+            p.name
+            for p in folder.iterdir()
+            if p.name != _LOCK and not (p.name.startswith(f"{MARKER}.") and p.name.endswith(".tmp"))
+        ]
     except OSError as error:
         raise FolderError(f"{folder}: cannot be used: {error.strerror}") from None
     if others:
@@ -51,7 +59,7 @@ def ClaimFolder(folder: str | pathlib.Path, kind: str) -> pathlib.Path:
             "choose an empty or new folder"
         )
     try:
-        marker.write_text(StrictJson({"kind": kind}))
+        WriteTextAtomically(marker, StrictJson({"kind": kind}))  # never a half-written marker
     except OSError as error:
         raise FolderError(f"{folder}: cannot be written: {error.strerror}") from None
     return folder

@@ -54,11 +54,22 @@ class Scenario(StationConfig):
     simulator_config: SimulatorConfig = dc.field(default_factory=SimulatorConfig)
 
 
+# The slowest real-time rate a run may ask for (a simulated second in 100 s; slower runs would
+# go for days without a line of output).
+MIN_REALTIME_RATE = 0.01
+
+
 def ScenarioErrors(scenario: Scenario) -> list[str]:
     """What is wrong with ``scenario`` that its types cannot say (empty: nothing)."""
     errors = StationConfigErrors(scenario)
     if not (math.isfinite(scenario.duration) and 0 < scenario.duration <= MAX_DURATION):
         errors.append(f"duration must be > 0 and <= {MAX_DURATION:g} s, got {scenario.duration}")
+    rate = scenario.simulator_config.target_realtime_rate
+    if not (rate == 0 or (math.isfinite(rate) and rate >= MIN_REALTIME_RATE)):
+        errors.append(
+            f"simulator_config target_realtime_rate must be 0 (as fast as it goes) or >= "
+            f"{MIN_REALTIME_RATE:g}, got {rate}"
+        )
     try:
         scenario.attractor.Validate()
     except ValueError as e:

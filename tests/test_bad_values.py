@@ -113,6 +113,18 @@ class TestFixedRegressions(unittest.TestCase):
         "{attractor: !ExploreAttractor {agents: [{name: a, joints: []}]}}": "needs joints",
         "{attractor: !ExploreAttractor {agents: [{name: a, joints: [r_elbow]}, "
         "{name: a, joints: [l_elbow]}]}}": "unique",
+        # Issue 31, item 9: no run that would go for days without a line.
+        "{time_step: 1e-9}": "time_step must be >= 0.0001",
+        "{mover: !Dynamic {plant_config: {time_step: 1e-9}}}": "plant_config time_step must be",
+        "{simulator_config: {target_realtime_rate: 1e-6}}": "target_realtime_rate must be 0",
+        "{simulator_config: {target_realtime_rate: -1}}": "target_realtime_rate must be 0",
+        # Issue 31, item 3: a name is a file name in checkpoints, never a path.
+        "{attractor: !ExploreAttractor {agents: [{name: ../../x, joints: [r_elbow]}]}}": (
+            "exploring agent name '../../x': use letters"
+        ),
+        "{attractor: !ExploreAttractor {agents: [{name: a/b, joints: [r_elbow]}]}}": (
+            "exploring agent name 'a/b'"
+        ),
     }
 
     def test_each_ends_in_our_error_naming_the_override(self):

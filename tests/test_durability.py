@@ -115,6 +115,21 @@ class TestOwnedFolders(TemporaryFolder):
         with self.assertRaisesRegex(FolderError, "holds a checkpoint, not a battery"):
             ClaimFolder(self.folder / "empty", "battery")
 
+    def test_a_claim_a_kill_interrupted_is_no_obstacle_and_a_damaged_marker_says_its_fix(self):
+        """Issue 31, item 4: the marker is written through a staging file, which a kill may
+        leave behind (the claim then simply happens again); a marker that is not ours (empty,
+        damaged) is refused with the way out."""
+        folder = self.folder / "run"
+        folder.mkdir()
+        (folder / ".mobee-drake.abc123.tmp").write_text("")  # a claim killed mid-write
+        ClaimFolder(folder, "checkpoint")
+        self.assertEqual(json.loads((folder / ".mobee-drake").read_text()), {"kind": "checkpoint"})
+        (folder / ".mobee-drake").write_text("")
+        with self.assertRaisesRegex(
+            FolderError, r"not a marker that mobee-drake wrote \(empty or damaged\); .*delete"
+        ):
+            ClaimFolder(folder, "checkpoint")
+
     def test_one_writer_at_a_time(self):
         with OwnedFolder(self.folder / "run", "checkpoint"):
             with self.assertRaisesRegex(FolderError, "in use by another run"):
@@ -169,6 +184,20 @@ class TestBatteryArguments(TemporaryFolder):
             RunBattery(jobs, self.folder, progress=False)
 
 
+class TestCommandsClaimTheirFolders(TemporaryFolder):
+    def test_trm_never_writes_into_a_users_folder(self):
+        """Issue 31, item 1: ``experiment trm --output`` replaced a user's report.md."""
+        report = self.folder / "report.md"
+        report.write_text("my report")
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err), self.assertRaises(SystemExit) as exit_:
+            cli.main(["experiment", "trm", "--output", str(self.folder), "--max-vertices", "5"])
+        self.assertEqual(exit_.exception.code, 2)
+        self.assertRegex(err.getvalue(), r"^error: .*not empty and not a mobee-drake trm roadmaps")
+        self.assertEqual(report.read_text(), "my report")
+        self.assertEqual(sorted(p.name for p in self.folder.iterdir()), ["report.md"])
+
+
 class TestExplorationCheckpoints(TemporaryFolder):
     """An exploration (the ch. 8 MDP's training, ch. 7.4.1's) interrupted after a checkpoint
     resumes to the model an uninterrupted one learns."""
@@ -219,6 +248,28 @@ class TestInterrupts(TemporaryFolder):
         battery.send_signal(signal.SIGINT)
         _, err = battery.communicate(timeout=60)
         self.assertEqual(battery.returncode, 130)
+        self.assertEqual(
+            err.strip().splitlines()[-1],
+            "interrupted: run the same command again to go on from the last checkpoints",
+        )
+        self.assertNotIn("Traceback", err)
+
+    def test_sigterm_on_a_run_ends_in_one_line_and_code_130(self):
+        """Issue 31, item 7: ``run`` ended silently with -15."""
+        run = subprocess.Popen(
+            [sys.executable, "-m", "mobee_drake.cli", "run", "reach_around_ball", "--duration",
+             "1000", "--no-meshcat", "--no-log", "--checkpoint", "run"],
+            stderr=subprocess.PIPE,
+            text=True,
+            cwd=self.folder,
+        )  # fmt: skip
+        self.addCleanup(run.kill)
+        deadline = time.monotonic() + 60
+        while not (self.folder / "run" / ".mobee-drake").exists() and time.monotonic() < deadline:
+            time.sleep(0.1)  # until the run has claimed its folder: it is under way
+        run.send_signal(signal.SIGTERM)
+        _, err = run.communicate(timeout=60)
+        self.assertEqual(run.returncode, 130)
         self.assertEqual(
             err.strip().splitlines()[-1],
             "interrupted: run the same command again to go on from the last checkpoints",

@@ -38,8 +38,8 @@ parent keeps submitted):
   only the parent. The parent then stops the queue, asks the running jobs to stop (SIGUSR1:
   :func:`StopRequested` turns True, and a job that checkpoints saves and stops at its next safe
   point), waits for them up to :data:`STOP_SECONDS`, kills the workers and re-raises. During a
-  battery, SIGTERM raises :class:`SystemExit` in the parent (as SIGINT raises
-  :class:`KeyboardInterrupt`), so the same clean-up runs; after a SIGKILL of the parent the kernel
+  battery, SIGTERM raises :class:`KeyboardInterrupt` in the parent as SIGINT does, so the same
+  clean-up runs; after a SIGKILL of the parent the kernel
   kills the workers (processes that a job starts itself are the job's to tie to its own life). A
   worker that dies (say, at the hands of the OOM killer) breaks the pool: the battery stops with
   :class:`BatteryError`, and running it again resumes.
@@ -380,12 +380,12 @@ Backend = InProcess | LocalProcesses | Ray
 
 
 def _Terminate(signum, frame):
-    raise SystemExit(128 + signum)
+    raise KeyboardInterrupt  # (the command line's one line and exit code 130, as for Ctrl-C)
 
 
 @contextlib.contextmanager
 def _TerminationRaises():
-    """SIGTERM raises SystemExit in the main thread while the context lasts."""
+    """SIGTERM raises KeyboardInterrupt in the main thread while the context lasts."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return

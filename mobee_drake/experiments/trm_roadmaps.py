@@ -14,8 +14,10 @@ import pathlib
 
 import numpy as np
 
+from mobee_drake.atomic_files import WriteTextAtomically
 from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
 from mobee_drake.experiments.plots import Figure, SaveFigure, plt
+from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.station.viewer import RecordingMeshcat
 from mobee_drake.trm.display import MarkerCloud, PathMotion, RecordMotion, ShowRoadmap
 from mobee_drake.trm.examples import EXAMPLES, OpenBox, TrmExample
@@ -142,11 +144,12 @@ def main(argv: list[str] | None = None) -> None:
     )
     args = parser.parse_args(argv)
     output = pathlib.Path(args.output)
-    output.mkdir(parents=True, exist_ok=True)
     config = TrmConfig(max_vertices=args.max_vertices)
-    sections = [RunExample(name, output, config, args.seed) for name in args.examples]
-    report = "# Task-relevant roadmaps\n\n" + "\n".join(sections)
-    (output / "report.md").write_text(report)
+    # (Claimed like every folder a command writes: never a user's, one writer at a time.)
+    with OwnedFolder(output, "trm roadmaps"):
+        sections = [RunExample(name, output, config, args.seed) for name in args.examples]
+        report = "# Task-relevant roadmaps\n\n" + "\n".join(sections)
+        WriteTextAtomically(output / "report.md", report)
     print(report)
 
 

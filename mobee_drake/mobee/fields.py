@@ -123,7 +123,8 @@ class RobotFields:
         def Approaching(d, margin, a, b) -> bool:
             return margin <= d < gap + (reach[a[0]] if a else 0.0) + (reach[b[0]] if b else 0.0)
 
-        return self._Pairs(query, gap + 2 * reach.max(), Approaching)
+        farthest = np.sort(reach)[-2:].sum()  # two solids close by at most this together
+        return self._Pairs(query, gap + farthest, Approaching)
 
     def _Pairs(self, query: QueryObject, max_distance: float, keep) -> FieldPairs:
         """The pairs with a robot geometry closer than ``max_distance`` that ``keep(distance,

@@ -516,8 +516,7 @@ class Mobee(LeafSystem):
         # How far each solid may move (the largest lever of any of its points, any posture);
         # two solids close by at most the two largest together.
         reach = self._support.Lookahead(np.abs(offset + gain * (total + change)))
-        farthest = np.sort(reach)[-2:].sum() if len(reach) > 1 else reach.sum()
-        if params.clearance + farthest <= self._fields.min_margin:
+        if params.clearance + np.sort(reach)[-2:].sum() <= self._fields.min_margin:
             return change  # No solid can cross its field in the period.
         far = self._fields.FindApproaching(self._query_port.Eval(context), reach, params.clearance)
         if not len(far):

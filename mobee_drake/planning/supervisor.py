@@ -18,6 +18,7 @@ of a model.
 import dataclasses as dc
 import json
 import pathlib
+import re
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -366,6 +367,10 @@ def RoadmapStateSpace(
     return FromGraph(centres, roadmap.edges)
 
 
+# An agent's name: its model's file name in a checkpoint (``<name>.npz``), so no path in it.
+AGENT_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]*")
+
+
 @dc.dataclass
 class ExploringAgent:
     """A curious agent on some joints (dissertation ch. 6-7), its states a hyper-lattice."""
@@ -399,6 +404,12 @@ class ExploreAttractor:
             raise ValueError("exploring agents: there is none")
         if len(set(names)) != len(names) or not all(names):
             raise ValueError(f"exploring agents need unique, non-empty names, got {names}")
+        for name in names:  # (a name is the file name of the agent's model in checkpoints)
+            if not AGENT_NAME.fullmatch(name):
+                raise ValueError(
+                    f"exploring agent name '{name}': use letters, digits, '_' and '-' only "
+                    "(it names the agent's files), starting with a letter or digit"
+                )
         for agent in self.agents:
             where = f"exploring agent '{agent.name}'"
             if not agent.joints or len(set(agent.joints)) != len(agent.joints):

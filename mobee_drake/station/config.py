@@ -29,6 +29,10 @@ CONTROL_MODALITIES = ("position", "velocity", "force")
 # The longest period MoBeE may run at (s; our choice: the original ran at 20 ms, and at 0.1 s a
 # hand at 1 m/s already moves 10 cm, more than MoBeE's fields, between two reactions).
 MAX_TIME_STEP = 0.1
+# The shortest periods (s): MoBeE's, and the simulated plant's (shorter ones only make a run take
+# days without a line of output: 1e-9 s is 10^9 periods a simulated second).
+MIN_TIME_STEP = 1e-4
+MIN_PLANT_TIME_STEP = 1e-5
 
 
 def _Finite(values) -> bool:
@@ -161,8 +165,11 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
                 f"mover control must be one of {CONTROL_MODALITIES}, got '{mover.control}'"
             )
         step = mover.plant_config.time_step
-        if not (math.isfinite(step) and 0 < step <= config.time_step):
-            errors.append(f"plant_config time_step must be > 0 and <= time_step, got {step}")
+        if not (math.isfinite(step) and MIN_PLANT_TIME_STEP <= step <= config.time_step):
+            errors.append(
+                f"plant_config time_step must be >= {MIN_PLANT_TIME_STEP:g} s and <= time_step, "
+                f"got {step}"
+            )
     if isinstance(mover, Reflex) and not (
         _Finite([mover.speed_deg, mover.tolerance_deg])
         and mover.speed_deg > 0
@@ -170,8 +177,11 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
         and mover.tolerance_deg > 0
     ):
         errors.append("reflex: speed_deg and tolerance_deg must be finite and > 0, history >= 2")
-    if not (math.isfinite(config.time_step) and 0 < config.time_step <= MAX_TIME_STEP):
-        errors.append(f"time_step must be > 0 and <= {MAX_TIME_STEP} s, got {config.time_step}")
+    if not (math.isfinite(config.time_step) and MIN_TIME_STEP <= config.time_step <= MAX_TIME_STEP):
+        errors.append(
+            f"time_step must be >= {MIN_TIME_STEP:g} and <= {MAX_TIME_STEP} s, "
+            f"got {config.time_step}"
+        )
     shown, log = config.visualization, config.data_log
     if not (math.isfinite(shown.frame_rate) and shown.frame_rate > 0):
         errors.append(f"visualization frame_rate must be > 0, got {shown.frame_rate}")
