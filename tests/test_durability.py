@@ -245,14 +245,7 @@ class TestInterrupts(TemporaryFolder):
         deadline = time.monotonic() + 60
         while not list(output.glob("runs/*/progress.json")) and time.monotonic() < deadline:
             time.sleep(0.2)
-        battery.send_signal(signal.SIGINT)
-        _, err = battery.communicate(timeout=60)
-        self.assertEqual(battery.returncode, 130)
-        self.assertEqual(
-            err.strip().splitlines()[-1],
-            "interrupted: run the same command again to go on from the last checkpoints",
-        )
-        self.assertNotIn("Traceback", err)
+        self.AssertInterruptedInOneLine(battery, signal.SIGINT)
 
     def test_sigterm_on_a_run_ends_in_one_line_and_code_130(self):
         """Issue 31, item 7: ``run`` ended silently with -15."""
@@ -267,9 +260,13 @@ class TestInterrupts(TemporaryFolder):
         deadline = time.monotonic() + 60
         while not (self.folder / "run" / ".mobee-drake").exists() and time.monotonic() < deadline:
             time.sleep(0.1)  # until the run has claimed its folder: it is under way
-        run.send_signal(signal.SIGTERM)
-        _, err = run.communicate(timeout=60)
-        self.assertEqual(run.returncode, 130)
+        self.AssertInterruptedInOneLine(run, signal.SIGTERM)
+
+    def AssertInterruptedInOneLine(self, process: subprocess.Popen, signum: int) -> None:
+        """``signum`` ends ``process`` (a command) with one line and exit code 130."""
+        process.send_signal(signum)
+        _, err = process.communicate(timeout=60)
+        self.assertEqual(process.returncode, 130)
         self.assertEqual(
             err.strip().splitlines()[-1],
             "interrupted: run the same command again to go on from the last checkpoints",
