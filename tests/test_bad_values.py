@@ -113,6 +113,21 @@ class TestFixedRegressions(unittest.TestCase):
         "{attractor: !ExploreAttractor {agents: [{name: a, joints: []}]}}": "needs joints",
         "{attractor: !ExploreAttractor {agents: [{name: a, joints: [r_elbow]}, "
         "{name: a, joints: [l_elbow]}]}}": "unique",
+        # Issue 31, item 6: explorer settings that would run a meaningless experiment.
+        "{attractor: !ExploreAttractor {agents: [{name: a, joints: [r_elbow], levels: [0.5]}]}}": (
+            "levels need at least two different values"
+        ),
+        "{attractor: !ExploreAttractor {agents: [{name: a, joints: [r_elbow], "
+        "levels: [0.5, 0.5]}]}}": "levels need at least two different values",
+        "{attractor: !ExploreAttractor {agents: [{name: a, joints: [r_elbow], nearest: 1000}]}}": (
+            "nearest must be >= 0 and less than the 2 states"
+        ),
+        "{attractor: !ExploreAttractor {agents: [{name: a, joints: [r_elbow], "
+        "explorer: {delta: -1}}]}}": "explorer delta must be > 0",
+        "{attractor: !ExploreAttractor {agents: [{name: a, joints: [r_elbow], "
+        "explorer: {delta: .nan}}]}}": "explorer delta must be > 0",
+        "{attractor: !ExploreAttractor {agents: [{name: a, joints: [r_elbow], "
+        "explorer: {strategy: bold}}]}}": "explorer strategy must be one of",
         # Issue 31, item 9: no run that would go for days without a line.
         "{time_step: 1e-9}": "time_step must be >= 0.0001",
         "{mover: !Dynamic {plant_config: {time_step: 1e-9}}}": "plant_config time_step must be",

@@ -79,6 +79,14 @@ class TestStateActionSpaces(unittest.TestCase):
         for space, states, state_actions in cases:
             self.assertEqual((space.num_states, space.num_state_actions), (states, state_actions))
 
+    def test_a_centre_at_a_limit_is_on_it(self):
+        """Issue 31, item 6: ``levels: [0, 1]`` put a centre a rounding error past a limit
+        (lower + 1 * (upper - lower) > upper for these two), and MoBeE refused the attractor."""
+        lower, upper = np.array([-2.877079428191416]), np.array([1.668729436108269])
+        space = Lattice([0.0, 1.0], 1)
+        centres = [space.Centre(s, lower, upper)[0] for s in range(space.num_states)]
+        self.assertEqual(sorted(centres), [lower[0], upper[0]])
+
     def test_equidistant_neighbours_of_the_rank_3_lattice(self):
         space = Lattice([0.25, 0.5, 0.75], 4)
         counts = np.bincount(space.action_state)
@@ -177,9 +185,9 @@ class TestExplorers(unittest.TestCase):
 
     def test_bad_configuration(self):
         space = Lattice([0.25, 0.75], 2)
-        with self.assertRaisesRegex(ValueError, "unknown strategy 'bold'"):
+        with self.assertRaisesRegex(ValueError, "strategy must be one of .*, got 'bold'"):
             Explorer(space, ExplorerConfig(strategy="bold"))
-        with self.assertRaisesRegex(ValueError, "unknown initialization '70-30'"):
+        with self.assertRaisesRegex(ValueError, "initialization must be .*, got '70-30'"):
             Explorer(space, ExplorerConfig(initialization="70-30"))
 
 

@@ -14,6 +14,7 @@ too, so a run is reproducible from its seed.
 import copy
 import dataclasses as dc
 import json
+import math
 import pathlib
 
 import numpy as np
@@ -37,6 +38,22 @@ class ExplorerConfig:
     # The state the "planner" strategy heads for.
     goal_state: int = -1
 
+    def Errors(self) -> list[str]:
+        """What is wrong with the settings that their types cannot say (empty: nothing)."""
+        errors = []
+        if self.strategy not in STRATEGIES:
+            errors.append(f"strategy must be one of {', '.join(STRATEGIES)}, got '{self.strategy}'")
+        if self.initialization not in INITIALIZATIONS:
+            errors.append(
+                f"initialization must be {' or '.join(INITIALIZATIONS)}, got "
+                f"'{self.initialization}'"
+            )
+        if not (math.isfinite(self.gamma) and 0 <= self.gamma < 1):
+            errors.append(f"gamma must be in [0, 1), got {self.gamma}")
+        if not (math.isfinite(self.delta) and self.delta > 0):
+            errors.append(f"delta must be > 0, got {self.delta}")
+        return errors
+
 
 class Explorer:
     """One agent exploring one state-action space, its generator seeded with ``seed``."""
@@ -45,19 +62,12 @@ class Explorer:
         self, space: StateActionSpace, config: ExplorerConfig | None = None, seed: int = 0
     ):
         config = config or ExplorerConfig()
-        if config.strategy not in STRATEGIES:
-            raise ValueError(
-                f"unknown strategy '{config.strategy}'; strategies are " + ", ".join(STRATEGIES)
-            )
+        for error in config.Errors():
+            raise ValueError(error)
         if config.strategy == "planner" and not 0 <= config.goal_state < space.num_states:
             raise ValueError(
                 f"the planner needs a goal_state in 0..{space.num_states - 1}, "
                 f"got {config.goal_state}"
-            )
-        if config.initialization not in INITIALIZATIONS:
-            raise ValueError(
-                f"unknown initialization '{config.initialization}'; use "
-                + " or ".join(INITIALIZATIONS)
             )
         self.space, self.config = space, config
         self.rng = np.random.default_rng(seed)

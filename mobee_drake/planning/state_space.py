@@ -50,8 +50,9 @@ class StateActionSpace:
         return self.StateOf((q - lower) / (upper - lower))
 
     def Centre(self, state: int, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
-        """A state's centre as joint positions (rad) of joints with limits ``lower``, ``upper``."""
-        return lower + self.centres[state] * (upper - lower)
+        """A state's centre as joint positions (rad) of joints with limits ``lower``, ``upper``
+        (a centre at a limit lands on it, not a rounding error beyond it)."""
+        return np.clip(lower + self.centres[state] * (upper - lower), lower, upper)
 
     @property
     def _tree(self) -> cKDTree:

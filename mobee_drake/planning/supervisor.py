@@ -421,8 +421,19 @@ class ExploreAttractor:
                     f"{where}: levels must be fractions of each joint's range in [0, 1], "
                     f"got {agent.levels}"
                 )
-            if agent.nearest < 0:
-                raise ValueError(f"{where}: nearest must be >= 0, got {agent.nearest}")
+            if not agent.roadmap and len(set(agent.levels)) < 2:
+                raise ValueError(
+                    f"{where}: levels need at least two different values (one state is no "
+                    f"space to explore), got {agent.levels}"
+                )
+            states = len(set(agent.levels)) ** len(agent.joints)
+            if agent.nearest < 0 or (not agent.roadmap and agent.nearest >= states):
+                raise ValueError(
+                    f"{where}: nearest must be >= 0 and less than the {states} states, "
+                    f"got {agent.nearest}"
+                )
+            for error in agent.explorer.Errors():
+                raise ValueError(f"{where}: explorer {error}")
 
     def AddToBuilder(self, parts: StationParts) -> ClientPorts:
         mobee = parts.mobee
