@@ -197,6 +197,26 @@ class TestCommandsClaimTheirFolders(TemporaryFolder):
         self.assertEqual(report.read_text(), "my report")
         self.assertEqual(sorted(p.name for p in self.folder.iterdir()), ["report.md"])
 
+    def test_saggriac_analyses_only_its_own_battery(self):
+        """Issue 31, item 1: ``saggriac --analyse-only`` replaced a user's report.md, and would
+        have replaced another battery's (a ch. 8 battery's folder carries the same marker)."""
+        report = self.folder / "report.md"
+        report.write_text("my report")
+        other = self.folder / "ch8"
+        ClaimFolder(other, "battery")
+        (other / "report.md").write_text("the ch. 8 report")
+        for output, message in ((self.folder, "not empty and not a mobee-drake battery"),
+                                (other, "holds no SAGG-RIAC run of these arguments")):  # fmt: skip
+            with self.subTest(output.name):
+                err = io.StringIO()
+                with contextlib.redirect_stderr(err), self.assertRaises(SystemExit) as exit_:
+                    cli.main(["experiment", "saggriac", "--analyse-only", "--output", str(output)])
+                self.assertEqual(exit_.exception.code, 2)
+                self.assertIn(message, err.getvalue())
+                self.assertEqual(len(err.getvalue().strip().splitlines()), 1)
+        self.assertEqual(report.read_text(), "my report")
+        self.assertEqual((other / "report.md").read_text(), "the ch. 8 report")
+
 
 class TestExplorationCheckpoints(TemporaryFolder):
     """An exploration (the ch. 8 MDP's training, ch. 7.4.1's) interrupted after a checkpoint

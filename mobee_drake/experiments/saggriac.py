@@ -57,6 +57,7 @@ from mobee_drake.goal_babbling.config import (
 )
 from mobee_drake.goal_babbling.evaluation import MEASURES, Evaluator, MakeTestSet
 from mobee_drake.goal_babbling.sagg_riac import SaggRiac
+from mobee_drake.owned_folders import OwnedFolder
 
 METHODS = {
     learner.name: learner for learner in (SaggRiac, SaggRandom, ActuatorRandom, ActuatorRiac)
@@ -1022,7 +1023,11 @@ def main(argv=None) -> None:
     command = "mobee-drake experiment saggriac " + " ".join(
         argv if argv is not None else sys.argv[1:]
     )
-    Analyse(specs, args.output, command)
+    # (Claimed like the battery: a user's folder, or another battery's, is never written into.)
+    with OwnedFolder(args.output, "battery"):
+        if not any((args.output / "runs" / spec.Name() / RESULT).exists() for spec in specs):
+            parser.error(f"--output {args.output}: holds no SAGG-RIAC run of these arguments")
+        Analyse(specs, args.output, command)
     print(
         f"done in {time.perf_counter() - started:.1f} s; report: {args.output / 'report.md'}",
         flush=True,
