@@ -197,6 +197,17 @@ class TestDamagedCheckpoints(unittest.TestCase):
             saved["time"] = np.array(np.nan)
             np.savez(generation / "simulation.npz", **saved)
 
+        def NanModel(generation):
+            saved = dict(np.load(generation / "right_arm.npz"))
+            key = next(k for k, v in saved.items() if np.issubdtype(v.dtype, np.floating))
+            saved[key] = np.full_like(saved[key], np.nan)
+            np.savez(generation / "right_arm.npz", **saved)
+
+        def NegativeTime(generation):
+            saved = dict(np.load(generation / "simulation.npz"))
+            saved["time"] = np.array(-5.0)
+            np.savez(generation / "simulation.npz", **saved)
+
         cases = {
             "truncated": (Truncate, "damaged checkpoint"),
             "nan": (Nan, "'time' holds NaN"),
@@ -206,6 +217,13 @@ class TestDamagedCheckpoints(unittest.TestCase):
                 "damaged checkpoint",
             ),
             "no model": (lambda g: (g / "right_arm.npz").unlink(), "damaged checkpoint"),
+            # Issue 31, item 10: each damage with its own message.
+            "nan in a model": (NanModel, "right_arm.npz: '.*' holds NaN"),
+            "negative time": (NegativeTime, "holds the time -5.0 s, not >= 0"),
+            "no configuration": (
+                lambda g: (g / "configuration.yaml").unlink(),
+                "damaged checkpoint \\(no configuration.yaml\\)",
+            ),
         }
         for name, (damage, message) in cases.items():
             with self.subTest(name):

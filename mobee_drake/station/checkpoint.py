@@ -96,12 +96,23 @@ def ReadCheckpointFiles(station: Station, context, folder: pathlib.Path) -> None
         ) from None
 
 
-def _ReadFiles(station: Station, context, folder: pathlib.Path) -> None:
-    saved = dict(np.load(folder / "simulation.npz"))
-    for key, value in saved.items():
+def _CheckNoNan(path: pathlib.Path) -> dict:
+    """The arrays of ``path`` (an .npz), CheckpointError naming the first that holds NaN."""
+    arrays = dict(np.load(path))
+    for key, value in arrays.items():
         if np.issubdtype(value.dtype, np.floating) and np.isnan(value).any():
-            raise CheckpointError(f"{folder / 'simulation.npz'}: '{key}' holds NaN")
-    context.SetTime(float(saved["time"]))
+            raise CheckpointError(f"{path}: '{key}' holds NaN")
+    return arrays
+
+
+def _ReadFiles(station: Station, context, folder: pathlib.Path) -> None:
+    saved = _CheckNoNan(folder / "simulation.npz")
+    for other in sorted(folder.glob("*.npz")):  # (the agents' models too)
+        _CheckNoNan(other)
+    time = float(saved["time"])
+    if not (np.isfinite(time) and time >= 0):
+        raise CheckpointError(f"{folder / 'simulation.npz'}: holds the time {time} s, not >= 0")
+    context.SetTime(time)
     for key, current in _DiscreteStates(station, context):
         system_name, group = key.rsplit("/", 1)
         if key not in saved:
@@ -156,9 +167,12 @@ def LoadCheckpoint(
     generation = CurrentGeneration(folder)
     if generation is None:
         raise CheckpointError(f"{folder}: holds no checkpoint")
-    saved = (
-        (generation / CONFIGURATION).read_text() if (generation / CONFIGURATION).is_file() else ""
-    )
+    if not (generation / CONFIGURATION).is_file():
+        raise CheckpointError(
+            f"{generation}: a damaged checkpoint (no {CONFIGURATION}); delete this generation "
+            "to resume from the one before it, or start afresh in another folder"
+        )
+    saved = (generation / CONFIGURATION).read_text()
     if saved != configuration:
         differences = YamlDifferences(saved or "{}", configuration or "{}")
         raise CheckpointError(
