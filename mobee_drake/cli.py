@@ -15,7 +15,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake import __version__
 from mobee_drake.atomic_files import WriteJsonAtomically
-from mobee_drake.experiments.arguments import CommandParser, PositiveFloat
+from mobee_drake.experiments.arguments import CommandParser, NonEmpty, PositiveFloat
 from mobee_drake.experiments.battery import BatteryRefused
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.owned_folders import CanWrite, FolderError
@@ -57,12 +57,15 @@ def _Run(args: list[str]) -> None:
     parser.add_argument(
         "--duration", type=PositiveFloat, help="seconds to simulate instead of the scenario's"
     )
-    parser.add_argument("--record", help="save a replayable Meshcat recording to this HTML file")
+    parser.add_argument(
+        "--record", type=NonEmpty, help="save a replayable Meshcat recording to this HTML file"
+    )
     parser.add_argument(
         "--no-record", action="store_true", help="do not save a recording (opens no port)"
     )
     parser.add_argument(
         "--log",
+        type=NonEmpty,
         help="write the data log (Parquet) to this file instead of beside the summary; "
         "full force vectors with --set '{data_log: {full_forces: true}}'",
     )
@@ -82,11 +85,14 @@ def _Run(args: list[str]) -> None:
     )
     parser.add_argument(
         "--checkpoint",
+        type=NonEmpty,
         default=None,
         help="a folder: resume from the checkpoint there, and save one after "
         "every completed action of the exploring agents",
     )
-    parser.add_argument("--graphviz", help="write the diagram's Graphviz (dot) text to this file")
+    parser.add_argument(
+        "--graphviz", type=NonEmpty, help="write the diagram's Graphviz (dot) text to this file"
+    )
     known = parser.parse_args(args)
 
     overrides = list(known.set)

@@ -30,7 +30,13 @@ from mobee_drake.station.config import DataLog, StationConfig, StationConfigErro
 from mobee_drake.station.executor import StateActionAttractor
 from mobee_drake.station.runner import RunStation, RunSummary
 from mobee_drake.station.viewer import RecordingMeshcat
-from mobee_drake.yaml_io import CheckYamlStructure, LoadYamlFile, LoadYamlOverride, YamlFileError
+from mobee_drake.yaml_io import (
+    CheckYamlStructure,
+    LoadYamlFile,
+    LoadYamlOverride,
+    TaggedData,
+    YamlFileError,
+)
 
 # The longest run a scenario may ask for (s; our choice: about 116 simulated days, far beyond any
 # experiment of the sources, and short enough that a typo like 1e308 is caught, not simulated).
@@ -100,6 +106,10 @@ def LoadScenario(
         source = f"overrides '{_OneLine(text)}'"
         try:
             CheckYamlStructure(text, source)  # (alias bombs, absurd nesting)
+            if not isinstance(TaggedData(text), dict):
+                raise YamlFileError(
+                    f"{source}: not a YAML mapping; give one, e.g. '{{duration: 5}}'"
+                )
             scenario = LoadYamlOverride(schema=Scenario, text=text, defaults=scenario)
         except YamlFileError:
             raise

@@ -90,6 +90,12 @@ class TestMistakes(unittest.TestCase):
             ),  # fmt: skip
             (["bench", "safety", "--doc", "README.md"], "no generated block 'safety scenes'"),
             (["bench", "safety", "--report-only"], "--report-only needs --output"),
+            # Issue 31, item 11: nonsense that ran silently, or ended in a Python type error.
+            (["run", "reach_around_ball", "--set", ""], "overrides '': not a YAML mapping"),
+            (["run", "reach_around_ball", "--record", ""], "--record: must be a non-empty path"),
+            (["run", "reach_around_ball", "--checkpoint", ""], "--checkpoint: must be a non-empty"),
+            (["bench", "forces", "--amplitude", "5"], "--amplitude: must be a number in (0, 1]"),
+            (["experiment", "ch8", "--stages", "2", "2"], "--stages must differ from each other"),
         ):
             with self.subTest(args):
                 code, _, err = _Call(*args)

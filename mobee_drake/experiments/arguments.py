@@ -30,6 +30,16 @@ def PositiveFloat(text: str) -> float:
     return _Checked(text, float, lambda v: math.isfinite(v) and v > 0, "a finite number > 0")
 
 
+def Fraction(text: str) -> float:
+    """A number in (0, 1] (a share of a range)."""
+    return _Checked(text, float, lambda v: 0 < v <= 1, "a number in (0, 1]")
+
+
+def NonEmpty(text: str) -> str:
+    """A non-empty text (a path: an empty one would be silently ignored)."""
+    return _Checked(text, str, bool, "a non-empty path")
+
+
 class HelpFormatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
     """Every command's help: its description as written, each option with its default."""
 

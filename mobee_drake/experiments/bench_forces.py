@@ -27,7 +27,12 @@ import numpy as np
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph, MultibodyPlant
 from pydrake.systems.framework import Diagram, DiagramBuilder
 
-from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
+from mobee_drake.experiments.arguments import (
+    CommandParser,
+    Fraction,
+    NonNegativeInt,
+    PositiveInt,
+)
 from mobee_drake.experiments.plots import Figure, SaveFigure, plt
 from mobee_drake.mobee.barrier import StepModel
 from mobee_drake.mobee.system import Mobee
@@ -301,7 +306,7 @@ def main(argv=None) -> None:
     parser.add_argument("--repeats", type=PositiveInt, default=5, help="sweeps per row")
     parser.add_argument(
         "--amplitude",
-        type=float,
+        type=Fraction,
         default=1.0,
         help="fraction of each joint's range swept (1: the whole range, Fig. 2.4)",
     )

@@ -1030,6 +1030,8 @@ def main(argv=None) -> None:
     stages = args.stages or [s for s in SOURCE_STAGES if s <= args.problem_tries]
     if any(s < 0 or s > args.problem_tries for s in stages):
         parser.error(f"--stages must lie in 0..{args.problem_tries}")
+    if len(set(stages)) != len(stages):
+        parser.error(f"--stages must differ from each other, got {stages}")
     output = pathlib.Path(args.output)
     output.mkdir(parents=True, exist_ok=True)
     preset = REACH_PRESETS[args.preset]
