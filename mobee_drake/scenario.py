@@ -18,7 +18,8 @@ import pathlib
 
 from pydrake.common.yaml import yaml_dump_typed
 from pydrake.geometry import Meshcat
-from pydrake.systems.analysis import SimulatorConfig
+from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
+from pydrake.systems.primitives import ConstantVectorSource
 import yaml
 
 from mobee_drake import __version__
@@ -70,6 +71,10 @@ def ScenarioErrors(scenario: Scenario) -> list[str]:
     errors = StationConfigErrors(scenario)
     if not (math.isfinite(scenario.duration) and 0 < scenario.duration <= MAX_DURATION):
         errors.append(f"duration must be > 0 and <= {MAX_DURATION:g} s, got {scenario.duration}")
+    try:  # Drake's own check of its strings (the integration scheme)
+        ApplySimulatorConfig(scenario.simulator_config, Simulator(ConstantVectorSource([0.0])))
+    except (RuntimeError, ValueError) as error:
+        errors.append(f"simulator_config: {error}")
     rate = scenario.simulator_config.target_realtime_rate
     if not (rate == 0 or (math.isfinite(rate) and rate >= MIN_REALTIME_RATE)):
         errors.append(

@@ -128,6 +128,17 @@ class TestFixedRegressions(unittest.TestCase):
         "explorer: {delta: .nan}}]}}": "explorer delta must be > 0",
         "{attractor: !ExploreAttractor {agents: [{name: a, joints: [r_elbow], "
         "explorer: {strategy: bold}}]}}": "explorer strategy must be one of",
+        # Issue 31, item 8: tracebacks.
+        "{robot: {controlled_joints: []}}": "controlled_joints must name at least one joint",
+        "{mover: !Dynamic {plant_config: {contact_model: bogus}}}": (
+            "plant_config: Unknown contact_model: 'bogus'"
+        ),
+        "{mover: !Dynamic {plant_config: {discrete_contact_approximation: bogus}}}": (
+            "plant_config: Unknown discrete_contact_approximation"
+        ),
+        "{simulator_config: {integration_scheme: bogus}}": (
+            "simulator_config: Unknown integration scheme: bogus"
+        ),
         # Issue 31, item 9: no run that would go for days without a line.
         "{time_step: 1e-9}": "time_step must be >= 0.0001",
         "{mover: !Dynamic {plant_config: {time_step: 1e-9}}}": "plant_config time_step must be",

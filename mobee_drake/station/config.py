@@ -13,10 +13,15 @@ tagged choices, so that no illegal combination can be written:
   the rewinding reflex (ch. 4.1) move the kinematic robot.
 """
 
+import copy
 import dataclasses as dc
 import math
 
-from pydrake.multibody.plant import MultibodyPlantConfig
+from pydrake.multibody.plant import (
+    ApplyMultibodyPlantConfig,
+    MultibodyPlant,
+    MultibodyPlantConfig,
+)
 
 from mobee_drake.mobee.params import Dissertation, MobeeParams
 from mobee_drake.mobee.reflex import ReflexParams
@@ -165,6 +170,12 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
                 f"mover control must be one of {CONTROL_MODALITIES}, got '{mover.control}'"
             )
         step = mover.plant_config.time_step
+        try:  # Drake's own check of its strings (contact model, approximation, solver)
+            probe = copy.deepcopy(mover.plant_config)
+            probe.time_step = 1e-3  # (the step is checked below)
+            ApplyMultibodyPlantConfig(probe, MultibodyPlant(probe.time_step))
+        except (RuntimeError, ValueError) as error:
+            errors.append(f"plant_config: {error}")
         if not (math.isfinite(step) and MIN_PLANT_TIME_STEP <= step <= config.time_step):
             errors.append(
                 f"plant_config time_step must be >= {MIN_PLANT_TIME_STEP:g} s and <= time_step, "
@@ -177,6 +188,8 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
         and mover.tolerance_deg > 0
     ):
         errors.append("reflex: speed_deg and tolerance_deg must be finite and > 0, history >= 2")
+    if isinstance(config.robot, IcubConfig) and not config.robot.controlled_joints:
+        errors.append("robot controlled_joints must name at least one joint")
     if not (math.isfinite(config.time_step) and MIN_TIME_STEP <= config.time_step <= MAX_TIME_STEP):
         errors.append(
             f"time_step must be >= {MIN_TIME_STEP:g} and <= {MAX_TIME_STEP} s, "
