@@ -16,7 +16,7 @@ from pydrake.systems.framework import DiagramBuilder
 from mobee_drake import __version__
 from mobee_drake.atomic_files import WriteJsonAtomically
 from mobee_drake.experiments.arguments import CommandParser, NonEmpty, PositiveFloat
-from mobee_drake.experiments.battery import BatteryRefused
+from mobee_drake.experiments.battery import BatteryError, BatteryRefused
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.owned_folders import CanWrite, FolderError
 from mobee_drake.resources import ScenarioNames
@@ -270,6 +270,17 @@ def main(argv: list[str] | None = None) -> None:
         sys.exit(130)
     except OSError as e:  # A full disk, a folder gone: the machine's, not the run's, fault.
         print(f"error: {e}", file=sys.stderr)
+        sys.exit(1)
+    except BatteryError as e:  # (--debug: the traceback) One line: how many, the first, resume.
+        if _debug:
+            raise
+        count, *failures = str(e).splitlines()
+        more = f" (and {len(failures) - 1} more)" if len(failures) > 1 else ""
+        print(
+            f"error: {count} {failures[0] if failures else ''}{more}; the others' results are "
+            "kept: run the same command again to resume",
+            file=sys.stderr,
+        )
         sys.exit(1)
 
 

@@ -10,8 +10,10 @@ import subprocess
 import sys
 import tempfile
 import unittest
+from unittest import mock
 
 from mobee_drake import cli
+from mobee_drake.experiments.battery import BatteryError
 
 COMMANDS = [
     ["run"],
@@ -103,6 +105,22 @@ class TestMistakes(unittest.TestCase):
                 self.assertEqual(len(err.strip().splitlines()), 1, err)
                 self.assertIn(message, err)
                 self.assertNotIn("Traceback", err)
+
+    def test_a_failed_battery_is_one_line_and_exit_code_1(self):
+        """Issue 31, item 7: a killed worker or a full disk ended in a multi-screen traceback."""
+
+        def Failing(args):
+            raise BatteryError("2 of 5 jobs failed:\nrandom_seed0: BrokenProcessPool: a worker "
+                               "died\ngreedy_seed0: OSError: [Errno 28] no space")  # fmt: skip
+
+        with mock.patch.dict(cli.COMMANDS, {"experiment": Failing}):
+            code, _, err = _Call("experiment", "ch8")
+        self.assertEqual(code, 1)
+        self.assertEqual(
+            err,
+            "error: 2 of 5 jobs failed: random_seed0: BrokenProcessPool: a worker died (and 1 "
+            "more); the others' results are kept: run the same command again to resume\n",
+        )
 
     def test_debug_shows_the_traceback(self):
         with self.assertRaisesRegex(ValueError, "unknown iCub model"):

@@ -1,6 +1,9 @@
-"""MoBeE's safety guarantee (mobee/barrier.py): closed forms of the barrier force, the parameters
-that would break the guarantee refused, and saturated client pushes into a table, a ball and the
-robot itself that penetrate without the barrier and never with it, on both robots."""
+"""MoBeE's safety guarantee (mobee/barrier.py, docs/mobee.md): closed forms of the barrier's rows
+and of each robot's predicted displacement (the dynamic plant against its prediction), the
+parameters that would break the guarantee refused, saturated client pushes into a table, a ball
+and the robot itself for 10 s, with both presets on the kinematic robot and the dynamic robot's
+three modes, that penetrate without the barrier and never with it, babbling with random pushes,
+runs that start in penetration, and the docs' safety tables written by the benchmark."""
 
 import contextlib
 import io
@@ -27,7 +30,8 @@ DOC = pathlib.Path(__file__).resolve().parents[1] / "docs" / "mobee.md"
 
 
 class TestBarrierForce(unittest.TestCase):
-    """The rows ``n . (offset + gain (T + dT)) >= -rate (d - clearance)`` (m over the period)."""
+    """The rows ``n . (offset + gain (T + dT)) >= -rate max(d - clearance, -clearance)`` (m
+    over the period)."""
 
     def test_a_gap_closing_too_fast_is_held_at_the_rate_with_the_least_force(self):
         """One pair: the period's closing is cut to the allowed one, by the change of least
