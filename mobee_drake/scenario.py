@@ -75,6 +75,11 @@ def ScenarioErrors(scenario: Scenario) -> list[str]:
         ApplySimulatorConfig(scenario.simulator_config, Simulator(ConstantVectorSource([0.0])))
     except (RuntimeError, ValueError) as error:
         errors.append(f"simulator_config: {error}")
+    simulator = scenario.simulator_config
+    for name in ("max_step_size", "accuracy"):
+        value = getattr(simulator, name)
+        if not (math.isfinite(value) and value > 0):
+            errors.append(f"simulator_config {name} must be finite and > 0, got {value}")
     rate = scenario.simulator_config.target_realtime_rate
     if not (rate == 0 or (math.isfinite(rate) and rate >= MIN_REALTIME_RATE)):
         errors.append(

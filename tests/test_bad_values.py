@@ -139,6 +139,12 @@ class TestFixedRegressions(unittest.TestCase):
         "{simulator_config: {integration_scheme: bogus}}": (
             "simulator_config: Unknown integration scheme: bogus"
         ),
+        # Issue 31, item 11: silent nonsense.
+        "{objects: [{name: a, shape: !Sphere {radius: 0.1}, position: [1e300, 0, 0]}]}": (
+            "position must lie within 1000 m"
+        ),
+        "{simulator_config: {max_step_size: -1}}": "max_step_size must be finite and > 0",
+        "{simulator_config: {accuracy: .nan}}": "accuracy must be finite and > 0",
         # Issue 31, item 9: no run that would go for days without a line.
         "{time_step: 1e-9}": "time_step must be >= 0.0001",
         "{mover: !Dynamic {plant_config: {time_step: 1e-9}}}": "plant_config time_step must be",

@@ -98,6 +98,11 @@ class TestMistakes(unittest.TestCase):
             (["run", "reach_around_ball", "--checkpoint", ""], "--checkpoint: must be a non-empty"),
             (["bench", "forces", "--amplitude", "5"], "--amplitude: must be a number in (0, 1]"),
             (["experiment", "ch8", "--stages", "2", "2"], "--stages must differ from each other"),
+            (["bench", "forces", "--plot", "README.md/x.png"], "--plot README.md/x.png: cannot be"),
+            (
+                ["experiment", "ch8", "--report-only", "--output", "/missing/ch8"],
+                "--report-only: /missing/ch8 is not a folder",
+            ),
         ):
             with self.subTest(args):
                 code, _, err = _Call(*args)

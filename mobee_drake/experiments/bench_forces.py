@@ -36,6 +36,7 @@ from mobee_drake.experiments.arguments import (
 from mobee_drake.experiments.plots import Figure, SaveFigure, plt
 from mobee_drake.mobee.barrier import StepModel
 from mobee_drake.mobee.system import Mobee
+from mobee_drake.owned_folders import CanWrite
 from mobee_drake.robots.icub import IcubConfig
 from mobee_drake.robots.scenario_robot import AddScenarioRobot
 from mobee_drake.robots.zero_position import ZeroPositionConfig
@@ -332,6 +333,8 @@ def main(argv=None) -> None:
         help="instead, time each stage of one evaluation: " + ", ".join(STAGES),
     )
     args = parser.parse_args(argv)
+    if args.plot and not CanWrite(args.plot):  # (checked before the work)
+        parser.error(f"--plot {args.plot}: cannot be written (its folder is missing, read-only?)")
     if args.stages:
         print("| robot | boxes | " + " | ".join(f"{s} (us)" for s in STAGES) + " |")
         print("|---|---:|" + "---:|" * len(STAGES))

@@ -1033,6 +1033,8 @@ def main(argv=None) -> None:
     if len(set(stages)) != len(stages):
         parser.error(f"--stages must differ from each other, got {stages}")
     output = pathlib.Path(args.output)
+    if args.report_only and not output.is_dir():  # (checked before a folder is made)
+        parser.error(f"--report-only: {output} is not a folder of reach-learning runs")
     output.mkdir(parents=True, exist_ok=True)
     preset = REACH_PRESETS[args.preset]
     variants = [

@@ -38,6 +38,9 @@ MAX_TIME_STEP = 0.1
 # days without a line of output: 1e-9 s is 10^9 periods a simulated second).
 MIN_TIME_STEP = 1e-4
 MIN_PLANT_TIME_STEP = 1e-5
+# How far from the world's origin an object may be (m): a robot's workspace, with room to spare
+# (an object at 1e300 m breaks SceneGraph's arithmetic without a word).
+MAX_WORLD_EXTENT = 1000.0
 
 
 def _Finite(values) -> bool:
@@ -224,6 +227,11 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
             errors.append(f"object '{obj.name}': position and rpy_deg need three numbers")
         elif not _Finite(obj.position + obj.rpy_deg):
             errors.append(f"object '{obj.name}': position and rpy_deg must be finite")
+        elif max(map(abs, obj.position)) > MAX_WORLD_EXTENT:
+            errors.append(
+                f"object '{obj.name}': position must lie within {MAX_WORLD_EXTENT:g} m of the "
+                f"world's origin, got {obj.position}"
+            )
         errors += _ShapeErrors(obj.name, obj.shape)
     for event in config.world_events:
         where = f"world event at {event.time} s"
@@ -235,6 +243,8 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
             errors.append(f"{where}: position needs three numbers")
         if not (_Finite([event.time, *event.position]) and event.time >= 0):
             errors.append(f"{where}: its time must be >= 0 and its numbers finite")
+        elif event.position and max(map(abs, event.position)) > MAX_WORLD_EXTENT:
+            errors.append(f"{where}: position must lie within {MAX_WORLD_EXTENT:g} m of the origin")
     for companion in config.companions:
         if isinstance(mover, Dynamic):
             errors.append(
