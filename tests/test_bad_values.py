@@ -165,6 +165,15 @@ class TestFixedRegressions(unittest.TestCase):
                 with self.assertRaisesRegex(YamlFileError, rf"^overrides '.*{message}"):
                     LoadScenario("reach_around_ball", text)
 
+    def test_too_many_objects_are_refused_at_load(self):
+        """Issue 31, item 5: 10,000 objects built for minutes and ended in a MemoryError."""
+        objects = ", ".join(
+            f"{{name: b{i}, shape: !Sphere {{radius: 0.01}}, position: [-2, 0, {i * 0.03}]}}"
+            for i in range(2001)
+        )
+        with self.assertRaisesRegex(YamlFileError, r"objects: at most 2000 .*got 2001"):
+            LoadScenario("reach_around_ball", f"{{objects: [{objects}]}}")
+
     def test_bad_files(self):
         folder = pathlib.Path(tempfile.mkdtemp())
         self.addCleanup(shutil.rmtree, folder)
