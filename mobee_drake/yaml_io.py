@@ -33,8 +33,9 @@ MAX_ALIAS_NODES = 10_000
 
 
 def CheckYamlStructure(text: str, source: str) -> None:
-    """Refuses nesting deeper than :data:`MAX_YAML_DEPTH` and aliases that repeat more than
-    :data:`MAX_ALIAS_NODES` nodes, reading the parser's events one at a time (linear time).
+    """Refuses nesting deeper than :data:`MAX_YAML_DEPTH`, aliases that repeat more than
+    :data:`MAX_ALIAS_NODES` nodes and a key given twice in one mapping (YAML keeps the last,
+    silently), reading the parser's events one at a time (linear time).
 
     Raises:
         YamlFileError: naming ``source`` and the line; yaml.MarkedYAMLError for invalid YAML.
@@ -42,9 +43,13 @@ def CheckYamlStructure(text: str, source: str) -> None:
     sizes: dict[str, int] = {}  # an anchor's node count, its aliases expanded
     open_nodes: list[list] = []  # [anchor, node count so far] of each open collection
     repeated = 0
+    mappings: list = []  # per open collection: [next is a key, keys seen], None for a sequence
     for event in yaml.parse(text, Loader=yaml.SafeLoader):
         line = event.start_mark.line + 1
+        if isinstance(event, yaml.NodeEvent) and mappings and mappings[-1] is not None:
+            _CheckKey(mappings[-1], event, f"{source}:{line}")
         if isinstance(event, yaml.CollectionStartEvent):
+            mappings.append([True, set()] if isinstance(event, yaml.MappingStartEvent) else None)
             if len(open_nodes) >= MAX_YAML_DEPTH:
                 raise YamlFileError(f"{source}:{line}: nested deeper than {MAX_YAML_DEPTH} levels")
             open_nodes.append([event.anchor, 1])
@@ -60,6 +65,7 @@ def CheckYamlStructure(text: str, source: str) -> None:
                     f"*{event.anchor}); write the data out instead"
                 )
         elif isinstance(event, yaml.CollectionEndEvent):
+            mappings.pop()
             anchor, size = open_nodes.pop()
         else:
             continue
@@ -67,6 +73,15 @@ def CheckYamlStructure(text: str, source: str) -> None:
             sizes[anchor] = size
         if open_nodes:
             open_nodes[-1][1] += size
+
+
+def _CheckKey(mapping: list, event: yaml.NodeEvent, where: str) -> None:
+    """``mapping``'s next node ``event``: a key (refused if it was given before) or a value."""
+    if mapping[0] and isinstance(event, yaml.ScalarEvent):
+        if event.value in mapping[1]:
+            raise YamlFileError(f"{where}: key '{event.value}' given twice (YAML keeps the last)")
+        mapping[1].add(event.value)
+    mapping[0] = not mapping[0]
 
 
 def LineOf(text: str, names: list[str]) -> int | None:

@@ -140,6 +140,8 @@ class TestFixedRegressions(unittest.TestCase):
             "simulator_config: Unknown integration scheme: bogus"
         ),
         # Issue 31, item 11: silent nonsense.
+        "{duration: 1, duration: 2}": "key 'duration' given twice",
+        "{mobee: {damping: 30, damping: 40}}": "key 'damping' given twice",
         "{objects: [{name: a, shape: !Sphere {radius: 0.1}, position: [1e300, 0, 0]}]}": (
             "position must lie within 1000 m"
         ),
