@@ -137,6 +137,37 @@ class TestDataLog(unittest.TestCase):
             resumed["q.r_elbow"].to_numpy(), whole["q.r_elbow"].to_numpy(), atol=1e-12
         )
 
+    def test_a_resumed_log_is_the_checkpoints_never_a_file_left_at_its_path(self):
+        """Issue 31, item 2: the log was written at the end only, and a resumed run kept the
+        rows of whatever file sat at its path. Here the first run's log never reaches the path
+        (as after a kill), another run's log sits there instead, and the stale segment of a
+        killed run lies beside the checkpoint's: the resumed log is still the whole run's."""
+        folder = _Folder()
+        path, checkpoint = folder / "run.parquet", folder / "checkpoint"
+        RunScenario(
+            LoadScenario("reach_around_ball", "{duration: 0.5}"),
+            data_log=str(folder / "first.parquet"),
+            checkpoint=str(checkpoint),
+        )
+        RunScenario(
+            LoadScenario("reach_around_ball", "{duration: 1.0, time_step: 0.02}"),
+            data_log=str(path),
+        )
+        (checkpoint / "log" / "000001.parquet").write_bytes(b"a killed run's segment")
+        RunScenario(
+            LoadScenario("reach_around_ball", "{duration: 1.0}"),
+            data_log=str(path),
+            checkpoint=str(checkpoint),
+        )
+        resumed = pd.read_parquet(path)
+        whole = _Folder() / "whole.parquet"
+        RunScenario(LoadScenario("reach_around_ball", "{duration: 1.0}"), data_log=str(whole))
+        whole = pd.read_parquet(whole)
+        self.assertEqual(list(resumed["time"]), list(whole["time"]))
+        np.testing.assert_allclose(
+            resumed["q.r_elbow"].to_numpy(), whole["q.r_elbow"].to_numpy(), atol=1e-12
+        )
+
     def test_a_long_run_keeps_at_most_its_rows(self):
         """2 s at 10 ms periods with at most 50 rows: a row every 40 ms (memory bounded)."""
         scenario = LoadScenario("reach_around_ball", "{duration: 2.0, data_log: {max_rows: 50}}")

@@ -35,6 +35,8 @@ class CheckpointError(ValueError):
 
 # The configuration a checkpoint was written with.
 CONFIGURATION = "configuration.yaml"
+# How many of the data log's segments a generation covers.
+LOG_SEGMENTS = "log_segments.txt"
 # Systems whose state only serves the viewer: a checkpoint may have them or not.
 _VIEWER_SYSTEMS = ("trail",)
 
@@ -137,15 +139,21 @@ def _ReadFiles(station: Station, context, folder: pathlib.Path) -> None:
 
 
 def SaveCheckpoint(
-    station: Station, context, folder: str | pathlib.Path, configuration: str = ""
+    station: Station,
+    context,
+    folder: str | pathlib.Path,
+    configuration: str = "",
+    log_segments: int = 0,
 ) -> None:
     """Saves the state of ``context`` (the diagram's root context) as the newest generation of
     ``folder`` (see :func:`~mobee_drake.atomic_files.WriteGeneration`), with the
-    ``configuration`` it was run with (YAML text; see :func:`LoadCheckpoint`)."""
+    ``configuration`` it was run with (YAML text; see :func:`LoadCheckpoint`) and how many of
+    the data log's segments it covers (:class:`~mobee_drake.station.data_log.CheckpointedLog`)."""
 
     def Write(staging: pathlib.Path) -> None:
         WriteCheckpointFiles(station, context, staging)
         (staging / CONFIGURATION).write_text(configuration)
+        (staging / LOG_SEGMENTS).write_text(str(log_segments))
 
     WriteGeneration(folder, Write)
 
@@ -182,3 +190,12 @@ def LoadCheckpoint(
             + "); resume with the same one, or start afresh in another folder"
         )
     ReadCheckpointFiles(station, context, generation)
+
+
+def LogSegments(folder: str | pathlib.Path) -> int:
+    """How many data-log segments the newest checkpoint in ``folder`` covers (0: none saved)."""
+    path = CurrentGeneration(folder) / LOG_SEGMENTS
+    try:
+        return int(path.read_text()) if path.is_file() else 0
+    except ValueError:
+        raise CheckpointError(f"{path}: a damaged checkpoint (not a count)") from None

@@ -183,19 +183,68 @@ class DataLogger:
             texts.append("; ".join(new))
         return texts
 
-    def Write(
-        self, path: str | pathlib.Path, root_context, *, resumed_at: float | None = None
-    ) -> None:
-        """Writes the log as Parquet, atomically. A resumed run keeps the rows of the file it
-        resumes before ``resumed_at`` (if the file is there, with the same columns)."""
-        table = self.Table(root_context, first_row_events=resumed_at is None)
-        path = pathlib.Path(path)
-        if resumed_at is not None and path.exists():
-            before = pq.read_table(path)
-            if before.schema.names == table.schema.names:
-                kept = before.filter(pc.less(before["time"], resumed_at))
-                table = pa.concat_tables([kept.cast(table.schema), table])
-        WriteFileAtomically(path, lambda staging: pq.write_table(table, staging))
+    def Write(self, path: str | pathlib.Path, root_context) -> None:
+        """Writes the log of ``root_context`` as Parquet, atomically (a run with checkpoints:
+        :class:`CheckpointedLog`)."""
+        WriteTable(path, self.Table(root_context))
+
+
+def WriteTable(path: str | pathlib.Path, table: pa.Table) -> None:
+    """Writes ``table`` as Parquet, atomically."""
+    WriteFileAtomically(path, lambda staging: pq.write_table(table, staging))
+
+
+class CheckpointedLog:
+    """The data log of a run with checkpoints, saved with them: every checkpoint adds the rows
+    since the one before as a segment, ``log/<k>.parquet`` in the checkpoint's folder, and its
+    generation records how many segments it covers (:meth:`Save`'s count). A resumed run reads
+    exactly the segments of the checkpoint it resumes (:meth:`Resume`; those a killed run wrote
+    after it are removed), so its log is the uninterrupted run's, never a file of another run.
+    """
+
+    def __init__(self, logger: DataLogger, folder: str | pathlib.Path):
+        self._logger, self._folder = logger, pathlib.Path(folder) / "log"
+        self._earlier: pa.Table | None = None  # the rows before this process's
+        self._resumed_at: float | None = None
+        self._count = 0  # segments on disk that count
+        self._saved_until = -np.inf  # the last time this process saved
+
+    def _Segment(self, k: int) -> pathlib.Path:
+        return self._folder / f"{k:06d}.parquet"
+
+    def Resume(self, count: int, resumed_at: float) -> None:
+        """Reads the first ``count`` segments (a checkpoint's) for a run resumed at ``resumed_at``
+        and removes the rest."""
+        segments = [pq.read_table(self._Segment(k)) for k in range(count)]
+        for stale in self._folder.glob("*.parquet"):
+            if int(stale.stem) >= count:
+                stale.unlink()
+        self._earlier = pa.concat_tables(segments) if segments else None
+        self._resumed_at, self._count, self._saved_until = resumed_at, count, resumed_at
+
+    def _Current(self, root_context) -> pa.Table:
+        """This process's rows after what the segments hold."""
+        table = self._logger.Table(root_context, first_row_events=self._resumed_at is None)
+        if self._resumed_at is None:
+            return table
+        return table.filter(pc.greater(table["time"], self._resumed_at))
+
+    def Save(self, root_context) -> int:
+        """Writes the rows since the last save as a new segment; returns the segments' count."""
+        current = self._Current(root_context)
+        new = current.filter(pc.greater(current["time"], self._saved_until))
+        if len(new):
+            WriteTable(self._Segment(self._count), new)
+            self._count += 1
+            self._saved_until = float(new["time"][-1].as_py())
+        return self._count
+
+    def Table(self, root_context) -> pa.Table:
+        """The whole log: the segments of the run resumed, then this process's rows."""
+        current = self._Current(root_context)
+        if self._earlier is None:
+            return current
+        return pa.concat_tables([self._earlier.cast(current.schema), current])
 
 
 def AddDataLog(

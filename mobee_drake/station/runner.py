@@ -12,7 +12,13 @@ from mobee_drake.atomic_files import WriteTextAtomically
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.progress import ProgressBar
 from mobee_drake.station.builder import Station
-from mobee_drake.station.checkpoint import HasCheckpoint, LoadCheckpoint, SaveCheckpoint
+from mobee_drake.station.checkpoint import (
+    HasCheckpoint,
+    LoadCheckpoint,
+    LogSegments,
+    SaveCheckpoint,
+)
+from mobee_drake.station.data_log import CheckpointedLog, WriteTable
 from mobee_drake.station.outcome import RunOutcome
 from mobee_drake.station.safety import CheckStart, SafetyReport
 from mobee_drake.station.world_events import MakeSimulator
@@ -160,8 +166,8 @@ def RunStation(
     if given, overrides its target real-time rate); with ``record`` saves its Meshcat recording
     (HTML; the station must have been built with Meshcat) at the viewer's frame rate, or at the
     lower rate that keeps it within ``max_recorded_frames``; with ``data_log`` (a Parquet file)
-    writes the station's data log (see :mod:`mobee_drake.station.data_log`; a resumed run keeps
-    the file's rows from before it resumed).
+    writes the station's data log (see :mod:`mobee_drake.station.data_log`; with a checkpoint
+    it is saved with every checkpoint, and a resumed run's log is the uninterrupted run's).
 
     With ``checkpoint`` (a folder: new, empty or one of our checkpoints, and held by this run
     alone; see :mod:`mobee_drake.owned_folders`), a run resumes from the checkpoint there if
@@ -177,9 +183,15 @@ def RunStation(
             simulator.set_target_realtime_rate(realtime_rate)
         context = simulator.get_mutable_context()
         resumed = None
+        # With checkpoints the log is saved with them (and resumed from them).
+        log = None
+        if checkpoint and data_log and station.data_log is not None:
+            log = CheckpointedLog(station.data_log, checkpoint)
         if checkpoint and HasCheckpoint(checkpoint):
             LoadCheckpoint(station, context, checkpoint, configuration)
             resumed = context.get_time()
+            if log is not None:
+                log.Resume(LogSegments(checkpoint), resumed)
         if resumed is not None and resumed >= duration:
             report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
             return RunSummary(0.0, 0.0, report, finished_before=resumed)
@@ -192,7 +204,8 @@ def RunStation(
         saved = [CompletedActions(counters, context)]
 
         def Save(context) -> None:
-            SaveCheckpoint(station, context, checkpoint, configuration)
+            segments = log.Save(context) if log is not None else 0
+            SaveCheckpoint(station, context, checkpoint, configuration, segments)
 
         def AfterChunk(context):
             done = CompletedActions(counters, context)
@@ -214,7 +227,8 @@ def RunStation(
             recording = str(path.resolve())
         written_log = None
         if data_log and station.data_log is not None:
-            station.data_log.Write(data_log, context, resumed_at=resumed)
+            table = log.Table(context) if log is not None else station.data_log.Table(context)
+            WriteTable(data_log, table)
             written_log = str(pathlib.Path(data_log).resolve())
         report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
         return RunSummary(
