@@ -122,12 +122,8 @@ class TestDataLog(unittest.TestCase):
         self.assertEqual(done.iloc[-1], outcome["actions"])
         self.assertGreater(log[f"agent.{name}.state_action"].nunique(), 1)
 
-    def test_a_resumed_run_continues_the_log(self):
-        folder = _Folder()
-        path, checkpoint = folder / "run.parquet", str(folder / "checkpoint")
-        for duration in (0.5, 1.0):
-            scenario = LoadScenario("reach_around_ball", f"{{duration: {duration}}}")
-            RunScenario(scenario, data_log=str(path), checkpoint=checkpoint)
+    def AssertIsTheWholeRun(self, path: pathlib.Path) -> None:
+        """The log at ``path`` is that of reach_around_ball run for 1 s without a stop."""
         resumed = pd.read_parquet(path)
         whole = _Folder() / "whole.parquet"
         RunScenario(LoadScenario("reach_around_ball", "{duration: 1.0}"), data_log=str(whole))
@@ -136,6 +132,14 @@ class TestDataLog(unittest.TestCase):
         np.testing.assert_allclose(
             resumed["q.r_elbow"].to_numpy(), whole["q.r_elbow"].to_numpy(), atol=1e-12
         )
+
+    def test_a_resumed_run_continues_the_log(self):
+        folder = _Folder()
+        path, checkpoint = folder / "run.parquet", str(folder / "checkpoint")
+        for duration in (0.5, 1.0):
+            scenario = LoadScenario("reach_around_ball", f"{{duration: {duration}}}")
+            RunScenario(scenario, data_log=str(path), checkpoint=checkpoint)
+        self.AssertIsTheWholeRun(path)
 
     def test_a_resumed_log_is_the_checkpoints_never_a_file_left_at_its_path(self):
         """Issue 31, item 2: the log was written at the end only, and a resumed run kept the
@@ -159,14 +163,7 @@ class TestDataLog(unittest.TestCase):
             data_log=str(path),
             checkpoint=str(checkpoint),
         )
-        resumed = pd.read_parquet(path)
-        whole = _Folder() / "whole.parquet"
-        RunScenario(LoadScenario("reach_around_ball", "{duration: 1.0}"), data_log=str(whole))
-        whole = pd.read_parquet(whole)
-        self.assertEqual(list(resumed["time"]), list(whole["time"]))
-        np.testing.assert_allclose(
-            resumed["q.r_elbow"].to_numpy(), whole["q.r_elbow"].to_numpy(), atol=1e-12
-        )
+        self.AssertIsTheWholeRun(path)
 
     def test_a_long_run_keeps_at_most_its_rows(self):
         """2 s at 10 ms periods with at most 50 rows: a row every 40 ms (memory bounded)."""
