@@ -1,15 +1,30 @@
-"""Tries, as a new user would, the bad inputs and misuses of issue 18 on the command line, and
-the malformed robot (MoBeE XML), overlay and scenario files of issue 5, and prints what each ends
-in (exit code and the last line it printed), as a markdown table.
+"""Tries bad inputs as a new user would, and tallies what each ends in.
 
-Run: ``python scripts/try_bad_inputs.py [FOLDER]`` (FOLDER: where to make the trials' files; a
-temporary folder by default). About two minutes: each trial starts the command afresh.
+The bad inputs and misuses of issues 18 and 31 on the command line, and the malformed robot
+(MoBeE XML), overlay and scenario files of issue 5: it prints what each ends in (exit code and
+the last line it printed) as a markdown table, then the tally:
+
+- *clear*: a bad input refused with one line beginning ``error:`` (or the parser's
+  ``...: error:``) and a non-zero exit code;
+- *unclear*: refused otherwise (several lines, no ``error:``);
+- *traceback*: a Python traceback;
+- *silent*: a bad input that ran and exited 0;
+- *hang*: no end within two minutes;
+- *valid*: a legitimate use (:data:`VALID`) that ran (exit 0).
+
+Run: ``python scripts/try_bad_inputs.py [--folder FOLDER] [--doc docs/durability.md]`` (FOLDER:
+where to make the trials' files, a temporary folder by default; ``--doc`` rewrites the doc's
+generated table and tally). A few minutes: each trial starts the command afresh.
 """
 
+import argparse
+import collections
 import pathlib
 import subprocess
 import sys
 import tempfile
+
+from mobee_drake.experiments.doc_tables import WriteGeneratedTable
 
 
 def _Tree(body: str) -> str:
@@ -139,26 +154,111 @@ def Trials(folder: pathlib.Path) -> list[tuple[str, list[str]]]:
         ("a 'billion laughs' scenario file", ["run", str(folder / "bomb_scenario.yaml")]),
         ("a scenario file nested 5000 deep", ["run", str(folder / "deep_scenario.yaml")]),
         ("a 'billion laughs' overlay file", ["run", "reach_around_ball", "--duration", "0.1", "--no-meshcat", "--no-log", "--set", f"{{robot: {{overlay: {folder / 'bomb_overlay.yaml'}}}}}"]),
+        *_Issue31Trials(folder, thesis_folder),
     ]  # fmt: skip
 
 
+def _Issue31Trials(folder: pathlib.Path, thesis_folder: pathlib.Path) -> list:
+    """The reproductions of issue 31 (each was a traceback, silent or a hang)."""
+    run = ["run", "reach_around_ball", "--no-meshcat", "--no-log", "--duration", "0.1", "--set"]
+    agent = "{{attractor: !ExploreAttractor {{agents: [{{name: a, joints: [r_elbow], {}}}]}}}}"
+    return [
+        ("an agent named '../../x'", [*run, "{attractor: !ExploreAttractor {agents: [{name: ../../x, joints: [r_elbow]}]}}"]),
+        ("levels: [0.5]", [*run, agent.format("levels: [0.5]")]),
+        ("levels: [0.5, 0.5]", [*run, agent.format("levels: [0.5, 0.5]")]),
+        ("nearest: 1000", [*run, agent.format("nearest: 1000")]),
+        ("explorer delta: -1", [*run, agent.format("explorer: {delta: -1}")]),
+        ("explorer delta: .nan", [*run, agent.format("explorer: {delta: .nan}")]),
+        ("controlled_joints: []", [*run, "{robot: {controlled_joints: []}}"]),
+        ("an unknown contact_model", [*run, "{mover: !Dynamic {plant_config: {contact_model: bogus}}}"]),
+        ("an unknown integration_scheme", [*run, "{simulator_config: {integration_scheme: bogus}}"]),
+        ("time_step: 1e-9", [*run, "{time_step: 1e-9}"]),
+        ("target_realtime_rate: 1e-6", [*run, "{simulator_config: {target_realtime_rate: 1e-6}}"]),
+        ("a key given twice", [*run, "{duration: 1, duration: 2}"]),
+        ("an object at 1e300 m", [*run, "{objects: [{name: b, shape: !Sphere {radius: 0.1}, position: [1e300, 0, 0]}]}"]),
+        ("max_step_size: -1", [*run, "{simulator_config: {max_step_size: -1}}"]),
+        ("--set ''", [*run, ""]),
+        ("--record ''", ["run", "reach_around_ball", "--record", ""]),
+        ("--checkpoint ''", ["run", "reach_around_ball", "--checkpoint", ""]),
+        ("bench forces --amplitude 5", ["bench", "forces", "--amplitude", "5"]),
+        ("bench forces --plot into a file", ["bench", "forces", "--plot", str(folder / "notes.txt" / "x.png")]),
+        ("ch8 --stages 2 2", ["experiment", "ch8", "--stages", "2", "2"]),
+        ("ch8 --report-only on a missing folder", ["experiment", "ch8", "--report-only", "--output", str(folder / "missing")]),
+        ("trm into a user's folder", ["experiment", "trm", "--output", str(thesis_folder)]),
+        ("saggriac --analyse-only into a user's folder", ["experiment", "saggriac", "--analyse-only", "--output", str(thesis_folder)]),
+    ]  # fmt: skip
+
+
+# The trials that are legitimate uses (they should run, exit 0); every other one is a mistake.
+VALID = {
+    "a run to 3 s with a checkpoint",
+    "the same run again (finished)",
+    "resume with the same configuration, longer",
+    "saggriac smoke battery",
+    "robot file: ISO-8859-1, declared (valid)",
+    "robot file: 20,000 markers (valid)",
+}
+HANG_SECONDS = 120
+
+
+def Verdict(what: str, code: int | None, output: str) -> str:
+    """What a trial ended in (the module's tally: clear, unclear, traceback, silent, hang,
+    valid); ``code`` None: it did not end."""
+    lines = output.strip().splitlines()
+    if code is None:
+        return "hang"
+    if "Traceback" in output:
+        return "traceback"
+    if what in VALID:
+        return "valid" if code == 0 else "unclear"
+    if code == 0:
+        return "silent"
+    one_line = len([line for line in lines if "error:" in line]) == 1
+    return "clear" if one_line and "error:" in (lines[-1] if lines else "") else "unclear"
+
+
 def main() -> None:
-    folder = pathlib.Path(sys.argv[1] if len(sys.argv) > 1 else tempfile.mkdtemp())
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--folder", help="where to make the trials' files")
+    parser.add_argument("--doc", help="rewrite this doc's generated bad-input table and tally")
+    args = parser.parse_args()
+    folder = pathlib.Path(args.folder or tempfile.mkdtemp())
     folder.mkdir(parents=True, exist_ok=True)
-    print("| tried | exit code | last line |")
-    print("|---|---:|---|")
-    for what, args in Trials(folder):
-        done = subprocess.run(
-            [sys.executable, "-m", "mobee_drake.cli", *args],
-            capture_output=True,
-            text=True,
-            timeout=600,
-        )
-        lines = (done.stdout + done.stderr).strip().splitlines()
-        last = lines[-1] if lines else ""
-        if "Traceback" in done.stderr:
-            last = "TRACEBACK: " + last
-        print(f"| {what} | {done.returncode} | {last.replace('|', '/')[:150]} |", flush=True)
+    rows = ["| tried | exit code | verdict | last line |", "|---|---:|---|---|"]
+    print("\n".join(rows))
+    tally = collections.Counter()
+    for what, args_ in Trials(folder):
+        try:
+            done = subprocess.run(
+                [sys.executable, "-m", "mobee_drake.cli", *args_],
+                capture_output=True,
+                text=True,
+                timeout=HANG_SECONDS,
+            )
+            code, output = done.returncode, done.stdout + done.stderr
+        except subprocess.TimeoutExpired:
+            code, output = None, ""
+        verdict = Verdict(what, code, output)
+        tally[verdict] += 1
+        lines = output.strip().splitlines()
+        last = (lines[-1] if lines else "").replace("|", "/")[:150]
+        rows.append(f"| {what} | {code if code is not None else '-'} | {verdict} | {last} |")
+        print(rows[-1], flush=True)
+    kinds = ("clear", "unclear", "traceback", "silent", "hang", "valid")
+    summary = (
+        "| "
+        + " | ".join(kinds)
+        + " |\n|"
+        + "---:|" * len(kinds)
+        + "\n| "
+        + " | ".join(str(tally[k]) for k in kinds)
+        + " |\n"
+    )
+    print("\n" + summary)
+    if args.doc:
+        command = "python scripts/try_bad_inputs.py --doc " + args.doc
+        WriteGeneratedTable(args.doc, "bad-input tally", command, summary)
+        WriteGeneratedTable(args.doc, "bad inputs", command, "\n".join(rows) + "\n")
 
 
 if __name__ == "__main__":
