@@ -98,6 +98,17 @@ class TestMistakes(unittest.TestCase):
             (["run", "reach_around_ball", "--checkpoint", ""], "--checkpoint: must be a non-empty"),
             (["bench", "forces", "--amplitude", "5"], "--amplitude: must be a number in (0, 1]"),
             (["experiment", "ch8", "--stages", "2", "2"], "--stages must differ from each other"),
+            # Issue 31, item 8: ch8-discounting's flags ended in tracebacks.
+            (["experiment", "ch8-discounting", "--model", "m", "--gamma", "1.5"], "--gamma: must"),
+            (["experiment", "ch8-discounting", "--model", "m", "--units", "0"], "--units: must"),
+            (
+                ["experiment", "ch8-discounting", "--model", "m", "--misses", "0.3", "0.1"],
+                "--misses: the first must be the smaller",
+            ),
+            (
+                ["experiment", "ch8-discounting", "--model", "m", "--runs", "/no/such.json"],
+                "--runs: /no/such.json is not a file",
+            ),
             (["bench", "forces", "--plot", "README.md/x.png"], "--plot README.md/x.png: cannot be"),
             (
                 ["experiment", "ch8", "--report-only", "--output", "/missing/ch8"],

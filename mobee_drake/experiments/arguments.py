@@ -35,6 +35,11 @@ def Fraction(text: str) -> float:
     return _Checked(text, float, lambda v: 0 < v <= 1, "a number in (0, 1]")
 
 
+def Discount(text: str) -> float:
+    """A discount factor in [0, 1)."""
+    return _Checked(text, float, lambda v: 0 <= v < 1, "a number in [0, 1)")
+
+
 def NonEmpty(text: str) -> str:
     """A non-empty text (a path: an empty one would be silently ignored)."""
     return _Checked(text, str, bool, "a non-empty path")

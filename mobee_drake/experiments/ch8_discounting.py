@@ -18,6 +18,7 @@ import numpy as np
 
 from mobee_drake.experiments.arguments import (
     CommandParser,
+    Discount,
     NonNegativeInt,
     PositiveFloat,
     PositiveInt,
@@ -54,19 +55,29 @@ def ReachMisses(space, force: float, states, problems: np.ndarray, radius: float
 def main(argv=None) -> None:
     parser = CommandParser(prog="mobee-drake experiment ch8-discounting", description=__doc__)
     parser.add_argument("--model", required=True, help="the MDP's folder (runs/mdp_tries5/model)")
-    parser.add_argument("--gamma", type=float, default=0.9, help="the discount factor")
+    parser.add_argument(
+        "--gamma", type=Discount, default=0.9, help="the discount factor, in [0, 1)"
+    )
     parser.add_argument(
         "--favourites",
-        type=int,
+        type=NonNegativeInt,
         nargs="+",
         default=[57, 77],
         help="the favourite pre-reach states (the source's reaches 489 and 509)",
     )
     parser.add_argument(
-        "--misses", type=float, nargs=2, default=[0.01, 0.33], help="the misses' range in m"
+        "--misses",
+        type=PositiveFloat,
+        nargs=2,
+        default=[0.01, 0.33],
+        help="the misses' range in m (the first the smaller)",
     )
     parser.add_argument(
-        "--units", type=float, nargs="+", default=[1.0, 0.1, 0.03, 0.01], help="distance units (m)"
+        "--units",
+        type=PositiveFloat,
+        nargs="+",
+        default=[1.0, 0.1, 0.03, 0.01],
+        help="distance units (m)",
     )
     parser.add_argument(
         "--runs",
@@ -87,11 +98,18 @@ def main(argv=None) -> None:
     parser.add_argument("--probe-problems", type=PositiveInt, default=9, help="problems drawn")
     parser.add_argument("--seed", type=NonNegativeInt, default=0, help="seed of the draws")
     args = parser.parse_args(argv)
+    if args.misses[0] >= args.misses[1]:
+        parser.error(f"--misses: the first must be the smaller, got {args.misses}")
+    for path in args.runs:  # (checked before any work)
+        if not pathlib.Path(path).is_file():
+            parser.error(f"--runs: {path} is not a file")
     try:
         model = LoadAgentModel(args.model, AGENT, ExplorerConfig())
     except (OSError, ValueError) as error:
         parser.error(f"--model: {error}")
     space, counts = model.space, model.transitions.counts
+    if any(s >= space.num_states for s in args.favourites):
+        parser.error(f"--favourites: states are 0..{space.num_states - 1}, got {args.favourites}")
     learner = ReachLearner(
         space, counts, np.zeros((1, 3)), ReachLearningConfig(gamma=args.gamma, delta=1e-10)
     )
