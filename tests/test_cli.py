@@ -98,6 +98,10 @@ class TestMistakes(unittest.TestCase):
             (["run", "reach_around_ball", "--checkpoint", ""], "--checkpoint: must be a non-empty"),
             (["bench", "forces", "--amplitude", "5"], "--amplitude: must be a number in (0, 1]"),
             (["experiment", "ch8", "--stages", "2", "2"], "--stages must differ from each other"),
+            # Issue 31, item 8: bench simulation's values ended in tracebacks.
+            (["bench", "simulation", "--seconds", "0.5"], "--seconds: the timing leaves out"),
+            (["bench", "simulation", "--scenario", "nonexistent"], "nonexistent: no such file"),
+            (["bench", "simulation", "--controls", "bogus"], "--controls: invalid choice"),
             # Issue 31, item 8: ch8-discounting's flags ended in tracebacks.
             (["experiment", "ch8-discounting", "--model", "m", "--gamma", "1.5"], "--gamma: must"),
             (["experiment", "ch8-discounting", "--model", "m", "--units", "0"], "--units: must"),

@@ -21,7 +21,7 @@ import time
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat
 from mobee_drake.experiments.bench_forces import BuildPosedScene, FloorEvaluation
 from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario, Scenario
-from mobee_drake.station.config import DataLog
+from mobee_drake.station.config import CONTROL_MODALITIES, DataLog
 from mobee_drake.station.world_events import MakeSimulator
 
 SCENARIO = "motor_babbling"
@@ -69,11 +69,15 @@ def main(argv=None) -> None:
         description=__doc__,
     )
     parser.add_argument(
-        "--seconds", type=PositiveFloat, default=600.0, help="simulated time per run"
+        "--seconds",
+        type=PositiveFloat,
+        default=600.0,
+        help="simulated time per run (more than the 1 s the timing leaves out)",
     )
     parser.add_argument(
         "--controls",
         nargs="*",
+        choices=CONTROL_MODALITIES,
         default=["position"],
         help="dynamic-robot modalities to run (none: kinematic only)",
     )
@@ -81,7 +85,17 @@ def main(argv=None) -> None:
         "--scenario", default=str(SCENARIO), help="the scenario run (a file or a shipped name)"
     )
     args = parser.parse_args(argv)
-    kinematic = LoadScenario(args.scenario, f"{{mover: !Kinematic {{}}, duration: {args.seconds}}}")
+    if args.seconds <= 1.0:
+        parser.error(
+            f"--seconds: the timing leaves out the first second: give more than 1, got "
+            f"{args.seconds:g}"
+        )
+    try:  # (a user's scenario: checked before any work)
+        kinematic = LoadScenario(
+            args.scenario, f"{{mover: !Kinematic {{}}, duration: {args.seconds}}}"
+        )
+    except ValueError as error:
+        parser.error(f"--scenario: {error}")
     period, floor = ControlPeriodAndFloor(kinematic)
     print(
         f"kinematic robot, one control period of {kinematic.time_step * 1000:g} ms: "
