@@ -160,6 +160,11 @@ def Trials(folder: pathlib.Path) -> list[tuple[str, list[str]]]:
 
 def _Issue31Trials(folder: pathlib.Path, thesis_folder: pathlib.Path) -> list:
     """The reproductions of issue 31 (each was a traceback, silent or a hang)."""
+    objects = "".join(
+        f"  - {{name: b{i}, shape: !Sphere {{radius: 0.01}}, position: [-2, 0, {i * 0.03:.2f}]}}\n"
+        for i in range(2001)
+    )
+    (folder / "many_objects.yaml").write_text("objects:\n" + objects)
     run = ["run", "reach_around_ball", "--no-meshcat", "--no-log", "--duration", "0.1", "--set"]
     agent = "{{attractor: !ExploreAttractor {{agents: [{{name: a, joints: [r_elbow], {}}}]}}}}"
     return [
@@ -186,6 +191,14 @@ def _Issue31Trials(folder: pathlib.Path, thesis_folder: pathlib.Path) -> list:
         ("ch8 --report-only on a missing folder", ["experiment", "ch8", "--report-only", "--output", str(folder / "missing")]),
         ("trm into a user's folder", ["experiment", "trm", "--output", str(thesis_folder)]),
         ("saggriac --analyse-only into a user's folder", ["experiment", "saggriac", "--analyse-only", "--output", str(thesis_folder)]),
+        ("ch8-discounting --gamma 1.5", ["experiment", "ch8-discounting", "--model", "m", "--gamma", "1.5"]),
+        ("ch8-discounting --units 0", ["experiment", "ch8-discounting", "--model", "m", "--units", "0"]),
+        ("ch8-discounting --misses 0.3 0.1", ["experiment", "ch8-discounting", "--model", "m", "--misses", "0.3", "0.1"]),
+        ("ch8-discounting --runs of a missing file", ["experiment", "ch8-discounting", "--model", "m", "--runs", str(folder / "no.json")]),
+        ("bench simulation --seconds 0.5", ["bench", "simulation", "--seconds", "0.5"]),
+        ("bench simulation --scenario nonexistent", ["bench", "simulation", "--scenario", "nonexistent"]),
+        ("bench simulation --controls bogus", ["bench", "simulation", "--controls", "bogus"]),
+        ("2,001 objects", ["run", str(folder / "many_objects.yaml")]),
     ]  # fmt: skip
 
 
