@@ -14,6 +14,7 @@ import tempfile
 import unittest
 
 import numpy as np
+from pydrake.multibody.tree import JacobianWrtVariable
 
 from mobee_drake.experiments import bench_safety
 from mobee_drake.experiments.bench_safety import MOVERS, PRESETS, SCENES, BabblingRun, SceneRun
@@ -172,6 +173,51 @@ class TestStepModels(unittest.TestCase):
                 error = np.abs(predicted - moved).max()
                 self.assertLess(error, 0.01 * np.abs(moved).max())
                 self.assertLess(10 * error, np.abs(h * x[n:] - moved).max())
+
+
+class TestLeverBounds(unittest.TestCase):
+    def test_no_point_of_a_solid_outruns_its_bound_in_any_posture(self):
+        """mobee/levers.py: the bound over every configuration of how fast each solid's points
+        move per unit speed of each joint, against the iCub's Jacobians at 30 random postures
+        (every box corner, capsule end and sphere centre, plus its radius turned)."""
+        station = BuildScenario(LoadScenario("reach_around_ball", "{objects: []}"))
+        mobee, plant, robot = station.mobee, station.plant, station.robot
+        support = mobee._support  # (MoBeE's; its bounds are what this checks)
+        n = len(mobee.joints)
+        bounds = np.array([support.Lookahead(np.eye(n)[j]) for j in range(n)]).T  # (G, n)
+        columns = [plant.GetJointByName(j).velocity_start() for j in mobee.joints]
+        primitives = {p.name: p for p in robot.overlay.primitives}
+        context = plant.CreateDefaultContext()
+        lower, upper = mobee.position_limits
+        rng = np.random.default_rng(0)
+        closest = np.inf
+        for _ in range(30):
+            for joint, angle in zip(mobee.joints, rng.uniform(lower, upper)):
+                plant.GetJointByName(joint).set_angle(context, angle)
+            for g, geometry in enumerate(robot.field_margins):
+                shape = primitives[robot.geometry_names[geometry]].shape
+                points, radius = _SupportPointsOf(shape)
+                frame = plant.get_frame(robot.geometry_frames[geometry])
+                J = plant.CalcJacobianTranslationalVelocity(
+                    context, JacobianWrtVariable.kV, frame, points.T, plant.world_frame(),
+                    plant.world_frame(),
+                )[:, columns].reshape(len(points), 3, n)  # fmt: skip
+                speeds = np.linalg.norm(J, axis=1).max(axis=0)
+                speeds += radius * (speeds > 0)  # (the joints that move the solid turn its ball)
+                self.assertTrue(np.all(speeds <= bounds[g] + 1e-9), robot.geometry_names[geometry])
+                closest = min(closest, np.min(bounds[g] - speeds))
+        self.assertLess(closest, 0.05)  # (and not loose everywhere: some posture comes close)
+
+
+def _SupportPointsOf(shape) -> tuple[np.ndarray, float]:
+    """A primitive's corners or end caps (or centre) in its geometry frame, and its radius."""
+    if hasattr(shape, "size"):
+        half = np.asarray(shape.size) / 2
+        return np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * half, 0
+    if hasattr(shape, "start"):
+        length = np.linalg.norm(np.subtract(shape.end, shape.start))
+        return np.array([[0, 0, -length / 2], [0, 0, length / 2]]), shape.radius
+    return np.zeros((1, 3)), shape.radius
 
 
 class TestBarrierParameters(unittest.TestCase):

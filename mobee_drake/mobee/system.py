@@ -167,18 +167,17 @@ class Mobee(LeafSystem):
         self._field_moves = np.vstack([moves, np.zeros(moves.shape[1])])
         # The barrier also watches the support points of each robot solid with a field, and
         # watches pairs as far beyond their fields as the next period may move them.
-        primitives = {p.name: p for p in robot.overlay.primitives}
-        geometry_frames = [
-            plant.get_frame(robot.geometry_frames[g]) for g in self._fields.geometries
-        ]
-        self._support = SupportPoints(
-            plant,
-            [primitives[self._geometry_names[g]] for g in self._fields.geometries],
-            field_bodies,
-            [f.GetFixedPoseInBodyFrame().GetAsMatrix4() for f in geometry_frames],
-            self._screws,
-            self._field_moves,
-        )
+        if self._barrier:
+            primitives = {p.name: p for p in robot.overlay.primitives}
+            frames = [plant.get_frame(robot.geometry_frames[g]) for g in self._fields.geometries]
+            self._support = SupportPoints(
+                plant,
+                [primitives[self._geometry_names[g]] for g in self._fields.geometries],
+                field_bodies,
+                [f.GetFixedPoseInBodyFrame().GetAsMatrix4() for f in frames],
+                self._screws,
+                self._field_moves,
+            )
         self._markers, self._marker_bodies = controlled.markers, controlled.marker_bodies
         self._marker_moves = self._screws.Moves(
             np.array([int(b.index()) for b in self._marker_bodies], dtype=int)
