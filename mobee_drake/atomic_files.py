@@ -13,6 +13,7 @@ are ignored, and cleared by the next write.
 """
 
 import contextlib
+import glob
 import json
 import os
 import pathlib
@@ -41,6 +42,9 @@ def WriteFileAtomically(path: str | pathlib.Path, write) -> None:
     except BaseException:
         pathlib.Path(staging).unlink(missing_ok=True)
         raise
+    # What a kill left of earlier writes of this file (one writer a file: folders are locked).
+    for leftover in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"):
+        leftover.unlink(missing_ok=True)
 
 
 def WriteTextAtomically(path: str | pathlib.Path, text: str) -> None:

@@ -20,7 +20,7 @@ from battery_jobs import Count, StopWalk
 import numpy as np
 
 from mobee_drake import cli
-from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration
+from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration, WriteJsonAtomically
 from mobee_drake.experiments import ch7_model_learning, saggriac
 from mobee_drake.experiments.battery import InProcess, Job, RunBattery
 from mobee_drake.experiments.ch7_model_learning import Stop
@@ -92,6 +92,18 @@ class TestGenerations(TemporaryFolder):
     def test_an_empty_folder_holds_no_generation(self):
         self.assertIsNone(CurrentGeneration(self.folder / "none"))
         self.assertIsNone(CurrentGeneration(self.folder))
+
+
+class TestAtomicFiles(TemporaryFolder):
+    def test_what_a_killed_write_left_goes_with_the_next_write(self):
+        """Issue 31, item 11: a killed worker left ``.progress.json.*.tmp`` files for good."""
+        (self.folder / ".progress.json.k1ll3d.tmp").write_text("{")
+        (self.folder / ".other.json.k1ll3d.tmp").write_text("{")  # another file's: kept
+        WriteJsonAtomically(self.folder / "progress.json", {"done": 3})
+        self.assertEqual(
+            sorted(p.name for p in self.folder.iterdir()),
+            [".other.json.k1ll3d.tmp", "progress.json"],
+        )
 
 
 class TestOwnedFolders(TemporaryFolder):
