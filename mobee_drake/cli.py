@@ -4,9 +4,7 @@ import argparse
 import importlib
 import logging
 import pathlib
-import signal
 import sys
-import threading
 
 import numpy as np
 from pydrake.geometry import StartMeshcat
@@ -16,7 +14,7 @@ from pydrake.systems.framework import DiagramBuilder
 from mobee_drake import __version__
 from mobee_drake.atomic_files import WriteJsonAtomically
 from mobee_drake.experiments.arguments import CommandParser, NonEmpty, PositiveFloat
-from mobee_drake.experiments.battery import BatteryError, BatteryRefused
+from mobee_drake.experiments.battery import BatteryError, BatteryRefused, TerminationInterrupts
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.owned_folders import CanWrite, FolderError
 from mobee_drake.resources import ScenarioNames
@@ -233,10 +231,6 @@ def _Info(args: list[str]) -> None:
 COMMANDS = {"bench": _Bench, "experiment": _Experiment, "info": _Info, "run": _Run}
 
 
-def _Terminated(signum, frame):
-    raise KeyboardInterrupt
-
-
 def main(argv: list[str] | None = None) -> None:
     argv = sys.argv[1:] if argv is None else argv
     parser = CommandParser(
@@ -252,15 +246,14 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("command", choices=sorted(COMMANDS), help="what to do")
     parser.add_argument("args", nargs=argparse.REMAINDER, help="the command's own arguments")
     known = parser.parse_args(argv)
-    if threading.current_thread() is threading.main_thread():  # (signals reach only it)
-        signal.signal(signal.SIGTERM, _Terminated)  # one line and exit code 130, as Ctrl-C
     global _debug
     _debug = known.debug
     level = logging.DEBUG if known.verbose else logging.WARNING if known.quiet else logging.INFO
     logging.basicConfig(level=level, format="%(levelname)s:%(name)s:%(message)s")
     logging.getLogger("drake").setLevel(level)
     try:
-        COMMANDS[known.command](known.args)
+        with TerminationInterrupts():  # SIGTERM: one line and exit code 130, as Ctrl-C
+            COMMANDS[known.command](known.args)
     except KeyboardInterrupt:
         # The workers are gone with the battery; runs resume from their last checkpoint.
         print(

@@ -384,7 +384,7 @@ def _Terminate(signum, frame):
 
 
 @contextlib.contextmanager
-def _TerminationRaises():
+def TerminationInterrupts():
     """SIGTERM raises KeyboardInterrupt in the main thread while the context lasts."""
     if threading.current_thread() is not threading.main_thread():
         yield
@@ -539,7 +539,7 @@ def _RunJobs(
     errors = {}
     display = _Display(output, len(jobs), len(jobs) - len(queue), description, progress)
     try:
-        with _TerminationRaises(), backend.Session() as submit:
+        with TerminationInterrupts(), backend.Session() as submit:
             running = {}
             while queue or running:
                 while queue and len(running) < backend.capacity:

@@ -73,9 +73,13 @@ class SafetyMonitor(LeafSystem):
             return  # Nothing to record: the state (which Drake passes in) stays as it is.
         x = context.get_discrete_state(self._state).value().copy()
         x[n + 2] += barrier
-        if not len(pairs):
-            discrete_state.get_mutable_vector(self._state).SetFromVector(x)
-            return
+        if len(pairs):
+            self._RecordPairs(context, pairs, x)
+        discrete_state.get_mutable_vector(self._state).SetFromVector(x)
+
+    def _RecordPairs(self, context, pairs, x: np.ndarray) -> None:
+        """The pairs' closest approaches and penetration into the state vector ``x``."""
+        n = len(self._names)
         inspector = self._query_port.Eval(context).inspector()
         for geometry_id, distance, robot in zip(pairs.geometry_B, pairs.distance, pairs.b_is_robot):
             i = (
@@ -88,7 +92,6 @@ class SafetyMonitor(LeafSystem):
         if deepest_now > 0:
             x[n] += 1
             x[n + 1] = max(x[n + 1], deepest_now)
-        discrete_state.get_mutable_vector(self._state).SetFromVector(x)
 
     def Report(self, context) -> SafetyReport:
         x = context.get_discrete_state(self._state).value()
