@@ -39,6 +39,9 @@ def WriteFileAtomically(path: str | pathlib.Path, write) -> None:
         write(staging)
         os.chmod(staging, 0o666 & ~_Umask())  # As open() would have made it (mkstemp: 0o600).
         os.replace(staging, path)
+    except OSError as error:  # (named by the file meant, not the staging file or nothing)
+        pathlib.Path(staging).unlink(missing_ok=True)
+        raise OSError(error.errno, error.strerror, str(path)) from error
     except BaseException:
         pathlib.Path(staging).unlink(missing_ok=True)
         raise

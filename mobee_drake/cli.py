@@ -30,12 +30,25 @@ from mobee_drake.station.viewer import RecordingMeshcat
 _debug = False
 
 
+# The longest error line shown: a message quoting a huge value (a 10 MB key in a file) is cut.
+MAX_ERROR_LINE = 1000
+
+
+def _PrintError(message: str) -> None:
+    """``error: message`` on stderr, on one line of at most about :data:`MAX_ERROR_LINE`."""
+    message = message.replace("\n", " ")
+    if len(message) > MAX_ERROR_LINE:
+        cut = len(message) - MAX_ERROR_LINE
+        message = f"{message[: MAX_ERROR_LINE - 200]} [... {cut:,} characters ...] {message[-200:]}"
+    print(f"error: {message}", file=sys.stderr)
+
+
 def _Fail(message: str) -> None:
     """Ends the command on a user's mistake: one line on stderr, exit code 2 (with ``--debug``,
     the exception being handled is raised again, with its traceback)."""
     if _debug and sys.exc_info()[1] is not None:
         raise
-    print(f"error: {message}", file=sys.stderr)
+    _PrintError(message)
     sys.exit(2)
 
 
@@ -171,6 +184,7 @@ def _Bench(args: list[str]) -> None:
         {
             "babbling": "mobee_drake.experiments.bench_babbling",
             "forces": "mobee_drake.experiments.bench_forces",
+            "objects": "mobee_drake.experiments.bench_objects",
             "ik": "mobee_drake.experiments.bench_ik",
             "reactive": "mobee_drake.experiments.bench_reactive",
             "safety": "mobee_drake.experiments.bench_safety",
@@ -262,17 +276,16 @@ def main(argv: list[str] | None = None) -> None:
         )
         sys.exit(130)
     except OSError as e:  # A full disk, a folder gone: the machine's, not the run's, fault.
-        print(f"error: {e}", file=sys.stderr)
+        _PrintError(f"{e.filename}: {e.strerror}" if e.filename and e.strerror else str(e))
         sys.exit(1)
     except BatteryError as e:  # (--debug: the traceback) One line: how many, the first, resume.
         if _debug:
             raise
         count, *failures = str(e).splitlines()
         more = f" (and {len(failures) - 1} more)" if len(failures) > 1 else ""
-        print(
-            f"error: {count} {failures[0] if failures else ''}{more}; the others' results are "
-            "kept: run the same command again to resume",
-            file=sys.stderr,
+        _PrintError(
+            f"{count} {failures[0] if failures else ''}{more}; the others' results are "
+            "kept: run the same command again to resume"
         )
         sys.exit(1)
 

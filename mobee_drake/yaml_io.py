@@ -21,6 +21,9 @@ import typing
 from pydrake.common.yaml import yaml_load_typed
 import yaml
 
+# libyaml's parser where PyYAML was built with it (its wheels are), for speed; the same events.
+_SafeLoader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
 
 class YamlFileError(ValueError):
     """A YAML file that does not match its schema; the message names the file and line."""
@@ -44,7 +47,7 @@ def CheckYamlStructure(text: str, source: str) -> None:
     open_nodes: list[list] = []  # [anchor, node count so far] of each open collection
     repeated = 0
     mappings: list = []  # per open collection: [next is a key, keys seen], None for a sequence
-    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+    for event in _Events(text, source):
         line = event.start_mark.line + 1
         if isinstance(event, yaml.NodeEvent) and mappings and mappings[-1] is not None:
             _CheckKey(mappings[-1], event, f"{source}:{line}")
@@ -75,6 +78,19 @@ def CheckYamlStructure(text: str, source: str) -> None:
             open_nodes[-1][1] += size
 
 
+def _Events(text: str, source: str):
+    """The parser's events of ``text``; libyaml's own depth limit (deeper than ours) reported
+    as ours."""
+    try:
+        yield from yaml.parse(text, Loader=_SafeLoader)
+    except yaml.MarkedYAMLError as error:
+        if "nesting depth" not in str(error.problem):
+            raise
+        raise YamlFileError(
+            f"{source}:{error.problem_mark.line + 1}: nested deeper than {MAX_YAML_DEPTH} levels"
+        ) from None
+
+
 def _CheckKey(mapping: list, event: yaml.NodeEvent, where: str) -> None:
     """``mapping``'s next node ``event``: a key (refused if it was given before) or a value."""
     if mapping[0] and isinstance(event, yaml.ScalarEvent):
@@ -90,7 +106,7 @@ def LineOf(text: str, names: list[str]) -> int | None:
     if not quoted:
         return None
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        root = yaml.compose(text, Loader=_SafeLoader)
     except yaml.YAMLError:
         return None
     stack = [root] if root is not None else []
@@ -117,7 +133,12 @@ def LoadYamlFile(*, schema, filename, child_name: str | None = None, defaults=No
     """
     path = pathlib.Path(filename)
     if not path.is_file():
-        raise YamlFileError(f"{path}: no such file")
+        what = "no such file"
+        if path.exists():
+            what = (
+                "a folder, not a file" if path.is_dir() else "not a regular file (a pipe or device)"
+            )
+        raise YamlFileError(f"{path}: {what}")
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError:
@@ -148,11 +169,11 @@ def LoadYamlFile(*, schema, filename, child_name: str | None = None, defaults=No
         raise YamlFileError(f"{where}: {e}") from e
 
 
-class _TaggedLoader(yaml.SafeLoader):
+class _TaggedLoader(_SafeLoader):
     """Reads YAML that Drake's ``yaml_dump_typed`` wrote, a tagged value as ``{"!Tag": value}``."""
 
 
-def _Tagged(loader: yaml.SafeLoader, suffix: str, node: yaml.Node):
+def _Tagged(loader: _SafeLoader, suffix: str, node: yaml.Node):
     if isinstance(node, yaml.MappingNode):
         return {"!" + suffix: loader.construct_mapping(node, deep=True)}
     if isinstance(node, yaml.SequenceNode):

@@ -6,7 +6,8 @@ the last line it printed) as a markdown table, then the tally:
 
 - *clear*: a bad input refused with one line beginning ``error:`` (or the parser's
   ``...: error:``) and a non-zero exit code;
-- *unclear*: refused otherwise (several lines, no ``error:``);
+- *unclear*: refused otherwise (several lines, no ``error:``, a line of more than
+  :data:`MAX_LINE` characters);
 - *traceback*: a Python traceback;
 - *silent*: a bad input that ran and exited 0;
 - *hang*: no end within two minutes;
@@ -19,6 +20,7 @@ generated table and tally). A few minutes: each trial starts the command afresh.
 
 import argparse
 import collections
+import os
 import pathlib
 import subprocess
 import sys
@@ -165,6 +167,8 @@ def _Issue31Trials(folder: pathlib.Path, thesis_folder: pathlib.Path) -> list:
         for i in range(2001)
     )
     (folder / "many_objects.yaml").write_text("objects:\n" + objects)
+    os.mkfifo(folder / "fifo.yaml")
+    (folder / "huge.yaml").write_text("duration: " + "x" * 10_000_000 + "\n")
     run = ["run", "reach_around_ball", "--no-meshcat", "--no-log", "--duration", "0.1", "--set"]
     agent = "{{attractor: !ExploreAttractor {{agents: [{{name: a, joints: [r_elbow], {}}}]}}}}"
     return [
@@ -199,6 +203,18 @@ def _Issue31Trials(folder: pathlib.Path, thesis_folder: pathlib.Path) -> list:
         ("bench simulation --scenario nonexistent", ["bench", "simulation", "--scenario", "nonexistent"]),
         ("bench simulation --controls bogus", ["bench", "simulation", "--controls", "bogus"]),
         ("2,001 objects", ["run", str(folder / "many_objects.yaml")]),
+        ("--ray with an address nobody answers", ["experiment", "saggriac", "--smoke", "--output", str(folder / "ray"), "--ray", "127.0.0.1:1"]),
+        ("--ray with no address format", ["experiment", "saggriac", "--smoke", "--output", str(folder / "ray"), "--ray", "bogus"]),
+        ("saggriac --smoke with --budget-exp1", ["experiment", "saggriac", "--smoke", "--budget-exp1", "600", "--output", str(folder / "s1")]),
+        ("saggriac --checkpoints beyond the budget", ["experiment", "saggriac", "--experiments", "1", "--budget-exp1", "100", "--checkpoints", "500", "--output", str(folder / "s2")]),
+        ("ch8 --reach-force 1e300", ["experiment", "ch8", "--reach-force", "1e300", "--output", str(folder / "c1")]),
+        ("ch8 --distance-unit 1e-300", ["experiment", "ch8", "--distance-unit", "1e-300", "--output", str(folder / "c2")]),
+        ("ch8 --output a file", ["experiment", "ch8", "--output", str(folder / "notes.txt")]),
+        ("ch7 --output a file", ["experiment", "ch7", "--experiment", "7.1", "--output", str(folder / "notes.txt")]),
+        ("an unknown controlled joint", [*run, "{robot: {controlled_joints: [nope]}}"]),
+        ("a folder as the scenario", ["run", str(thesis_folder)]),
+        ("a FIFO as the scenario", ["run", str(folder / "fifo.yaml")]),
+        ("a 10 MB value in a scenario file", ["run", str(folder / "huge.yaml")]),
     ]  # fmt: skip
 
 
@@ -212,6 +228,8 @@ VALID = {
     "robot file: 20,000 markers (valid)",
 }
 HANG_SECONDS = 120
+# An error line longer than this is unclear (nobody reads a 10 MB line).
+MAX_LINE = 2000
 
 
 def Verdict(what: str, code: int | None, output: str) -> str:
@@ -227,7 +245,8 @@ def Verdict(what: str, code: int | None, output: str) -> str:
     if code == 0:
         return "silent"
     one_line = len([line for line in lines if "error:" in line]) == 1
-    return "clear" if one_line and "error:" in (lines[-1] if lines else "") else "unclear"
+    last = lines[-1] if lines else ""
+    return "clear" if one_line and "error:" in last and len(last) <= MAX_LINE else "unclear"
 
 
 def main() -> None:

@@ -3,6 +3,7 @@ workers import them by name (with ``tests/`` on their PYTHONPATH); and the batte
 tests run in a process of their own (:func:`Main`, run as
 ``python -c "import battery_jobs; battery_jobs.Main(...)"`` so that its jobs are this module's)."""
 
+import errno
 import json
 import os
 import pathlib
@@ -27,6 +28,13 @@ def Count(run, x: int, calls: str) -> dict:
     with open(calls, "a") as stream:
         stream.write(run.path.name + "\n")
     return dict(square=x * x, third=x / 3)
+
+
+def FullDisk(run, calls: str) -> dict:
+    """Appends the run's name to ``calls``, then fails as a write to a full disk does."""
+    with open(calls, "a") as stream:
+        stream.write(run.path.name + "\n")
+    raise OSError(errno.ENOSPC, "No space left on device", str(run.path / "result.json"))
 
 
 def Nan(run) -> dict:

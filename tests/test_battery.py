@@ -17,7 +17,7 @@ import time
 import unittest
 from unittest import mock
 
-from battery_jobs import Count, Nan, Walk
+from battery_jobs import Count, FullDisk, Nan, Walk
 
 from mobee_drake.experiments import saggriac
 from mobee_drake.experiments.battery import (
@@ -96,6 +96,23 @@ class LocalBatteryTest(TemporaryFolder):
             RunBattery(jobs, output, workers=2, progress=False)
         self.assertTrue((output / "runs/fine/result.json").is_file())
         self.assertFalse((output / "runs/bad/result.json").exists())
+
+    def test_a_full_disk_stops_the_queue_at_the_first_failed_write(self):
+        """Issue 31, item 7: on a full disk every queued run was still computed, then lost."""
+        calls = self.folder / "calls"
+        jobs = [Job(f"run{i}", FullDisk, dict(calls=str(calls))) for i in range(6)]
+        for backend in (InProcess(), LocalProcesses(2)):
+            with self.subTest(backend), self.assertRaises(BatteryError) as failed:
+                RunBattery(jobs, self.folder / str(backend), backend=backend, progress=False)
+            # The first failure stops the queue; with two workers, one other may be running.
+            started = Calls(calls)
+            calls.unlink()
+            self.assertLessEqual(len(started), backend.capacity)
+            message = str(failed.exception)
+            self.assertTrue(message.startswith("6 of 6 jobs failed:\n"), message)
+            self.assertRegex(message, r"OSError: \[Errno 28\] No space left on device: '.*"
+                                      r"result.json'")  # fmt: skip
+            self.assertEqual(message.count("NotStarted: not started: [Errno 28]"), 6 - len(started))
 
     def test_bad_jobs_are_refused(self):
         with self.assertRaisesRegex(TypeError, "job 'local'"):

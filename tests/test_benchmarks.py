@@ -5,9 +5,11 @@ import unittest
 
 import numpy as np
 
+from mobee_drake.experiments import bench_objects
 from mobee_drake.experiments.bench_forces import STAGES, MeasureForceEvaluations, MeasureStages
 from mobee_drake.experiments.bench_simulation import ControlPeriodAndFloor
 from mobee_drake.scenario import LoadScenario
+from mobee_drake.station.config import MAX_OBJECTS
 
 
 class TestBenchmarks(unittest.TestCase):
@@ -35,3 +37,25 @@ class TestBenchmarks(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class TestObjectCount(unittest.TestCase):
+    def test_builds_measured_in_their_own_processes_and_the_limit_refused(self):
+        """Issue 31, item 5: ``bench objects`` on 20 boxes and one more than the limit."""
+        table = bench_objects.Table([20, MAX_OBJECTS + 1], cap_bytes=8 * 2**30)
+        header, _, small, large = (line.strip("|").split("|") for line in table.splitlines())
+        self.assertEqual(len(header), 7)
+        floor_seconds, floor_peak, seconds, peak, time_ratio, memory_ratio = map(float, small[1:])
+        # A build's peak is at least an imported pydrake's, and each ratio is its columns' (but
+        # for their rounding to 0.01).
+        self.assertGreater(min(floor_peak, peak), 0.1)
+        rounding = 0.005 / floor_seconds + 0.005 / seconds
+        self.assertAlmostEqual(time_ratio, seconds / floor_seconds, delta=time_ratio * rounding)
+        self.assertAlmostEqual(memory_ratio, peak / floor_peak, delta=0.03)
+        self.assertEqual(large[0].strip(), f"{MAX_OBJECTS + 1:,}")
+        self.assertNotIn("over the cap", large[1])
+        self.assertRegex(large[3], r"refused at load \(\d+\.\d s\)")
+
+    def test_a_process_over_its_cap_is_reported_as_such(self):
+        seconds, peak, error = bench_objects.Measure("floor", 100, cap_bytes=2**28)
+        self.assertEqual(error, "over the cap")

@@ -28,6 +28,7 @@ COMMANDS = [
     ["bench", "ik"],
     ["bench", "babbling"],
     ["bench", "safety"],
+    ["bench", "objects"],
 ]
 
 
@@ -118,6 +119,44 @@ class TestMistakes(unittest.TestCase):
                 ["experiment", "ch8", "--report-only", "--output", "/missing/ch8"],
                 "--report-only: /missing/ch8 is not a folder",
             ),
+            (
+                [
+                    "experiment",
+                    "saggriac",
+                    "--experiments",
+                    "1",
+                    "--budget-exp1",
+                    "100",
+                    "--checkpoints",
+                    "500",
+                ],
+                "--checkpoints 500: more evaluations than experiment 1's budget of 100",
+            ),  # fmt: skip
+            (["experiment", "ch8", "--reach-force", "1e300"], "--reach-force: must be a number in"),
+            (["experiment", "ch8", "--distance-unit", "1e-300"], "--distance-unit: must be a num"),
+            (["run", "tests"], "tests: a folder, not a file"),
+            (["experiment", "ch8", "--output", "README.md"], "README.md: is a file, not a folder"),
+            (
+                ["experiment", "ch7", "--experiment", "7.1", "--output", "README.md"],
+                "README.md: is a file, not a folder",
+            ),
+            # Issue 31, item 8: a bad --ray address hung for minutes.
+            (
+                ["experiment", "ch8", "--ray", "127.0.0.1:1"],
+                "no Ray cluster answers at 127.0.0.1:1",
+            ),
+            (["experiment", "ch8", "--ray", "bogus"], "--ray: must be auto or [ray://]host:port"),
+            (
+                [
+                    "run",
+                    "reach_around_ball",
+                    "--no-meshcat",
+                    "--no-log",
+                    "--set",
+                    "{robot: {controlled_joints: [nope]}}",
+                ],
+                "robot (the iCub model iCubGazeboV2_5): unknown joint 'nope'",
+            ),  # fmt: skip
         ):
             with self.subTest(args):
                 code, _, err = _Call(*args)
@@ -141,6 +180,29 @@ class TestMistakes(unittest.TestCase):
             "error: 2 of 5 jobs failed: random_seed0: BrokenProcessPool: a worker died (and 1 "
             "more); the others' results are kept: run the same command again to resume\n",
         )
+
+    def test_a_machine_fault_names_the_file(self):
+        """Issue 31, item 11: ``[Errno 28]`` without a path."""
+
+        def FullDisk(args):
+            raise OSError(28, "No space left on device", "/results/runs/a/result.json")
+
+        with mock.patch.dict(cli.COMMANDS, {"experiment": FullDisk}):
+            code, _, err = _Call("experiment", "ch8")
+        self.assertEqual((code, err), (1, "error: /results/runs/a/result.json: No space left on "
+                                          "device\n"))  # fmt: skip
+
+    def test_a_huge_value_is_cut_in_the_error_line(self):
+        """Issue 31, item 11: a 10 MB value in a file made a 10 MB error line."""
+        with tempfile.TemporaryDirectory() as folder:
+            scenario = pathlib.Path(folder) / "huge.yaml"
+            scenario.write_text("duration: " + "x" * 2_000_000 + "z\n")
+            code, _, err = _Call("run", str(scenario))
+        self.assertEqual(code, 2)
+        self.assertEqual(len(err.splitlines()), 1)
+        self.assertLess(len(err), cli.MAX_ERROR_LINE + 100)
+        self.assertIn("huge.yaml:1: could not convert string to float: 'xxx", err)
+        self.assertRegex(err, r"\[\.\.\. 1,99\d,\d{3} characters \.\.\.\] x+z'")
 
     def test_debug_shows_the_traceback(self):
         with self.assertRaisesRegex(ValueError, "unknown iCub model"):

@@ -1,7 +1,11 @@
 """The data log of a run (station/data_log.py) and the recording's world (station/viewer.py)."""
 
 import pathlib
+import signal
+import subprocess
+import sys
 import tempfile
+import time
 import unittest
 
 import numpy as np
@@ -164,6 +168,33 @@ class TestDataLog(unittest.TestCase):
             checkpoint=str(checkpoint),
         )
         self.AssertIsTheWholeRun(path)
+
+    def test_a_run_killed_at_random_points_logs_the_uninterrupted_run_row_for_row(self):
+        """Issue 31, item 2: ``run --checkpoint --log`` SIGKILLed three times, each a random
+        0-50 ms after a random 1-4 more checkpoints (a seeded draw; some kills land inside a
+        checkpoint's write), then run to its end: its log equals an uninterrupted run's in every
+        row and column."""
+        folder = _Folder()
+        command = [sys.executable, "-m", "mobee_drake.cli", "run", "explore_hypercube",
+                   "--duration", "120", "--no-meshcat", "--no-record"]  # fmt: skip
+        subprocess.run([*command, "--log", "whole.parquet"], cwd=folder, check=True,
+                       capture_output=True)  # fmt: skip
+        resumed = [*command, "--log", "resumed.parquet", "--checkpoint", "checkpoint"]
+        rng, done = np.random.default_rng(31), 0
+        for _ in range(3):
+            run = subprocess.Popen(resumed, cwd=folder, stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.DEVNULL)  # fmt: skip
+            target, deadline = done + rng.integers(1, 5), time.monotonic() + 60
+            while done < target and run.poll() is None and time.monotonic() < deadline:
+                time.sleep(0.002)
+                done = max([int(p.name[1:]) for p in folder.glob("checkpoint/g*")] or [0])
+            time.sleep(rng.uniform(0.0, 0.05))
+            run.kill()
+            self.assertEqual(run.wait(), -signal.SIGKILL, "the run ended before its kill")
+        subprocess.run(resumed, cwd=folder, check=True, capture_output=True)
+        whole = pd.read_parquet(folder / "whole.parquet")
+        pd.testing.assert_frame_equal(pd.read_parquet(folder / "resumed.parquet"), whole)
+        self.assertAlmostEqual(whole["time"].iloc[-1], 120.0)
 
     def test_a_long_run_keeps_at_most_its_rows(self):
         """2 s at 10 ms periods with at most 50 rows: a row every 40 ms (memory bounded)."""

@@ -3,6 +3,7 @@ step of their write, folders that are ours before we write into them and have on
 time, and checkpoints and battery runs tied to the configuration they were made with."""
 
 import contextlib
+import errno
 import io
 import json
 import os
@@ -20,7 +21,12 @@ from battery_jobs import Count, StopWalk
 import numpy as np
 
 from mobee_drake import cli
-from mobee_drake.atomic_files import CurrentGeneration, WriteGeneration, WriteJsonAtomically
+from mobee_drake.atomic_files import (
+    CurrentGeneration,
+    WriteFileAtomically,
+    WriteGeneration,
+    WriteJsonAtomically,
+)
 from mobee_drake.experiments import ch7_model_learning, saggriac
 from mobee_drake.experiments.battery import InProcess, Job, RunBattery
 from mobee_drake.experiments.ch7_model_learning import Stop
@@ -104,6 +110,19 @@ class TestAtomicFiles(TemporaryFolder):
             sorted(p.name for p in self.folder.iterdir()),
             [".other.json.k1ll3d.tmp", "progress.json"],
         )
+
+    def test_a_failed_write_names_the_file_and_leaves_nothing(self):
+        """Issue 31, item 11: a full disk's ``[Errno 28]`` named no file."""
+
+        def FullDisk(staging):
+            raise OSError(errno.ENOSPC, "No space left on device")
+
+        target = self.folder / "result.json"
+        with self.assertRaises(OSError) as failed:
+            WriteFileAtomically(target, FullDisk)
+        self.assertEqual(failed.exception.errno, errno.ENOSPC)
+        self.assertEqual(failed.exception.filename, str(target))
+        self.assertEqual(list(self.folder.iterdir()), [])
 
 
 class TestOwnedFolders(TemporaryFolder):

@@ -8,6 +8,7 @@ import itertools
 import pathlib
 import tempfile
 import unittest
+from unittest import mock
 
 import numpy as np
 from scipy import stats
@@ -349,6 +350,26 @@ class TestVariants(unittest.TestCase):
                     experiments.main([*argv, "--output", str(pathlib.Path(folder) / "x")])
                 self.assertIn(message, stderr.getvalue())
                 self.assertEqual(len(stderr.getvalue().strip().splitlines()), 1, stderr.getvalue())
+
+    def test_smoke_sets_only_the_sizes_the_flags_do_not_give(self):
+        """Issue 31, item 11: ``--smoke`` silently overrode ``--budget-exp1``."""
+
+        class Ran(Exception):
+            pass
+
+        def Specs(argv: list[str]) -> list:
+            with mock.patch.object(experiments, "RunAll", side_effect=Ran) as run_all:
+                with self.assertRaises(Ran):
+                    experiments.main([*argv, "--experiments", "1", "--methods", "SAGG-RIAC"])
+            return run_all.call_args.args[0]
+
+        smoke = Specs(["--smoke"])
+        self.assertEqual(len(smoke), experiments.SMOKE["seeds"])
+        self.assertEqual({s.budget for s in smoke}, {experiments.SMOKE["budget_exp1"]})
+        given = Specs(["--smoke", "--budget-exp1", "700", "--seeds", "1"])
+        self.assertEqual([(s.budget, s.num_checkpoints) for s in given],
+                         [(700, experiments.SMOKE["checkpoints"])])  # fmt: skip
+        self.assertEqual({s.budget for s in Specs([])}, {experiments.FULL["budget_exp1"]})
 
     def test_smoke_battery_of_the_options(self):
         with tempfile.TemporaryDirectory() as folder:

@@ -30,6 +30,16 @@ def PositiveFloat(text: str) -> float:
     return _Checked(text, float, lambda v: math.isfinite(v) and v > 0, "a finite number > 0")
 
 
+def InRange(low: float, high: float):
+    """An argparse type: a number in [``low``, ``high``] (a physical value whose range outside
+    which a run means nothing, e.g. a force that MoBeE's squashing saturates long before)."""
+
+    def Checked(text: str) -> float:
+        return _Checked(text, float, lambda v: low <= v <= high, f"a number in [{low:g}, {high:g}]")
+
+    return Checked
+
+
 def Fraction(text: str) -> float:
     """A number in (0, 1] (a share of a range)."""
     return _Checked(text, float, lambda v: 0 < v <= 1, "a number in (0, 1]")

@@ -66,12 +66,14 @@ parent keeps submitted):
   (a breakpoint in a job works); the display only advances between jobs.
 """
 
+import argparse
 import collections
 from collections.abc import Callable, Iterable
 import concurrent.futures
 import contextlib
 import ctypes
 import dataclasses
+import errno
 import hashlib
 import json
 import math
@@ -82,6 +84,7 @@ import pickle
 import re
 import select
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -158,6 +161,18 @@ class BatteryRefused(ValueError):
     """A battery that may not run in its folder (runs of other arguments are there)."""
 
 
+class NotStarted(Exception):
+    """A job the battery did not start, after another's write failed for want of space."""
+
+
+# A write that fails for one of these fails for every job (the disk is full or read-only).
+DISK_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EROFS)
+
+
+def _DiskRefuses(error: BaseException) -> bool:
+    return isinstance(error, OSError) and error.errno in DISK_ERRNOS
+
+
 class JobStopped(Exception):
     """A job that, asked to stop (:func:`StopRequested`), saved its checkpoint and stopped."""
 
@@ -226,17 +241,23 @@ class InProcess:
         yield _RunHere
 
 
-def _DieWithParent(parent: int) -> None:
-    """The local workers' initializer: SIGKILL when the parent dies (Linux); no SIGINT; SIGUSR1
-    asks the job to stop (see :func:`StopRequested`)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGUSR1, _RequestStop)
+def DieWithParent(parent: int) -> None:
+    """Makes the calling process (a child of ``parent``) receive SIGKILL when its parent dies
+    (Linux; elsewhere nothing)."""
     if sys.platform.startswith("linux"):
         PR_SET_PDEATHSIG = 1
         if ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0):
             raise OSError(ctypes.get_errno(), "prctl(PR_SET_PDEATHSIG) failed")
         if os.getppid() != parent:  # The parent died before the prctl.
             os._exit(1)
+
+
+def _DieWithParent(parent: int) -> None:
+    """The local workers' initializer: SIGKILL when the parent dies; no SIGINT; SIGUSR1 asks
+    the job to stop (see :func:`StopRequested`)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGUSR1, _RequestStop)
+    DieWithParent(parent)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -557,6 +578,10 @@ def _RunJobs(
                         results[job.name] = json.loads(future.result())
                     except Exception as error:
                         errors[job.name] = error
+                        if _DiskRefuses(error):  # Every later job's writes would fail too.
+                            for waiting in queue:
+                                errors[waiting.name] = NotStarted(f"not started: {error}")
+                            queue.clear()
                 display.Update(running.values(), len(finished))
     finally:
         display.Close()
@@ -581,6 +606,30 @@ def Provenance(output: str | pathlib.Path) -> str:
     return f"mobee-drake {__version__}; the runs' arguments: sha256 {digest.hexdigest()[:16]}"
 
 
+# How long a cluster's address may take to accept a connection before --ray refuses it.
+RAY_CONNECT_SECONDS = 10.0
+
+
+def RayAddress(text: str) -> str:
+    """``--ray``'s address, checked before any work (``ray.init`` waits for an address that does
+    not answer for minutes, printing warnings): "auto" (Ray finds the local cluster), or
+    ``[ray://]host:port`` of a cluster that accepts a connection."""
+    if text == "auto":
+        return text
+    match = re.fullmatch(r"(?:ray://)?(\[[^\]]+\]|[^:/\s]+):(\d{1,5})", text)
+    if match is None or not 0 < int(match[2]) < 65536:
+        raise argparse.ArgumentTypeError(f"must be auto or [ray://]host:port, got '{text}'")
+    host, port = match[1].strip("[]"), int(match[2])
+    try:
+        socket.create_connection((host, port), timeout=RAY_CONNECT_SECONDS).close()
+    except OSError as error:
+        reason = "timed out" if isinstance(error, TimeoutError) else error.strerror or str(error)
+        raise argparse.ArgumentTypeError(
+            f"no Ray cluster answers at {host}:{port} ({reason})"
+        ) from None
+    return text
+
+
 def AddBackendArguments(parser, workers: int = 1) -> None:
     """Adds ``--workers`` and ``--ray [ADDRESS]`` to an experiment's command line."""
     parser.add_argument(
@@ -594,6 +643,7 @@ def AddBackendArguments(parser, workers: int = 1) -> None:
         nargs="?",
         const="",
         default=None,
+        type=RayAddress,
         metavar="ADDRESS",
         help="run on Ray instead: a cluster's address, or none for a local Ray instance "
         '(needs pip install "mobee-drake[ray]")',

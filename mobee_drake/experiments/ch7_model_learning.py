@@ -58,6 +58,7 @@ from mobee_drake.experiments.exploration import (
 )
 from mobee_drake.experiments.plots import Figure, Legend, SaveFigure, StackedBars, plt
 from mobee_drake.mobee.constraints import ClauseSet
+from mobee_drake.owned_folders import ClaimFolder
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
 from mobee_drake.planning.planner import GreedyPlan
 from mobee_drake.planning.state_space import Lattice
@@ -835,8 +836,7 @@ def main(argv=None) -> None:
     AddBackendArguments(parser)
     argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(argv)
-    output = pathlib.Path(args.output)
-    output.mkdir(parents=True, exist_ok=True)
+    output = ClaimFolder(args.output, "battery")  # (a file or a user's folder refused)
     backend = BackendOf(args)
     if args.experiment == "7.1":
         results = RunHypercube(output, args.runs, backend)

@@ -54,8 +54,8 @@ from pydrake.geometry import StartMeshcat
 from mobee_drake.atomic_files import CurrentGeneration, StrictJson, WriteGeneration
 from mobee_drake.experiments.arguments import (
     CommandParser,
+    InRange,
     NonNegativeInt,
-    PositiveFloat,
     PositiveInt,
 )
 from mobee_drake.experiments.battery import (
@@ -73,7 +73,7 @@ from mobee_drake.experiments.exploration import ExplorationScenario, Explore
 from mobee_drake.experiments.plots import Figure, SaveFigure, StackedBars, plt
 from mobee_drake.experiments.statistics import CompareRuns, CompareToZero, RunMeans, Trend
 from mobee_drake.mobee.params import Dissertation
-from mobee_drake.owned_folders import OwnedFolder
+from mobee_drake.owned_folders import ClaimFolder, OwnedFolder
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig, LoadAgentModel
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import ExploringAgent
@@ -164,6 +164,12 @@ class ReachPreset:
     # The reach's force on the palm (N).
     reach_force: float
 
+
+# The ranges of the sweepable constants outside which a run means nothing: MoBeE's work-space
+# squashing (m = 20) saturates far below the largest force, and a unit of 0.1 mm or 100 m
+# makes every reward of eq. 8.4 either huge or nil over the iCub's reach.
+REACH_FORCE_RANGE = (1e-3, 1e5)  # (N)
+DISTANCE_UNIT_RANGE = (1e-4, 100.0)  # (m)
 
 REACH_PRESETS = {
     # Issue 23, point 6: the setting of the sweep whose behaviour matches the source's
@@ -996,7 +1002,7 @@ def main(argv=None) -> None:
     )
     parser.add_argument(
         "--reach-force",
-        type=PositiveFloat,
+        type=InRange(*REACH_FORCE_RANGE),
         nargs="+",
         default=None,
         help="the reach's force on the palm in N (default: the preset's; use another "
@@ -1004,7 +1010,7 @@ def main(argv=None) -> None:
     )
     parser.add_argument(
         "--distance-unit",
-        type=PositiveFloat,
+        type=InRange(*DISTANCE_UNIT_RANGE),
         nargs="+",
         default=None,
         help="the length in m that counts as 1 in the rewards and predictions of eq. 8.1-8.7 "
@@ -1035,7 +1041,7 @@ def main(argv=None) -> None:
     output = pathlib.Path(args.output)
     if args.report_only and not output.is_dir():  # (checked before a folder is made)
         parser.error(f"--report-only: {output} is not a folder of reach-learning runs")
-    output.mkdir(parents=True, exist_ok=True)
+    ClaimFolder(output, "battery")  # (a file, or a folder of the user's, refused in one line)
     preset = REACH_PRESETS[args.preset]
     variants = [
         RunSettings(

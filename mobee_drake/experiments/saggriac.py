@@ -20,6 +20,7 @@ Usage::
     mobee-drake experiment saggriac --smoke --output /tmp/saggriac_smoke [--ray [ADDRESS]]
 """
 
+import argparse
 from collections.abc import Callable
 import csv
 import dataclasses
@@ -58,6 +59,10 @@ from mobee_drake.goal_babbling.config import (
 from mobee_drake.goal_babbling.evaluation import MEASURES, Evaluator, MakeTestSet
 from mobee_drake.goal_babbling.sagg_riac import SaggRiac
 from mobee_drake.owned_folders import OwnedFolder
+
+# A battery's size: the paper's budgets (30 seeds where it ran 15), and --smoke's.
+FULL = {"seeds": 30, "budget_exp1": 50_000, "budget_exp2": 200_000, "checkpoints": 10}
+SMOKE = {"seeds": 2, "budget_exp1": 600, "budget_exp2": 800, "checkpoints": 2}
 
 METHODS = {
     learner.name: learner for learner in (SaggRiac, SaggRandom, ActuatorRandom, ActuatorRiac)
@@ -974,16 +979,30 @@ def main(argv=None) -> None:
             for name, variant in VARIANTS.items()
         ),
     )
-    parser.add_argument("--seeds", type=PositiveInt, default=30, help="number of seeds (paper: 15)")
+    parser.add_argument(
+        "--seeds",
+        type=PositiveInt,
+        default=argparse.SUPPRESS,
+        help=f"number of seeds (default: {FULL['seeds']}; paper: 15)",
+    )
     parser.add_argument("--first-seed", type=NonNegativeInt, default=0, help="the first seed")
     parser.add_argument(
-        "--budget-exp1", type=PositiveInt, default=50_000, help="paper: 50,000 movements"
+        "--budget-exp1",
+        type=PositiveInt,
+        default=argparse.SUPPRESS,
+        help=f"movements (default: {FULL['budget_exp1']:,}, the paper's)",
     )
     parser.add_argument(
-        "--budget-exp2", type=PositiveInt, default=200_000, help="paper: 200,000 time steps"
+        "--budget-exp2",
+        type=PositiveInt,
+        default=argparse.SUPPRESS,
+        help=f"time steps (default: {FULL['budget_exp2']:,}, the paper's)",
     )
     parser.add_argument(
-        "--checkpoints", type=PositiveInt, default=10, help="evaluations after step 0"
+        "--checkpoints",
+        type=PositiveInt,
+        default=argparse.SUPPRESS,
+        help=f"evaluations after step 0 (default: {FULL['checkpoints']})",
     )
     parser.add_argument(
         "--output",
@@ -997,13 +1016,21 @@ def main(argv=None) -> None:
     parser.add_argument(
         "--smoke",
         action="store_true",
-        help="tiny battery: 2 seeds, 600/800 time steps, 2 checkpoints",
+        help="tiny battery, unless the flags say otherwise: "
+        + ", ".join(f"--{name.replace('_', '-')} {value}" for name, value in SMOKE.items()),
     )
     AddBackendArguments(parser)
     args = parser.parse_args(argv)
-    if args.smoke:
-        args.seeds, args.budget_exp1, args.budget_exp2, args.checkpoints = 2, 600, 800, 2
+    # --smoke's sizes, or the paper's, for what the command line does not give.
+    for name, value in (SMOKE if args.smoke else FULL).items():
+        setattr(args, name, getattr(args, name, value))
     budgets = {1: args.budget_exp1, 2: args.budget_exp2}
+    for experiment in args.experiments:
+        if args.checkpoints > budgets[experiment]:
+            parser.error(
+                f"--checkpoints {args.checkpoints}: more evaluations than experiment "
+                f"{experiment}'s budget of {budgets[experiment]}"
+            )
     # Seed-major order: an interrupted battery leaves every group with about as many seeds.
     specs = [
         RunSpec(experiment, method, seed, budgets[experiment], args.checkpoints, variant)

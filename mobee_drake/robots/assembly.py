@@ -33,6 +33,7 @@ def AddRobotWithOverlay(
     X_WRoot: RigidTransform | None = None,
     model_name: str | None = None,
     couplings: tuple[JointCoupling, ...] = (),
+    model_source: str | None = None,
 ) -> RobotOverlay:
     """Adds the robot of ``model_file`` (URDF or SDFormat) with its MoBeE overlay to ``plant``.
 
@@ -42,8 +43,9 @@ def AddRobotWithOverlay(
     ``couplings`` (one motor driving several joints). Must be called before ``plant.Finalize()``.
 
     Raises:
-        ValueError: naming the file and the element, for unknown joints or links, home angles
-            outside their limits, or a malformed overlay.
+        ValueError: naming the file (or ``model_source``: what the user named, where the file is
+            one we made) and the element, for unknown joints or links, home angles outside their
+            limits, or a malformed overlay.
     """
     model_file = str(model_file)
     return AddModelWithOverlay(
@@ -54,7 +56,7 @@ def AddRobotWithOverlay(
         controlled_joints=controlled_joints,
         home=home,
         X_WRoot=X_WRoot,
-        model_source=model_file,
+        model_source=model_source or model_file,
         overlay_source=str(overlay_file),
         couplings=couplings,
     )

@@ -88,4 +88,5 @@ def AddIcub(
         home={name: math.radians(value) for name, value in config.home_deg.items()},
         X_WRoot=X_WRoot,
         model_name=f"icub_{config.model}",
+        model_source=f"robot (the iCub model {config.model})",
     )

@@ -42,8 +42,7 @@ MIN_PLANT_TIME_STEP = 1e-5
 # (an object at 1e300 m breaks SceneGraph's arithmetic without a word).
 MAX_WORLD_EXTENT = 1000.0
 # The most objects a scenario may list: SceneGraph's collision filter grows with the square of
-# the obstacles (measured building reach_around_ball: 1,000 boxes 0.3 GB and 0.8 s, 2,000
-# 0.5 GB and 3.5 s, 4,000 1.2 GB and 20 s).
+# the geometries, in memory and in time (docs/benchmarks.md, `mobee-drake bench objects`).
 MAX_OBJECTS = 2000
 
 
