@@ -205,7 +205,7 @@ def _Issue31Trials(folder: pathlib.Path, thesis_folder: pathlib.Path) -> list:
         ("2,001 objects", ["run", str(folder / "many_objects.yaml")]),
         ("--ray with an address nobody answers", ["experiment", "saggriac", "--smoke", "--output", str(folder / "ray"), "--ray", "127.0.0.1:1"]),
         ("--ray with no address format", ["experiment", "saggriac", "--smoke", "--output", str(folder / "ray"), "--ray", "bogus"]),
-        ("saggriac --smoke with --budget-exp1", ["experiment", "saggriac", "--smoke", "--budget-exp1", "600", "--output", str(folder / "s1")]),
+        ("saggriac --smoke --budget-exp1 700 (the flag's budget)", ["experiment", "saggriac", "--smoke", "--experiments", "1", "--budget-exp1", "700", "--output", str(folder / "s1")]),
         ("saggriac --checkpoints beyond the budget", ["experiment", "saggriac", "--experiments", "1", "--budget-exp1", "100", "--checkpoints", "500", "--output", str(folder / "s2")]),
         ("ch8 --reach-force 1e300", ["experiment", "ch8", "--reach-force", "1e300", "--output", str(folder / "c1")]),
         ("ch8 --distance-unit 1e-300", ["experiment", "ch8", "--distance-unit", "1e-300", "--output", str(folder / "c2")]),
@@ -226,6 +226,7 @@ VALID = {
     "saggriac smoke battery",
     "robot file: ISO-8859-1, declared (valid)",
     "robot file: 20,000 markers (valid)",
+    "saggriac --smoke --budget-exp1 700 (the flag's budget)",
 }
 HANG_SECONDS = 120
 # An error line longer than this is unclear (nobody reads a 10 MB line).

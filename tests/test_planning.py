@@ -167,6 +167,8 @@ class TestExplorers(unittest.TestCase):
         class HighestGoal:
             """Always the action to the state of the highest index."""
 
+            seeks_goal = False
+
             def Scores(self, explorer, actions):
                 return explorer.space.action_goal[actions].astype(float)
 
@@ -280,6 +282,22 @@ class TestSupervisor(unittest.TestCase):
         self.assertEqual(dut.Records(context)[0].actions_done, 1)  # timed out while moving
 
     def test_planner_takes_new_goals(self):
+        """The shipped planner, and (issue 32) a goal-seeking strategy registered by a user:
+        arrival is the strategy's property, not its name's."""
+        from mobee_drake.planning.strategies import STRATEGIES, Planner, RegisterStrategy
+
+        class MyPlanner(Planner):
+            pass
+
+        RegisterStrategy("my_planner", MyPlanner())
+        self.addCleanup(STRATEGIES.pop, "my_planner")
+        for strategy in ("planner", "my_planner"):
+            with self.subTest(strategy):
+                self._TakesNewGoals(strategy)
+        with self.assertRaisesRegex(TypeError, "strategy 'vague' must say whether it seeks_goal"):
+            RegisterStrategy("vague", object())
+
+    def _TakesNewGoals(self, strategy: str) -> None:
         from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
 
         # A 2 x 2 lattice over joints b, c; the planner starts in state 0 heading for state 3.
@@ -288,7 +306,7 @@ class TestSupervisor(unittest.TestCase):
             name="arm",
             joints=["b", "c"],
             space=space,
-            explorer=ExplorerConfig(strategy="planner", goal_state=3),
+            explorer=ExplorerConfig(strategy=strategy, goal_state=3),
         )
         dut = ExplorationSupervisor(
             agents=[agent], joints=["b", "c"], lower=np.zeros(2), upper=np.ones(2), home=np.zeros(2)

@@ -79,7 +79,7 @@ class TestStateActionExecutor(unittest.TestCase):
         self.assertFalse(self.dut.Done(self.context))
         self.simulator.AdvanceTo(2.65)
         self.assertTrue(self.dut.Done(self.context))
-        self.assertEqual(self.dut.FinishedActions(self.context), 1)
+        self.assertEqual(self.dut.CompletedActions(self.context), 1)
         np.testing.assert_array_equal(self.Attractor(), [0.5, -0.5])  # q* stays
 
     def test_transition_times_out(self):

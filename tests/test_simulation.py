@@ -683,6 +683,8 @@ class TestSupervisorWorldEvents(unittest.TestCase):
             parts.builder.Connect(
                 parts.mobee.GetOutputPort("marker_positions"), switcher.get_input_port()
             )
+            # The switcher's requests are declared with the client's offer.
+            client.world_events.append(switcher.GetOutputPort("world_events"))
             return client
 
         cls.station = MakeMobeeStation(cls.scenario, prebuild_callback=ClientAndSwitcher)

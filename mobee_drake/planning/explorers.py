@@ -64,9 +64,9 @@ class Explorer:
         config = config or ExplorerConfig()
         for error in config.Errors():
             raise ValueError(error)
-        if config.strategy == "planner" and not 0 <= config.goal_state < space.num_states:
+        if STRATEGIES[config.strategy].seeks_goal and not 0 <= config.goal_state < space.num_states:
             raise ValueError(
-                f"the planner needs a goal_state in 0..{space.num_states - 1}, "
+                f"strategy '{config.strategy}' needs a goal_state in 0..{space.num_states - 1}, "
                 f"got {config.goal_state}"
             )
         self.space, self.config = space, config
@@ -78,6 +78,11 @@ class Explorer:
             self.rewards[sa] = self.transitions.Observe(sa, s)
             for _ in range(INITIALIZATIONS[config.initialization]):
                 self.rewards[sa] = self.transitions.Observe(sa, g)
+
+    @property
+    def seeks_goal(self) -> bool:
+        """Whether its strategy heads for its ``goal_state`` (see :mod:`.strategies`)."""
+        return STRATEGIES[self.config.strategy].seeks_goal
 
     def Copy(self) -> "Explorer":
         """An independent copy (model, tries and generator), sharing the space and config."""

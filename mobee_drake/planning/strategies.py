@@ -22,26 +22,38 @@ from mobee_drake.planning.planner import PlanValues
 
 
 class Strategy(Protocol):
+    # Whether it heads for the agent's ``goal_state``: such an agent needs one, stops once an
+    # action has ended there, and takes new goals (``ExploringAgent.SetPlannerGoal``).
+    seeks_goal: bool
+
     def Scores(self, explorer, actions: np.ndarray) -> np.ndarray:
         """The score of each of ``actions`` (the current state's) for ``explorer``."""
 
 
 class Curious:
+    seeks_goal = False
+
     def Scores(self, explorer, actions: np.ndarray) -> np.ndarray:
         return explorer.Values()[0][actions]
 
 
 class Random:
+    seeks_goal = False
+
     def Scores(self, explorer, actions: np.ndarray) -> np.ndarray:
         return np.zeros(len(actions))
 
 
 class LeastTried:
+    seeks_goal = False
+
     def Scores(self, explorer, actions: np.ndarray) -> np.ndarray:
         return -explorer.tries[actions].astype(float)
 
 
 class Planner:
+    seeks_goal = True
+
     def Scores(self, explorer, actions: np.ndarray) -> np.ndarray:
         goal = {explorer.config.goal_state: 1.0}
         return PlanValues(explorer, goal, gamma=explorer.config.gamma)[0][actions]
@@ -59,4 +71,6 @@ def RegisterStrategy(name: str, strategy: Strategy) -> None:
     """Makes ``strategy`` available to exploring agents as ``name``."""
     if name in STRATEGIES:
         raise ValueError(f"an exploration strategy named '{name}' exists already")
+    if not isinstance(getattr(strategy, "seeks_goal", None), bool):
+        raise TypeError(f"strategy '{name}' must say whether it seeks_goal (True or False)")
     STRATEGIES[name] = strategy

@@ -224,7 +224,7 @@ class ExplorationSupervisor(LeafSystem):
                 explorer = record.explorer.Copy()
                 outcome = self._StateOf(agent, columns, q)
                 explorer.Observe(record.state_action, outcome)
-                if explorer.config.strategy == "planner" and outcome == explorer.config.goal_state:
+                if explorer.seeks_goal and outcome == explorer.config.goal_state:
                     records[i] = dc.replace(
                         record,
                         explorer=explorer,
@@ -275,10 +275,10 @@ class ExplorationSupervisor(LeafSystem):
         config, columns = self._agents[i], self._columns[i]
         records = list(self.Records(context))
         explorer = records[i].explorer.Copy()
-        if explorer.config.strategy != "planner":
+        if not explorer.seeks_goal:
             raise ValueError(
-                f"agent '{agent}' explores ('{explorer.config.strategy}'); only a "
-                "'planner' agent takes goals"
+                f"agent '{agent}' explores ('{explorer.config.strategy}'); only an agent whose "
+                "strategy seeks a goal (the 'planner') takes goals"
             )
         if not 0 <= goal < config.space.num_states:
             raise ValueError(
@@ -473,4 +473,11 @@ class ExploreAttractor:
             ),
         )
         parts.builder.Connect(parts.robot_state, supervisor.GetInputPort("robot_state"))
-        return ClientPorts(system=supervisor, attractor=supervisor.GetOutputPort("attractor"))
+        return ClientPorts(
+            system=supervisor,
+            attractor=supervisor.GetOutputPort("attractor"),
+            outcome=supervisor,
+            action_counters=[supervisor],
+            data_log=supervisor,
+            checkpointed=[supervisor],
+        )

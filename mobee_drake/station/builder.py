@@ -53,11 +53,11 @@ from mobee_drake.robots.overlay import RobotOverlay
 from mobee_drake.robots.scenario_robot import AddScenarioRobot
 from mobee_drake.station.config import Dynamic, Kinematic, Mover, Reflex, StationConfig
 from mobee_drake.station.data_log import AddDataLog, DataLogger
-from mobee_drake.station.parts import ClientPorts, StationParts
+from mobee_drake.station.parts import CheckClientPorts, ClientPorts, StationParts
 from mobee_drake.station.safety import SafetyMonitor
 from mobee_drake.station.viewer import AddViewer
 from mobee_drake.station.virtual_dynamics import VirtualDynamics
-from mobee_drake.station.world_events import RequestPorts, WorldEventLedger
+from mobee_drake.station.world_events import WorldEventLedger
 from mobee_drake.world.live_world import LiveWorld, ObjectPose
 from mobee_drake.world.objects import WorldEvent
 
@@ -90,12 +90,29 @@ class Station:
     scripted_events: list[WorldEvent]
     request_ports: list[OutputPort]
     event_ledger: WorldEventLedger
-    # The client's system (None: the attractor is an input of the diagram).
-    client: LeafSystem | None = None
+    # What the robot's client declared it offers (None: the attractor is an input of the
+    # diagram), and each companion's client's.
+    client_ports: ClientPorts | None = None
+    companion_ports: list[ClientPorts] = dc.field(default_factory=list)
     meshcat: Meshcat | None = None
     visualizer: MeshcatVisualizer | None = None
     # The run's data log (None: the scenario turned it off).
     data_log: DataLogger | None = None
+
+    @property
+    def client(self) -> LeafSystem | None:
+        """The robot's client's system (None without a client)."""
+        return self.client_ports.system if self.client_ports is not None else None
+
+    def Hooks(self, hook: str) -> list:
+        """Every client's systems (or ports) declared for ``hook``, a hook field of
+        :class:`~mobee_drake.station.parts.ClientPorts`: the robot's client's, then the
+        companions'."""
+        found = []
+        for ports in [self.client_ports, *self.companion_ports]:
+            declared = getattr(ports, hook) if ports is not None else None
+            found += declared if isinstance(declared, list) else [declared] if declared else []
+        return found
 
 
 def _JointTracking(control: str) -> JointTracking:
@@ -217,10 +234,10 @@ def _AddCompanions(
     world: LiveWorld,
     config: StationConfig,
     robots: list[tuple[RobotOverlay, list[str]]],
-) -> list[OutputPort]:
+) -> tuple[list[OutputPort], list[ClientPorts]]:
     """Each companion's MoBeE, virtual dynamics and attractor program; returns the ports of
-    their states in the plant's state vector."""
-    positions = []
+    their states in the plant's state vector and what their clients declared."""
+    positions, declared = [], []
     for i, (companion, (overlay, joints)) in enumerate(zip(config.companions, robots)):
         prefix = f"{companion.name}_"
         mobee, mover, _, to_plant = _AddMobee(
@@ -246,11 +263,12 @@ def _AddCompanions(
             random_seed=config.random_seed + 1 + i,  # its own draws
             prefix=prefix,
         )
-        builder.Connect(
-            companion.attractor.AddToBuilder(parts).attractor, mobee.GetInputPort("attractor")
-        )
+        ports = companion.attractor.AddToBuilder(parts)
+        CheckClientPorts(ports)
+        builder.Connect(ports.attractor, mobee.GetInputPort("attractor"))
         positions.append(to_plant.get_output_port())
-    return positions
+        declared.append(ports)
+    return positions, declared
 
 
 def _PoseKinematicRobots(
@@ -312,9 +330,9 @@ def MakeMobeeStation(
 
     ``prebuild_callback(parts: StationParts) -> ClientPorts | None``, if given, adds the client
     (see :mod:`mobee_drake.station.parts`) and any other systems of the user's (a logger, a
-    supervisor). A system with an abstract output port named ``world_events`` edits the live
-    world (see :mod:`mobee_drake.station.world_events`); simulate the station with
-    :func:`~mobee_drake.station.world_events.MakeSimulator`, which applies them.
+    supervisor). What the client offers, its world-event requests among it, is what its
+    :class:`~mobee_drake.station.parts.ClientPorts` declares, checked here; simulate the station
+    with :func:`~mobee_drake.station.world_events.MakeSimulator`, which applies the requests.
     """
     builder = DiagramBuilder()
     mover_config = config.mover
@@ -345,7 +363,9 @@ def MakeMobeeStation(
     )
     # The client's forces (eq. 5.9-5.10) are inputs of the diagram, for scripts and supervisors
     # (unfixed, they are zero), unless the client sets them (see _ConnectClient).
-    companion_positions = _AddCompanions(builder, plant, scene_graph, world, config, companions)
+    companion_positions, companion_ports = _AddCompanions(
+        builder, plant, scene_graph, world, config, companions
+    )
     if isinstance(mover_config, Dynamic):
         # The controlled joints' (q, v), read from the plant (followers left out).
         selector = JointStateSelector(plant, mobee.joints, robot.instance).T
@@ -384,6 +404,8 @@ def MakeMobeeStation(
         random_seed=config.random_seed,
     )
     client = prebuild_callback(parts) if prebuild_callback else None
+    if client is not None:
+        CheckClientPorts(client)
     attractor, marker_forces = _ConnectClient(
         builder, client, mobee, mover, isinstance(mover_config, Reflex)
     )
@@ -402,7 +424,9 @@ def MakeMobeeStation(
             attractor=attractor,
             marker_forces=marker_forces,
         )
-    request_ports = RequestPorts(builder.GetSystems())
+    request_ports = [
+        port for ports in [client, *companion_ports] if ports for port in ports.world_events
+    ]
     event_ledger = builder.AddNamedSystem(
         "world_event_ledger", WorldEventLedger(num_request_ports=len(request_ports))
     )
@@ -419,7 +443,7 @@ def MakeMobeeStation(
             event_counts=event_ledger.GetOutputPort("counts"),
             scripted_events=scripted_events,
             request_ports=request_ports,
-            client=client.system if client is not None else None,
+            client=client.data_log if client is not None else None,
         )
 
     builder.ExportOutput(robot_state, "robot_state")
@@ -443,7 +467,8 @@ def MakeMobeeStation(
         scripted_events=scripted_events,
         request_ports=request_ports,
         event_ledger=event_ledger,
-        client=client.system if client is not None else None,
+        client_ports=client,
+        companion_ports=companion_ports,
         meshcat=meshcat,
         visualizer=visualizer,
         data_log=data_log,

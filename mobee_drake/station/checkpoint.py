@@ -19,7 +19,6 @@ saved.
 
 import json
 import pathlib
-from typing import Protocol, runtime_checkable
 import zipfile
 
 import numpy as np
@@ -41,28 +40,12 @@ LOG_SEGMENTS = "log_segments.txt"
 _VIEWER_SYSTEMS = ("trail",)
 
 
-@runtime_checkable
-class CheckpointedSystem(Protocol):
-    """A system whose state is more than numbers: it writes and reads files of its own."""
-
-    def WriteCheckpoint(self, context, folder: pathlib.Path) -> None:
-        """Writes its state in ``context`` (its own) into ``folder``."""
-
-    def ReadCheckpoint(self, context, folder: pathlib.Path) -> None:
-        """Restores its state from ``folder`` into ``context`` (its own)."""
-
-
 def _DiscreteStates(station: Station, context):
     """(key, value) of every discrete state group of the diagram, keyed by system name."""
     for system in station.diagram.GetSystems():
         sub_context = system.GetMyContextFromRoot(context)
         for i in range(sub_context.num_discrete_state_groups()):
             yield f"{system.get_name()}/{i}", sub_context.get_discrete_state(i).value()
-
-
-def _CheckpointedSystems(station: Station) -> list:
-    """The systems that write and read checkpoint files of their own (see the module)."""
-    return [s for s in station.diagram.GetSystems() if isinstance(s, CheckpointedSystem)]
 
 
 def WriteCheckpointFiles(station: Station, context, folder: pathlib.Path) -> None:
@@ -74,7 +57,7 @@ def WriteCheckpointFiles(station: Station, context, folder: pathlib.Path) -> Non
         **{key: value for key, value in _DiscreteStates(station, context)},
     )
     (folder / "world.json").write_text(StrictJson(station.world.Snapshot(context)))
-    for system in _CheckpointedSystems(station):
+    for system in station.Hooks("checkpointed"):
         system.WriteCheckpoint(system.GetMyContextFromRoot(context), folder)
 
 
@@ -134,7 +117,7 @@ def _ReadFiles(station: Station, context, folder: pathlib.Path) -> None:
             int(group)
         ).SetFromVector(value)
     station.world.Restore(context, json.loads((folder / "world.json").read_text()))
-    for system in _CheckpointedSystems(station):
+    for system in station.Hooks("checkpointed"):
         system.ReadCheckpoint(system.GetMyMutableContextFromRoot(context), folder)
 
 

@@ -26,12 +26,12 @@ column                    unit         what
 ========================  ===========  ==================================================
 
 A world event applied at time t (see :mod:`mobee_drake.station.world_events`) first shows in the
-row after t's. A client joins the log by implementing :class:`ClientWithDataLog`.
+row after t's. A client joins the log by declaring a ``data_log`` system (see
+:mod:`mobee_drake.station.parts`).
 """
 
 import dataclasses as dc
 import pathlib
-from typing import Protocol, runtime_checkable
 
 import numpy as np
 import pyarrow as pa
@@ -46,18 +46,10 @@ from mobee_drake.atomic_files import WriteFileAtomically
 from mobee_drake.mobee.fields import NO_FIELD_PAIRS
 from mobee_drake.mobee.system import FORCE_TERMS, Mobee
 from mobee_drake.station.config import DataLog
+from mobee_drake.station.parts import DATA_LOG_PORT, LogsData
 from mobee_drake.world.objects import WorldEvent
 
-CLIENT_LOG_PORT = "data_log"
 FORCE_UNIT = "M rad/s^2"  # MoBeE's forces: virtual mass times joint acceleration (eq. 5.7)
-
-
-@runtime_checkable
-class ClientWithDataLog(Protocol):
-    """A client whose vector output port ``data_log`` the log keeps, one column per entry."""
-
-    def DataLogColumns(self) -> list[tuple[str, str]]:
-        """(name, unit) of each entry of the ``data_log`` port."""
 
 
 class FieldPairsSummary(LeafSystem):
@@ -258,7 +250,7 @@ def AddDataLog(
     event_counts: OutputPort,
     scripted_events: list[WorldEvent],
     request_ports: list[OutputPort],
-    client: LeafSystem | None,
+    client: LogsData | None,
 ) -> DataLogger:
     """Adds the log's sink and what it reads to ``builder`` (see the module)."""
     summary = builder.AddNamedSystem("field_pairs_summary", FieldPairsSummary())
@@ -267,9 +259,9 @@ def AddDataLog(
     signals = [robot_state, attractor]
     signals.append(mobee.GetOutputPort("forces"))
     signals += [mobee.GetOutputPort("marker_positions"), summary.get_output_port(), event_counts]
-    if isinstance(client, ClientWithDataLog):
+    if client is not None:
         client_columns = list(client.DataLogColumns())
-        signals.append(client.GetOutputPort(CLIENT_LOG_PORT))
+        signals.append(client.GetOutputPort(DATA_LOG_PORT))
     mux = builder.AddNamedSystem("data_log_signals", Multiplexer([p.size() for p in signals]))
     for i, port in enumerate(signals):
         builder.Connect(port, mux.get_input_port(i))

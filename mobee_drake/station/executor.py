@@ -27,6 +27,7 @@ import dataclasses as dc
 import enum
 
 import numpy as np
+from pydrake.common.containers import namedview
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import BasicVector, LeafSystem
 
@@ -40,6 +41,17 @@ class Phase(enum.IntEnum):
     MOVING = 1  # a transition: q* at the goal state's centre
     FORCING = 2  # a reach, the marker forced toward the target
     RETURNING = 3  # a reach, the forcing stopped, back to the state's centre
+
+
+# The executor's discrete state, named (q* of MoBeE's joints follows as q_star_<i>): the phase,
+# the actions finished, the phase's start time, since when the robot has been slow (inf: not
+# slow), whether the fields felt an object, the reaches whose forcing has ended, the target x*
+# of the last reach and where the marker was when its forcing stopped.
+SLOTS = ("phase", "finished_actions", "started", "slow_since", "felt_object", "reaches")
+SLOTS += tuple(f"target_{c}" for c in "xyz") + tuple(f"reached_{c}" for c in "xyz")
+TARGET = slice(SLOTS.index("target_x"), SLOTS.index("target_z") + 1)
+REACHED = slice(SLOTS.index("reached_x"), SLOTS.index("reached_z") + 1)
+Q_STAR = len(SLOTS)
 
 
 @dc.dataclass
@@ -79,15 +91,6 @@ class StateActionExecutor(LeafSystem):
     :meth:`FeltObject` whether the fields felt a workspace object during the action.
     """
 
-    # The discrete state: phase, the number of actions finished, the phase's start time, since
-    # when the robot has been slow (inf: not slow), the target x*, the marker's position when the
-    # forcing stopped, whether the fields felt an object, q*.
-    _PHASE, _FINISHED, _STARTED, _SLOW_SINCE = range(4)
-    _TARGET = slice(4, 7)
-    _REACHED = slice(7, 10)
-    _FELT_OBJECT = 10
-    _Q_STAR = 11
-
     def __init__(
         self,
         *,
@@ -108,22 +111,25 @@ class StateActionExecutor(LeafSystem):
                 f"reach forcing: force and softening must be > 0, got "
                 f"{self._forcing.force} and {self._forcing.softening}"
             )
-        initial = np.zeros(self._Q_STAR + num_joints)
-        initial[self._SLOW_SINCE] = np.inf
-        initial[self._Q_STAR :] = initial_attractor
+        self._View = namedview(
+            "ExecutorState", SLOTS + tuple(f"q_star_{i}" for i in range(num_joints))
+        )
+        initial = self._View(np.zeros(len(SLOTS) + num_joints))
+        initial.slow_since = np.inf
+        initial[Q_STAR:] = initial_attractor
         self._state_port = self.DeclareVectorInputPort("robot_state", 2 * num_joints)
         self._markers_port = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
         self._pairs_port = self.DeclareAbstractInputPort(
             "field_pairs", AbstractValue.Make(NO_FIELD_PAIRS)
         )
-        self._state = self.DeclareDiscreteState(BasicVector(initial))
+        self._state = self.DeclareDiscreteState(BasicVector(initial[:]))
         self.DeclarePeriodicDiscreteUpdateEvent(
             period_sec=period, offset_sec=period, update=self._Poll
         )
         self.DeclareVectorOutputPort(
             "attractor",
             num_joints,
-            lambda context, output: output.SetFromVector(self._Vector(context)[self._Q_STAR :]),
+            lambda context, output: output.SetFromVector(self._Vector(context)[Q_STAR:]),
             prerequisites_of_calc={self.discrete_state_ticket(self._state)},
         )
         self.DeclareVectorOutputPort(
@@ -141,7 +147,7 @@ class StateActionExecutor(LeafSystem):
             "data_log",
             2,
             lambda context, output: output.SetFromVector(
-                self._Vector(context)[[self._PHASE, self._FINISHED]]
+                self._Vector(context)[[SLOTS.index("phase"), SLOTS.index("finished_actions")]]
             ),
             prerequisites_of_calc={self.discrete_state_ticket(self._state)},
         )
@@ -154,53 +160,62 @@ class StateActionExecutor(LeafSystem):
     def _Vector(self, context) -> np.ndarray:
         return context.get_discrete_state(self._state).value()
 
+    def State(self, context):
+        """A copy of the discrete state in ``context`` (its own), as a named view (:data:`SLOTS`,
+        then ``q_star_<i>``); :meth:`SetState` writes one back."""
+        return self._View(self._Vector(context).copy())
+
+    def SetState(self, context, state) -> None:
+        context.SetDiscreteState(self._state, state[:])
+
     def _Marker(self, context) -> np.ndarray:
         return self._markers_port.Eval(context)[3 * self._marker : 3 * self._marker + 3]
 
     def _CalcMarkerForces(self, context, output) -> None:
-        x = self._Vector(context)
+        x = self._View(self._Vector(context))
         forces = np.zeros(3 * self._num_markers)
-        if x[self._PHASE] == Phase.FORCING:
-            error = x[self._TARGET] - self._Marker(context)
+        if x.phase == Phase.FORCING:
+            error = x[TARGET] - self._Marker(context)
             forces[3 * self._marker : 3 * self._marker + 3] = (
                 self._forcing.force * error / (np.linalg.norm(error) + self._forcing.softening)
             )
         output.SetFromVector(forces)
 
     def _Poll(self, context, discrete_state) -> None:
-        x = self._Vector(context).copy()
-        phase = Phase(int(x[self._PHASE]))
+        x = self.State(context)
+        phase = Phase(int(x.phase))
         if phase == Phase.IDLE:
             return
         now, timing = context.get_time(), self._timing
         v = self._state_port.Eval(context)[self._n :]
         pairs: FieldPairs = self._pairs_port.Eval(context)
         if not np.all(pairs.b_is_robot):
-            x[self._FELT_OBJECT] = 1.0
-        x[self._SLOW_SINCE] = timing.SlowSince(x[self._SLOW_SINCE], now, v)
-        if timing.Ended(now, x[self._STARTED], x[self._SLOW_SINCE]):
+            x.felt_object = 1.0
+        x.slow_since = timing.SlowSince(x.slow_since, now, v)
+        if timing.Ended(now, x.started, x.slow_since):
             if phase == Phase.FORCING:
-                x[self._REACHED] = self._Marker(context)
-                x[self._PHASE] = Phase.RETURNING
+                x[REACHED] = self._Marker(context)
+                x.reaches += 1
+                x.phase = Phase.RETURNING
             else:
-                x[self._PHASE] = Phase.IDLE
-                x[self._FINISHED] += 1
-            x[self._STARTED], x[self._SLOW_SINCE] = now, np.inf
-        discrete_state.set_value(self._state, x)
+                x.phase = Phase.IDLE
+                x.finished_actions += 1
+            x.started, x.slow_since = now, np.inf
+        discrete_state.set_value(self._state, x[:])
 
     def _Start(self, context, phase: Phase, q_star: np.ndarray, target=None) -> None:
         q_star = np.asarray(q_star, dtype=float)
         if q_star.shape != (self._n,):
             raise ValueError(f"q* must have {self._n} entries, got shape {q_star.shape}")
-        x = self._Vector(context).copy()
-        if x[self._PHASE] != Phase.IDLE:
-            raise ValueError(f"an action is in flight (phase {Phase(int(x[self._PHASE])).name})")
-        x[self._PHASE], x[self._STARTED], x[self._SLOW_SINCE] = phase, context.get_time(), np.inf
-        x[self._FELT_OBJECT] = 0.0
-        x[self._Q_STAR :] = q_star
+        x = self.State(context)
+        if x.phase != Phase.IDLE:
+            raise ValueError(f"an action is in flight (phase {Phase(int(x.phase)).name})")
+        x.phase, x.started, x.slow_since = phase, context.get_time(), np.inf
+        x.felt_object = 0.0
+        x[Q_STAR:] = q_star
         if target is not None:
-            x[self._TARGET] = target
-        context.SetDiscreteState(self._state, x)
+            x[TARGET] = target
+        self.SetState(context, x)
 
     def StartTransition(self, context, q_star: np.ndarray) -> None:
         """Starts a state transition to the attractor ``q_star`` (this system's context)."""
@@ -219,31 +234,32 @@ class StateActionExecutor(LeafSystem):
         return self._forcing.marker
 
     def CurrentPhase(self, context) -> Phase:
-        return Phase(int(self._Vector(context)[self._PHASE]))
+        return Phase(int(self.State(context).phase))
 
     def Done(self, context) -> bool:
         """Whether no action is in flight."""
         return self.CurrentPhase(context) == Phase.IDLE
 
-    def FinishedActions(self, context) -> int:
-        return int(self._Vector(context)[self._FINISHED])
+    def CompletedActions(self, context) -> int:
+        """How many actions it has finished (a run with a checkpoint saves one after each)."""
+        return int(self.State(context).finished_actions)
 
     def ReachedPosition(self, context) -> np.ndarray:
         """Where the marker was when the last reach's forcing stopped (world, m)."""
-        return self._Vector(context)[self._REACHED].copy()
+        return self.State(context)[REACHED].copy()
 
     def Outcome(self, context) -> dict:
         """The actions finished and, after a reach, the marker's distance to its target then."""
-        x = self._Vector(context)
-        outcome = {"finished_actions": int(x[self._FINISHED])}
-        if np.any(x[self._TARGET] != 0):
-            distance = np.linalg.norm(x[self._REACHED] - x[self._TARGET])
+        x = self.State(context)
+        outcome = {"finished_actions": int(x.finished_actions)}
+        if x.reaches > 0:  # (a target may be anywhere, the origin too)
+            distance = np.linalg.norm(x[REACHED] - x[TARGET])
             outcome["last_reach_distance_to_target_m"] = float(distance)
         return outcome
 
     def FeltObject(self, context) -> bool:
         """Whether MoBeE's fields felt a workspace object during the last (or current) action."""
-        return bool(self._Vector(context)[self._FELT_OBJECT])
+        return bool(self.State(context).felt_object)
 
 
 @dc.dataclass
@@ -288,4 +304,7 @@ class StateActionAttractor:
             system=executor,
             attractor=executor.GetOutputPort("attractor"),
             marker_forces=executor.GetOutputPort("marker_forces"),
+            outcome=executor,
+            action_counters=[executor],
+            data_log=executor,
         )

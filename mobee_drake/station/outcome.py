@@ -2,22 +2,14 @@
 
 - The attractor's: how far the robot ended from it, as the largest joint error, and how far each
   marker ended from where it would be at the attractor (its goal).
-- The client's own, from a client that implements ``Outcome(context) -> dict`` (its context):
+- The client's own, from the system its ``ClientPorts`` declare as ``outcome``
   the exploring agents' actions, state-actions tried and value-iteration residual; the
   state-action executor's finished actions and its last reach's distance to the target.
 """
 
-from typing import Protocol, runtime_checkable
-
 import numpy as np
 
 from mobee_drake.station.builder import Station
-
-
-@runtime_checkable
-class ClientWithOutcome(Protocol):
-    def Outcome(self, context) -> dict:
-        """What the client achieved in ``context`` (its own), as JSON-able data."""
 
 
 def AttractorOutcome(station: Station, context) -> dict:
@@ -48,7 +40,7 @@ def AttractorOutcome(station: Station, context) -> dict:
 def RunOutcome(station: Station, context) -> dict:
     """The attractor's outcome and, if the client has one, the client's."""
     outcome = {"attractor": AttractorOutcome(station, context)}
-    client = station.client
-    if isinstance(client, ClientWithOutcome):
+    client = station.client_ports.outcome if station.client_ports is not None else None
+    if client is not None:
         outcome["client"] = client.Outcome(client.GetMyContextFromRoot(context))
     return outcome

@@ -1,25 +1,47 @@
-"""The one seam between the station and its clients.
+"""The one seam between the station and its clients, and the one place their contract is declared.
 
 A client (an exploring agent, the reach executor, motor babbling, sliders, your own) is a
 callable ``AddToBuilder(parts: StationParts) -> ClientPorts | None`` handed to
 :func:`~mobee_drake.station.builder.MakeMobeeStation` as ``prebuild_callback``. It is called once,
 while the station's diagram is being built: it adds its systems to ``parts.builder``, connects
-their inputs to the station's outputs named here, and returns the ports the station should read
-its attractor (and, if the client sets them, the marker forces) from. Returning None leaves
-MoBeE's attractor and forces as inputs of the station's diagram, for a script to fix. The station
-imports no client; a scenario's client config classes implement the callable
-(see :mod:`mobee_drake.scenario`).
+their inputs to the station's outputs named here, and returns a :class:`ClientPorts` declaring
+everything it offers the station: the ports MoBeE reads (its attractor and, if the client sets
+them, the forces on the markers and in configuration space) and the optional hooks below, each
+the system that implements it. Returning None leaves MoBeE's attractor and forces as inputs of
+the station's diagram, for a script to fix.
+
+The hooks, each a Protocol here (the station reads them from ``Station.clients``, never by
+searching the diagram):
+
+- ``outcome`` (:class:`ReportsOutcome`): what the client achieved, in the run's summary;
+- ``action_counters`` (:class:`CountsActions`): actions completed, after each of which a run
+  with a checkpoint saves one;
+- ``data_log`` (:class:`LogsData`): columns of the run's data log;
+- ``checkpointed`` (:class:`Checkpointed`): state that is more than numbers, in files of its own;
+- ``world_events``: abstract output ports of ``list[WorldEvent]``, requests to edit the world
+  (see :mod:`mobee_drake.station.world_events`).
+
+The station checks the declaration when it is built (:func:`CheckClientPorts`): a hook whose
+system lacks the method, or has it with other parameters, is refused there, naming the system,
+the method, and the nearest name the system has. The station imports no client; a scenario's
+client config classes implement the callable (see :mod:`mobee_drake.scenario`).
 """
 
 import dataclasses as dc
+import difflib
+import inspect
+import pathlib
 from typing import Protocol
 
 from pydrake.geometry import Meshcat, SceneGraph
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.systems.framework import DiagramBuilder, LeafSystem, OutputPort
+from pydrake.systems.framework import DiagramBuilder, LeafSystem, OutputPort, PortDataType
 
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.world.live_world import LiveWorld
+
+# A client's vector output port that the data log keeps (see LogsData).
+DATA_LOG_PORT = "data_log"
 
 
 @dc.dataclass
@@ -40,16 +62,110 @@ class StationParts:
     prefix: str = ""
 
 
+class ReportsOutcome(Protocol):
+    def Outcome(self, context) -> dict:
+        """What the client achieved in ``context`` (its own), as JSON-able data."""
+
+
+class CountsActions(Protocol):
+    def CompletedActions(self, context) -> int:
+        """How many actions it has completed, in ``context`` (its own)."""
+
+
+class LogsData(Protocol):
+    """A system whose vector output port :data:`DATA_LOG_PORT` the log keeps, a column an entry."""
+
+    def DataLogColumns(self) -> list[tuple[str, str]]:
+        """(name, unit) of each entry of the port."""
+
+
+class Checkpointed(Protocol):
+    """A system whose state is more than numbers: it writes and reads files of its own."""
+
+    def WriteCheckpoint(self, context, folder: pathlib.Path) -> None:
+        """Writes its state in ``context`` (its own) into ``folder``."""
+
+    def ReadCheckpoint(self, context, folder: pathlib.Path) -> None:
+        """Restores its state from ``folder`` into ``context`` (its own)."""
+
+
 @dc.dataclass
 class ClientPorts:
-    """What a client offers the station: its system (a typed handle for scripts), the attractor
-    q* of MoBeE's joints, and optionally the forces on MoBeE's markers (eq. 5.10) and its
-    configuration-space force (eq. 5.9)."""
+    """Everything a client offers the station (see the module): its system (a typed handle for
+    scripts), the attractor q* of MoBeE's joints, optionally the forces on MoBeE's markers
+    (eq. 5.10) and its configuration-space force (eq. 5.9), and its hooks."""
 
     system: LeafSystem
     attractor: OutputPort
     marker_forces: OutputPort | None = None
     config_force: OutputPort | None = None
+    outcome: ReportsOutcome | None = None
+    action_counters: list[CountsActions] = dc.field(default_factory=list)
+    data_log: LogsData | None = None
+    checkpointed: list[Checkpointed] = dc.field(default_factory=list)
+    world_events: list[OutputPort] = dc.field(default_factory=list)
+
+
+class ClientContractError(TypeError):
+    """A client whose declared hook its system does not implement as declared."""
+
+
+# Each hook field of ClientPorts and the Protocol its systems implement.
+HOOKS = {
+    "outcome": ReportsOutcome,
+    "action_counters": CountsActions,
+    "data_log": LogsData,
+    "checkpointed": Checkpointed,
+}
+
+
+def _Parameters(function) -> list[str]:
+    return [p for p in inspect.signature(function).parameters if p != "self"]
+
+
+def _CheckImplements(system, protocol, hook: str) -> None:
+    name = system.get_name() if isinstance(system, LeafSystem) else type(system).__name__
+    for method, declared in inspect.getmembers(protocol, inspect.isfunction):
+        if method.startswith("_"):
+            continue
+        found = getattr(system, method, None)
+        if not callable(found):
+            methods = [m for m in dir(system) if not m.startswith("_")]
+            near = difflib.get_close_matches(method, methods, n=1, cutoff=0.5)
+            raise ClientContractError(
+                f"client system '{name}', declared as {hook}, has no method {method}"
+                + (f" (it has {near[0]})" if near else "")
+            )
+        expected, given = _Parameters(declared), _Parameters(found)
+        if len(given) != len(expected):
+            raise ClientContractError(
+                f"client system '{name}': {method}({', '.join(given)}) must take "
+                f"({', '.join(expected)}) to be its {hook} hook"
+            )
+
+
+def CheckClientPorts(ports: ClientPorts) -> None:
+    """Refuses a declaration whose hooks are not implemented as declared (see the module).
+
+    Raises:
+        ClientContractError: naming the system, the hook and the method.
+    """
+    for hook, protocol in HOOKS.items():
+        declared = getattr(ports, hook)
+        for system in declared if isinstance(declared, list) else [declared]:
+            if system is not None:
+                _CheckImplements(system, protocol, hook)
+    if ports.data_log is not None and not ports.data_log.HasOutputPort(DATA_LOG_PORT):
+        raise ClientContractError(
+            f"client system '{ports.data_log.get_name()}', declared as data_log, has no output "
+            f"port '{DATA_LOG_PORT}'"
+        )
+    for port in ports.world_events:
+        if port.get_data_type() != PortDataType.kAbstractValued:
+            raise ClientContractError(
+                f"world_events port '{port.get_system().get_name()}.{port.get_name()}' must be "
+                "abstract (a list of WorldEvent)"
+            )
 
 
 class ClientConfig(Protocol):

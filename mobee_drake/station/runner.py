@@ -4,7 +4,6 @@ import contextlib
 import dataclasses as dc
 import pathlib
 import time
-from typing import Protocol, runtime_checkable
 
 from pydrake.systems.analysis import InitializeParams, Simulator, SimulatorConfig
 
@@ -124,21 +123,10 @@ def Advance(
         bar.close()
 
 
-@runtime_checkable
-class ActionCounter(Protocol):
-    """A client that counts the actions it has completed (the runner checkpoints after each)."""
-
-    def CompletedActions(self, context) -> int:
-        """How many actions it has completed, in ``context`` (its own)."""
-
-
-def ActionCounters(station: Station) -> list:
-    """The station's systems that count their completed actions."""
-    return [s for s in station.diagram.GetSystems() if isinstance(s, ActionCounter)]
-
-
-def CompletedActions(counters: list, context) -> int:
-    """How many actions ``counters`` have completed in the root ``context`` (0 without any)."""
+def CompletedActions(station: Station, context) -> int:
+    """How many actions the station's clients have completed in the root ``context`` (0 when
+    none counts them)."""
+    counters = station.Hooks("action_counters")
     return sum(c.CompletedActions(c.GetMyContextFromRoot(context)) for c in counters)
 
 
@@ -200,15 +188,14 @@ def RunStation(
         if record:  # (Before the initialization's drawing, which the recording keeps.)
             _StartRecording(station, duration - (resumed or 0.0))
         simulator.Initialize(InitializeParams(suppress_initialization_events=resumed is not None))
-        counters = ActionCounters(station)
-        saved = [CompletedActions(counters, context)]
+        saved = [CompletedActions(station, context)]
 
         def Save(context) -> None:
             segments = log.Save(context) if log is not None else 0
             SaveCheckpoint(station, context, checkpoint, configuration, segments)
 
         def AfterChunk(context):
-            done = CompletedActions(counters, context)
+            done = CompletedActions(station, context)
             if checkpoint and done > saved[0]:
                 Save(context)
                 saved[0] = done

@@ -1,13 +1,14 @@
 """World events in a running station: the scenario's scripted ones and those a client requests.
 
-A client changes the world by listing every :class:`~mobee_drake.world.objects.WorldEvent` it
-has issued, in order, on an abstract output port named ``world_events`` (the list is a function
-of its state). SceneGraph's world lives in its Context's parameters, which no system's event may
-change, so the events are applied between simulation steps by a Simulator *monitor*
-(:func:`MakeSimulator`): after every step it applies the scripted events that are due and the
-requests not yet applied. How many of each have been applied is the discrete state of a
-:class:`WorldEventLedger` in the diagram, so a plain ``Simulator.AdvanceTo`` in one call, the
-runner's chunks, two contexts and a restored checkpoint all agree on the world.
+A client changes the world by listing every :class:`~mobee_drake.world.objects.WorldEvent` it has
+issued, in order, on an abstract output port (the list is a function of its state) that its
+``ClientPorts`` declare among its ``world_events`` (see :mod:`mobee_drake.station.parts`).
+SceneGraph's world lives in its Context's parameters, which no system's event may change, so the
+events are applied between simulation steps by a Simulator *monitor* (:func:`MakeSimulator`): after
+every step it applies the scripted events that are due and the requests not yet applied. How many of
+each have been applied is the discrete state of a :class:`WorldEventLedger` in the diagram, so a
+plain ``Simulator.AdvanceTo`` in one call, the runner's chunks, two contexts and a restored
+checkpoint all agree on the world.
 
 An event at time t is applied when the step that reaches t ends, before the discrete updates at
 t (the robot's next period sees the new world); a request issued by an update at t is applied
@@ -16,11 +17,9 @@ at the end of the next step.
 
 import numpy as np
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
-from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem, OutputPort
+from pydrake.systems.framework import BasicVector, EventStatus, LeafSystem
 
 from mobee_drake.station.safety import WarnOfPenetrations
-
-WORLD_EVENTS_PORT = "world_events"
 
 
 class WorldEventLedger(LeafSystem):
@@ -48,13 +47,6 @@ class WorldEventLedger(LeafSystem):
 
     def SetCounts(self, context, counts: np.ndarray) -> None:
         context.SetDiscreteState(self._counts, counts)
-
-
-def RequestPorts(systems) -> list[OutputPort]:
-    """The ``world_events`` output ports of ``systems``."""
-    return [
-        s.GetOutputPort(WORLD_EVENTS_PORT) for s in systems if s.HasOutputPort(WORLD_EVENTS_PORT)
-    ]
 
 
 def ApplyWorldEvents(station, root_context) -> None:
