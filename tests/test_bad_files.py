@@ -20,6 +20,10 @@ from mobee_drake.yaml_io import MAX_YAML_DEPTH, YamlFileError
 MODELS = pathlib.Path(__file__).resolve().parent / "models"
 HEADER = '<?xml version="1.0"?>\n<ZeroPositionKinematicTree version="1.0" robotName="r">\n'
 
+# (s) What a refused file may take: a guard against a hang (an alias bomb walked for hours), not
+# a speed test (speed belongs in benchmarks).
+HANG_GUARD = 10.0
+
 
 def _Tree(body: str) -> str:
     """A file whose ``body`` starts on line 4, inside the bodypart 'arm'."""
@@ -184,7 +188,7 @@ class TestMalformedRobotFiles(unittest.TestCase):
             _Tree('<link z="1">' * 1000 + "</link>" * 1000),
             rf"robot\.xml:4: <link>: elements nested deeper than {MAX_DEPTH}",
         )
-        self.assertLess(time.perf_counter() - started, 1.0)
+        self.assertLess(time.perf_counter() - started, HANG_GUARD)
 
     def test_version_and_length(self):
         self._Fails(
@@ -199,7 +203,7 @@ class TestMalformedRobotFiles(unittest.TestCase):
         started = time.perf_counter()
         robot = LoadZeroPositionTree(_Write(_Tree(f'<link z="1">{markers}</link>')))
         self.assertEqual(len(robot.overlay.markers), 20000)
-        self.assertLess(time.perf_counter() - started, 5.0)  # 31 s when the check was quadratic
+        self.assertLess(time.perf_counter() - started, HANG_GUARD)  # 31 s when it was quadratic
 
     def test_a_robot_without_a_joint_to_control(self):
         path = _Write(_Tree('<link z="1" radius="0.1"/>'))
@@ -227,7 +231,7 @@ class TestMalformedOverlays(unittest.TestCase):
         started = time.perf_counter()
         with self.assertRaises(ValueError) as caught:
             LoadOverlay(path)
-        self.assertLess(time.perf_counter() - started, 1.0)
+        self.assertLess(time.perf_counter() - started, HANG_GUARD)
         message = str(caught.exception)
         self.assertRegex(message, pattern)
         self.assertTrue(message.startswith(f"{path}"), message)
@@ -311,7 +315,7 @@ class TestMalformedScenarioFiles(unittest.TestCase):
         started = time.perf_counter()
         with self.assertRaisesRegex(YamlFileError, pattern):
             LoadScenario(path)
-        self.assertLess(time.perf_counter() - started, 1.0)
+        self.assertLess(time.perf_counter() - started, HANG_GUARD)
 
     def test_alias_bombs_deep_nesting_and_bad_files(self):
         self._Fails(_Bomb(key="objects"), r"scenario\.yaml:\d+: aliases repeat more than")
@@ -326,7 +330,7 @@ class TestMalformedScenarioFiles(unittest.TestCase):
         started = time.perf_counter()
         with self.assertRaisesRegex(YamlFileError, r"^overrides '_l0: [^\n]*':\d+: aliases repeat"):
             LoadScenario("reach_around_ball", _Bomb(key="objects"))
-        self.assertLess(time.perf_counter() - started, 1.0)
+        self.assertLess(time.perf_counter() - started, HANG_GUARD)
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ from unittest import mock
 
 from battery_jobs import Count, FullDisk, Nan, Walk
 
-from mobee_drake.experiments import saggriac
+from mobee_drake.experiments import battery, saggriac
 from mobee_drake.experiments.battery import (
     RAY_MISSING,
     BatteryError,
@@ -28,6 +28,7 @@ from mobee_drake.experiments.battery import (
     LocalProcesses,
     Ray,
     RunBattery,
+    RunFolder,
 )
 
 TESTS = str(pathlib.Path(__file__).parent)
@@ -113,6 +114,17 @@ class LocalBatteryTest(TemporaryFolder):
             self.assertRegex(message, r"OSError: \[Errno 28\] No space left on device: '.*"
                                       r"result.json'")  # fmt: skip
             self.assertEqual(message.count("NotStarted: not started: [Errno 28]"), 6 - len(started))
+
+    def test_the_progress_record_is_written_at_most_once_a_second(self):
+        """Issue 32: a ch. 7 run rewrote it about 1,000 times, 13 % of the run's time."""
+        run = RunFolder(self.folder)
+        with mock.patch.object(battery, "WriteJsonAtomically") as write:
+            for done in range(1000):
+                run.Progress(done)
+            self.assertEqual([c.args[1] for c in write.call_args_list], [{"done": 0}])
+            with mock.patch.object(battery.time, "monotonic", return_value=time.monotonic() + 1):
+                run.Progress(1000)
+            self.assertEqual(write.call_args.args[1], {"done": 1000})
 
     def test_bad_jobs_are_refused(self):
         with self.assertRaisesRegex(TypeError, "job 'local'"):

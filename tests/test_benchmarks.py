@@ -20,6 +20,8 @@ class TestBenchmarks(unittest.TestCase):
                 self.assertTrue(np.isfinite(result.ratio) and result.ratio > 0)
                 self.assertGreater(result.peak_rss_mib, 0.0)
                 self.assertGreater(result.mean_pairs_in_fields, 0.0)
+                # The poses sweep the joints' ranges, far from the attractor: MoBeE pulls back.
+                self.assertGreater(result.mean_total_norm, 1.0)
 
     def test_stages_of_an_evaluation(self):
         stages = MeasureStages(5, num_poses=40, repeats=2, seed=3)
@@ -31,8 +33,11 @@ class TestBenchmarks(unittest.TestCase):
 
     def test_one_control_period_beside_its_floor(self):
         scenario = LoadScenario("motor_babbling", "{duration: 2.0}")
-        period, floor = ControlPeriodAndFloor(scenario)
-        self.assertTrue(np.isfinite([period, floor]).all() and period > 0 and floor > 0)
+        measured = ControlPeriodAndFloor(scenario)
+        self.assertTrue(np.isfinite([measured.period_us, measured.floor_us]).all())
+        self.assertGreater(min(measured.period_us, measured.floor_us), 0.0)
+        # The periods timed are a babbling robot's: some joint swept a good part of its range.
+        self.assertGreater(measured.travel_deg, 20.0)
 
 
 if __name__ == "__main__":

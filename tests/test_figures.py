@@ -40,7 +40,37 @@ def _LegendColours(legend) -> set:
     return colours
 
 
+def PlottedValues(figure) -> np.ndarray:
+    """Every number a figure draws: its lines' and scatters' coordinates, its bars' extents and
+    its images' pixels (what a figure that plots the wrong data would not contain)."""
+    values = []
+    for axis in figure.axes:
+        for line in axis.lines:
+            data = line.get_data_3d() if hasattr(line, "get_data_3d") else line.get_data()
+            values += [np.ravel(np.asarray(d, dtype=float)) for d in data]
+        for patch in axis.patches:
+            if hasattr(patch, "get_height"):
+                values.append([patch.get_x(), patch.get_y(), patch.get_width(), patch.get_height()])
+        for collection in axis.collections:
+            values.append(np.ravel(collection.get_offsets()))
+            if hasattr(collection, "_offsets3d"):
+                values += [np.ravel(np.asarray(c, dtype=float)) for c in collection._offsets3d]
+            if collection.get_array() is not None:
+                values.append(np.ravel(collection.get_array()))
+            for path in getattr(collection, "get_segments", lambda: [])():
+                values.append(np.ravel(path))
+        for image in axis.images:
+            values.append(np.ravel(image.get_array()))
+    return np.concatenate([np.ravel(np.asarray(v, dtype=float)) for v in values])
+
+
 class FigureTest(unittest.TestCase):
+    def assertPlots(self, figure, expected, name: str):
+        """Every number of ``expected`` (computed from the synthetic input) is drawn."""
+        plotted = PlottedValues(figure)
+        for value in np.ravel(expected):
+            self.assertTrue(np.isclose(plotted, value, rtol=1e-9, atol=1e-12).any(), (name, value))
+
     def assertReadable(self, figure, name: str):
         """Checks every axes of ``figure``, then draws and saves it (small)."""
         axes = [axis for axis in figure.axes if not _IsColorbar(axis)]
@@ -89,7 +119,9 @@ class TestCh7Figures(FigureTest):
             for strategy in ("curious", "random", "least_tried")
             for run in range(2)
         ]
-        self.assertReadable(ch7_model_learning.CoverageFigure(runs), "7.2")
+        figure = ch7_model_learning.CoverageFigure(runs)
+        self.assertPlots(figure, [50, 100, 40, 70], "7.2")  # (every run's mean is its own)
+        self.assertReadable(figure, "7.2")
 
     def test_rank_4(self):
         space = Lattice([0.2, 0.8], 4)
@@ -104,6 +136,7 @@ class TestCh7Figures(FigureTest):
             values=[RNG.random(n)],
         )
         figure = ch7_model_learning.Rank4Figure(run, space, np.array([5, 6]))
+        self.assertPlots(figure, run["values"][0], "7.3")
         self.assertReadable(figure, "7.3")
 
     def test_moving_box_and_three_agents(self):
@@ -112,13 +145,17 @@ class TestCh7Figures(FigureTest):
             no_box=dict(reliability=np.ones(64)),
             unreliable=[3, 9],
         )
-        self.assertReadable(ch7_model_learning.MovingBoxFigure(moving), "7.4.1")
+        figure = ch7_model_learning.MovingBoxFigure(moving)
+        self.assertPlots(figure, moving["moving_box"]["reliability"], "7.4.1")
+        self.assertReadable(figure, "7.4.1")
         agents = dict(
             agents=["right_arm", "left_arm", "torso"],
             tries=[RNG.integers(0, 9, 30) for _ in range(3)],
             actions=[10, 11, 12],
         )
-        self.assertReadable(ch7_model_learning.ThreeAgentsFigure(agents), "7.4")
+        figure = ch7_model_learning.ThreeAgentsFigure(agents)
+        self.assertPlots(figure, agents["tries"][0][agents["tries"][0] > 0], "7.4")
+        self.assertReadable(figure, "7.4")
 
 
 class TestCh8Figures(FigureTest):
@@ -189,6 +226,7 @@ class TestOtherFigures(FigureTest):
             for seed in range(2)
         ]
         figure = saggriac.CurvesFigure(runs, ["SAGG-RIAC", "ACTUATOR-Random"], 1)
+        self.assertPlots(figure, [10 / 101, 10 / 201, 5 / 201], "saggriac curves")
         self.assertReadable(figure, "saggriac curves")
         goals = np.zeros((40, 7))
         goals[:, 1:3] = RNG.uniform([0, -100], [100, 100], (40, 2))
@@ -204,15 +242,24 @@ class TestOtherFigures(FigureTest):
             ],
             spec=dict(experiment=2, seed=0, budget=1000),
         )
-        self.assertReadable(saggriac.GoalsFigure(run), "saggriac goals")
+        figure = saggriac.GoalsFigure(run)
+        # The last panel: every goal's bin, counted.
+        counts, *_ = np.histogram2d(goals[:, 1], goals[:, 2], 30, [[0, 100], [-100, 100]])
+        drawn = [a for a in figure.axes if not _IsColorbar(a)][-1].collections[0].get_array()
+        np.testing.assert_array_equal(np.sort(np.ravel(drawn)), np.sort(counts.ravel()))
+        self.assertEqual(np.sum(drawn), 40)
+        self.assertReadable(figure, "saggriac goals")
 
     def test_roadmap_and_scalability(self):
         points = RNG.uniform(-0.3, 0.0, (6, 3))
         roadmap = types.SimpleNamespace(edges=[(0, 1), (1, 2), (3, 4)])
         figure = trm_roadmaps.RoadmapFigure(points, roadmap, "reach_into", boxes=True)
+        self.assertPlots(figure, points, "trm")
         self.assertReadable(figure, "trm")
         curves = {"katana": [(0, 2e4, 1.9e4), (10, 3e3, 2e3)], "icub": [(0, 7e3, 6e3)]}
-        self.assertReadable(bench_forces.ScalabilityFigure(curves, churn=True), "2.4")
+        figure = bench_forces.ScalabilityFigure(curves, churn=True)
+        self.assertPlots(figure, [2e4, 1.9e4, 3e3, 2e3, 7e3, 6e3], "2.4")
+        self.assertReadable(figure, "2.4")
 
 
 if __name__ == "__main__":

@@ -15,6 +15,7 @@ from mobee_drake.resources import ScenarioNames
 from mobee_drake.scenario import BuildScenario, LoadScenario, Scenario
 from mobee_drake.station.builder import MakeMobeeStation
 from mobee_drake.station.config import Dynamic
+from mobee_drake.station.outcome import AttractorOutcome
 from mobee_drake.station.parts import ClientPorts, StationParts
 from mobee_drake.station.runner import RunStation
 from mobee_drake.station.world_events import MakeSimulator
@@ -70,16 +71,90 @@ class TestScenarioFile(unittest.TestCase):
 
 
 class TestShippedScenarios(unittest.TestCase):
-    def test_every_shipped_scenario_builds_and_runs(self):
-        names = ScenarioNames()
-        self.assertGreaterEqual(len(names), 7)
-        for name in names:
-            with self.subTest(name):
-                scenario = LoadScenario(name, "{duration: 0.1}")
-                # The sliders need Meshcat; every other scenario runs headless.
-                meshcat = Meshcat() if name == "interactive" else None
-                summary = RunStation(BuildScenario(scenario, meshcat), scenario.duration)
-                self.assertAlmostEqual(summary.simulated_time, 0.1)
+    """Every shipped scenario builds, runs, and does what it is for: each asserts an outcome of
+    its own that a robot MoBeE does not move would miss (issue 32)."""
+
+    def _Run(self, name: str, duration: float, meshcat=None):
+        """(station, its final root context, the robot's (q, v) at the start) of ``name``."""
+        station = BuildScenario(LoadScenario(name, f"{{duration: {duration}}}"), meshcat)
+        simulator = MakeSimulator(station)
+        simulator.Initialize()
+        start = station.robot_state.Eval(simulator.get_context()).copy()
+        simulator.AdvanceTo(duration)
+        return station, simulator.get_context(), start
+
+    def _Travel(self, station, context, start) -> float:
+        """The largest joint displacement (deg) from the start to ``context``."""
+        n = len(station.mobee.joints)
+        return np.degrees(np.abs(station.robot_state.Eval(context)[:n] - start[:n]).max())
+
+    def test_every_shipped_scenario_is_tested_here(self):
+        tested = {n.removeprefix("test_") for n in dir(self) if n.startswith("test_")}
+        self.assertLessEqual(set(ScenarioNames()), tested)
+
+    def test_reach_around_ball(self):
+        """The palm heads for its goal, beyond the ball, and stops at the ball without touching
+        it (from 10.5 cm to 6.0 cm of the goal)."""
+        station, context, _ = self._Run("reach_around_ball", 4.0)
+        start = AttractorOutcome(station, station.diagram.CreateDefaultContext())
+        end = AttractorOutcome(station, context)
+        palm = "marker_distance_to_goal_m"
+        self.assertGreater(start[palm]["r_palm"], 0.09)
+        self.assertLess(end[palm]["r_palm"], 0.65 * start[palm]["r_palm"])
+        report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
+        self.assertGreater(report.closest_approach["ball"], 0.0)
+
+    def _AssertExplores(self, name: str, duration: float) -> None:
+        """Every agent starts its actions from more than one state: the robot moves between
+        states (the learned counts cannot show it: a prior fills every outcome)."""
+        station = BuildScenario(LoadScenario(name, f"{{duration: {duration}}}"))
+        simulator = MakeSimulator(station)
+        simulator.Initialize()
+        supervisor = station.client
+        starts = {agent: set() for agent in supervisor.agent_names}
+        for t in np.arange(1.0, duration + 0.5, 1.0):
+            simulator.AdvanceTo(t)
+            context = supervisor.GetMyContextFromRoot(simulator.get_context())
+            for agent, record in zip(supervisor.agent_names, supervisor.Records(context)):
+                starts[agent].add(record.state)
+        for agent, states in starts.items():
+            with self.subTest(agent):
+                self.assertGreater(len(states), 2)
+
+    def test_explore_hypercube(self):
+        self._AssertExplores("explore_hypercube", 40.0)
+
+    def test_three_agents_table(self):
+        self._AssertExplores("three_agents_table", 40.0)
+
+    def test_motor_babbling(self):
+        """The robot babbles: some joint travels far from home."""
+        self.assertGreater(self._Travel(*self._Run("motor_babbling", 8.0)), 20.0)
+
+    def test_katana(self):
+        self.assertGreater(self._Travel(*self._Run("katana", 6.0)), 20.0)
+
+    def test_icub_and_katana(self):
+        """Both robots move: the iCub's arms and its companion Katana."""
+        station, context, start = self._Run("icub_and_katana", 6.0)
+        self.assertGreater(self._Travel(station, context, start), 20.0)
+        katana = station.diagram.GetSubsystemByName("katana_mobee")
+        q = katana.GetInputPort("state").Eval(katana.GetMyContextFromRoot(context))
+        n = len(katana.joints)
+        self.assertGreater(np.degrees(np.abs(q[:n] - katana.home).max()), 20.0)
+
+    def test_interactive(self):
+        """A slider moves the robot: its joint follows the slider to the value set."""
+        meshcat = Meshcat()
+        station = BuildScenario(LoadScenario("interactive", "{duration: 3}"), meshcat)
+        simulator = MakeSimulator(station)
+        simulator.Initialize()
+        elbow = station.mobee.joint_index("r_elbow")
+        home = np.degrees(station.mobee.home[elbow])
+        meshcat.SetSliderValue("r_elbow", home + 30.0)
+        simulator.AdvanceTo(3.0)
+        q = station.robot_state.Eval(simulator.get_context())
+        self.assertAlmostEqual(np.degrees(q[elbow]), home + 30.0, delta=2.0)
 
 
 class TestIllegalCombinations(unittest.TestCase):

@@ -64,6 +64,8 @@ class ForceBenchmarkResult:
     floor_us: float = 0.0
     # Peak resident memory of the process after the row (MiB).
     peak_rss_mib: float = 0.0
+    # The mean norm of MoBeE's total over the poses (M rad/s^2): what the evaluations computed.
+    mean_total_norm: float = 0.0
 
     @property
     def ratio(self) -> float:
@@ -203,11 +205,12 @@ def MeasureForceEvaluations(
                 _RandomBox(f"floor{repeat}_{k}", robot, rng) for k in range(num_poses)
             ]
         rates.append(num_poses / Sweep(repeat, lambda: total.Eval(mobee_context)))
-    pairs = 0
-    for q in poses[::10]:  # Untimed: how busy the field term was.
+    pairs, norms = 0, []
+    for q in poses[::10]:  # Untimed: how busy the field term was, and what MoBeE computed.
         x[order] = q
         plant.SetPositions(plant_context, x)
         pairs += len(contacts.Eval(mobee_context))
+        norms.append(np.linalg.norm(total.Eval(mobee_context)))
     return ForceBenchmarkResult(
         num_obstacles,
         max(rates),
@@ -215,6 +218,7 @@ def MeasureForceEvaluations(
         pairs / len(poses[::10]),
         floor_us=1e6 * min(floors),
         peak_rss_mib=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        mean_total_norm=float(np.mean(norms)),
     )
 
 

@@ -18,6 +18,8 @@ Run: ``mobee-drake bench simulation [--seconds 600] [--controls position velocit
 import dataclasses as dc
 import time
 
+import numpy as np
+
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat
 from mobee_drake.experiments.bench_forces import BuildPosedScene, FloorEvaluation
 from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario, Scenario
@@ -27,10 +29,20 @@ from mobee_drake.station.world_events import MakeSimulator
 SCENARIO = "motor_babbling"
 
 
-def ControlPeriodAndFloor(scenario: Scenario) -> tuple[float, float]:
-    """(us per control period of the kinematic robot, us of Drake's floor per period) over the
-    scenario's duration (see the module); the period is timed without the data log, whose
-    second, untimed run gives the poses the floor replays."""
+@dc.dataclass
+class PeriodAndFloor:
+    """One control period of the kinematic robot beside Drake's floor for it (see the module)."""
+
+    period_us: float
+    floor_us: float
+    # How far the babbling robot went: the largest range of a joint over the run (deg).
+    travel_deg: float
+
+
+def ControlPeriodAndFloor(scenario: Scenario) -> PeriodAndFloor:
+    """One control period and Drake's floor over the scenario's duration (see the module); the
+    period is timed without the data log, whose second, untimed run gives the poses the floor
+    replays."""
     timed = BuildScenario(dc.replace(scenario, data_log=DataLog(enabled=False)))
     simulator = MakeSimulator(timed)
     simulator.Initialize()
@@ -60,7 +72,8 @@ def ControlPeriodAndFloor(scenario: Scenario) -> tuple[float, float]:
         scene.plant.SetPositions(plant_context, x)
         floor_evaluation()
     floor = (time.perf_counter() - start) / len(poses)
-    return 1e6 * per_period, 1e6 * floor
+    travel = np.degrees((poses.max(axis=0) - poses.min(axis=0)).max())
+    return PeriodAndFloor(1e6 * per_period, 1e6 * floor, float(travel))
 
 
 def main(argv=None) -> None:
@@ -96,7 +109,8 @@ def main(argv=None) -> None:
         )
     except ValueError as error:
         parser.error(f"--scenario: {error}")
-    period, floor = ControlPeriodAndFloor(kinematic)
+    measured = ControlPeriodAndFloor(kinematic)
+    period, floor = measured.period_us, measured.floor_us
     print(
         f"kinematic robot, one control period of {kinematic.time_step * 1000:g} ms: "
         f"{period:.0f} us ({kinematic.time_step * 1e6 / period:.0f}x real time); Drake's floor "

@@ -3,6 +3,7 @@
 import math
 
 import numpy as np
+from pydrake.common.containers import namedview
 from pydrake.common.value import AbstractValue
 from pydrake.geometry import QueryObject
 from pydrake.multibody.plant import MultibodyPlant
@@ -35,6 +36,8 @@ FORCE_TERMS = (
     "f_flow",
     "f_barrier",
 )
+# The rows of MoBeE's "forces" output, named: each term of FORCE_TERMS, then their total.
+ForceRows = namedview("ForceRows", FORCE_TERMS + ("total",))
 
 
 class Mobee(LeafSystem):
@@ -117,8 +120,16 @@ class Mobee(LeafSystem):
         self._plant = plant
         self._params = params = params or MobeeParams()
         self._joints = list(joints)
-        n = len(self._joints)
         params.Validate(self._joints)
+        self._SetUpJointTerms(plant, robot, params, step)
+        self._SetUpFieldsAndMarkers(plant, robot)
+        self._DeclareInputs()
+        self._DeclareCaches(plant)
+        self._DeclareOutputs()
+
+    def _SetUpJointTerms(self, plant, robot: RobotOverlay, params: MobeeParams, step) -> None:
+        """The constants of the joint-space terms: eq. 5.7's mass, damping and spring, the
+        joint limits (eq. 5.12) and constraints (eq. 5.15), and the barrier's step."""
         self._robot = controlled = ControlledRobot.Of(plant, robot, self._joints, "MoBeE")
         # Generalized forces over the plant's velocities onto the controlled joints (their
         # followers' included: robots/couplings.py).
@@ -153,6 +164,10 @@ class Mobee(LeafSystem):
             f"{j} velocity" for j in self._joints
         ]
 
+    def _SetUpFieldsAndMarkers(self, plant, robot: RobotOverlay) -> None:
+        """The robot's fields (eq. 5.11), the screws every Jacobian comes from, the barrier's
+        support points and the markers a client may push (eq. 5.10)."""
+        controlled = self._robot
         self._fields = RobotFields(robot.field_margins)
         self._geometry_names = dict(robot.geometry_names)
         # Every Jacobian below comes from the joints' screws, through the body of each point.
@@ -183,8 +198,9 @@ class Mobee(LeafSystem):
             np.array([int(b.index()) for b in self._marker_bodies], dtype=int)
         )
         self._marker_force_names = [f"{m.name}[{axis}]" for m in self._markers for axis in "xyz"]
-        num_markers = len(self._markers)
 
+    def _DeclareInputs(self) -> None:
+        n, num_markers = len(self._joints), len(self._markers)
         self._state_port = self.DeclareVectorInputPort("state", 2 * n)
         self._attractor_port = self.DeclareVectorInputPort("attractor", n)
         self._config_force_port = self.DeclareVectorInputPort("config_force", n)
@@ -194,6 +210,10 @@ class Mobee(LeafSystem):
         )
         self._reference_port = self.DeclareVectorInputPort("reference_state", 2 * n)
 
+    def _DeclareCaches(self, plant) -> None:
+        """Scratch data shared by the outputs: the checked attractor, the plant context at the
+        input configuration, the joints' screws there and the markers' poses."""
+        n, num_markers = len(self._joints), len(self._markers)
         # The attractor changes rarely: it is checked once per change, not once per evaluation.
         self._attractor_entry = self.DeclareCacheEntry(
             description="checked attractor",
@@ -222,7 +242,6 @@ class Mobee(LeafSystem):
             ),
             prerequisites_of_calc={plant_ticket},
         )
-        screws_ticket = self._screws_entry.ticket()
         self._marker_pose_entry = self.DeclareCacheEntry(
             description="marker positions and directions",
             value_producer=ValueProducer(
@@ -232,10 +251,13 @@ class Mobee(LeafSystem):
             prerequisites_of_calc={plant_ticket},
         )
 
+    def _DeclareOutputs(self) -> None:
+        n, num_markers = len(self._joints), len(self._markers)
+        screws_ticket = self._screws_entry.ticket()
         # The forces and the field pairs are computed by their own output ports, whose values Drake
         # caches: the other ports, MoBeE's own terms and every client share one evaluation.
         forces_prerequisites = {
-            state_ticket,
+            self._state_port.ticket(),
             screws_ticket,
             self._marker_pose_entry.ticket(),
             self._query_port.ticket(),  # (the field pairs)
@@ -305,21 +327,25 @@ class Mobee(LeafSystem):
         params: MobeeParams | None = None,
         step: StepModel | None = None,
         name: str = "mobee",
+        measured_state: bool = True,
     ) -> "Mobee":
-        """Adds MoBeE to ``builder`` and connects its state and geometry query.
-
-        The state comes from ``plant``'s state output through a selector of ``joints``; the
-        attractor and the client's forces are left for the caller to connect or fix.
+        """Adds MoBeE to ``builder`` and connects its geometry query and, with
+        ``measured_state``, its state: ``plant``'s state output through a selector of ``joints``
+        (the system ``<name>_state_selector``). Without it, the caller connects the state (the
+        kinematic robot's: MoBeE's own virtual dynamics, built from MoBeE's constants). The
+        attractor and the client's forces are left for the caller to connect or fix. The
+        station builds every MoBeE through here.
         """
         mobee = builder.AddNamedSystem(
             name, Mobee(plant, robot, joints=joints, params=params, step=step)
         )
-        joint_indices = [plant.GetJointByName(j, robot.instance).index() for j in joints]
-        selector = builder.AddNamedSystem(
-            f"{name}_state_selector", MatrixGain(plant.MakeStateSelectorMatrix(joint_indices))
-        )
-        builder.Connect(plant.get_state_output_port(), selector.get_input_port())
-        builder.Connect(selector.get_output_port(), mobee.GetInputPort("state"))
+        if measured_state:
+            joint_indices = [plant.GetJointByName(j, robot.instance).index() for j in joints]
+            selector = builder.AddNamedSystem(
+                f"{name}_state_selector", MatrixGain(plant.MakeStateSelectorMatrix(joint_indices))
+            )
+            builder.Connect(plant.get_state_output_port(), selector.get_input_port())
+            builder.Connect(selector.get_output_port(), mobee.GetInputPort("state"))
         builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
         return mobee
 
@@ -448,17 +474,17 @@ class Mobee(LeafSystem):
         p = self._params
         q, v = self._ReadState(context)
         q_star = self._attractor_entry.Eval(context)
-        terms = output.get_mutable_value().reshape(len(FORCE_TERMS) + 1, len(q))  # (a view)
+        f = ForceRows(output.get_mutable_value().reshape(len(FORCE_TERMS) + 1, len(q)))  # (views)
 
         # -L(K(q - q*)) as L(K(q* - q)): L is odd (the same numbers, one operation fewer).
-        terms[0] = Squash(self._stiffness * (q_star - q), *self._squash["spring"])
-        np.multiply(self._negative_damping, v, out=terms[1])
-        terms[2:] = 0.0
+        f.spring = Squash(self._stiffness * (q_star - q), *self._squash["spring"])
+        np.multiply(self._negative_damping, v, out=f.damping)
+        f[FORCE_TERMS.index("f_lim") :] = 0.0
         depths = self._band_rows @ q + self._band_offsets
         if depths.max() > 0.0:
             n = len(q)
-            terms[2] = self._limits.ForceAtDepths(depths[: 2 * n].reshape(2, n))
-            terms[3] = self._clauses.ForceAtDepths(
+            f.f_lim = self._limits.ForceAtDepths(depths[: 2 * n].reshape(2, n))  # eq. 5.12
+            f.f_cst = self._clauses.ForceAtDepths(  # eq. 5.15
                 depths[2 * n :], p.constraint_delta, p.constraint_force
             )
 
@@ -468,12 +494,12 @@ class Mobee(LeafSystem):
             normals = self._FieldNormals(context, pairs)
             # Eq. 5.11: the gain times the field penetration along each pair's normal, summed.
             collision = (p.collision_gain * (pairs.margin - pairs.distance)) @ normals
-            terms[4] = Squash(collision, *self._squash["collision"])
+            f.f_coll = Squash(collision, *self._squash["collision"])
 
         if self._config_force_port.HasValue(context):
             f_q = self._config_force_port.Eval(context)
             self._CheckFinite("config_force", f_q, self._joints)
-            terms[5] = Squash(f_q, *self._squash["config"])
+            f.f_config = Squash(f_q, *self._squash["config"])  # eq. 5.9
 
         if self._markers and self._marker_forces_port.HasValue(context):
             f_m = self._marker_forces_port.Eval(context).reshape(-1, 3)
@@ -486,11 +512,11 @@ class Mobee(LeafSystem):
                     self._marker_pose_entry.Eval(context)[0][loaded],
                     f_m[loaded],
                 ).sum(axis=0)
-                terms[6] = Squash(generalized, *self._squash["work"])
+                f.f_work = Squash(generalized, *self._squash["work"])  # eq. 5.10
 
         if p.flow.enabled and normals is not None:
-            goal_directed = terms[0] + terms[5] + terms[6]  # the spring and the client's forces
-            terms[7] = (
+            goal_directed = f.spring + f.f_config + f.f_work  # the spring and the client's forces
+            f.f_flow = (
                 ModulatedFlow(
                     goal_directed, normals, pairs.distance, pairs.margin, p.barrier.clearance
                 )
@@ -498,8 +524,9 @@ class Mobee(LeafSystem):
             )
 
         if self._barrier:
-            terms[8] = self._Barrier(context, q, v, terms[:8].sum(axis=0), pairs, normals)
-        np.sum(terms[:-1], axis=0, out=terms[-1])
+            others = f[: FORCE_TERMS.index("f_barrier")].sum(axis=0)
+            f.f_barrier = self._Barrier(context, q, v, others, pairs, normals)
+        np.sum(f[: len(FORCE_TERMS)], axis=0, out=f.total)
 
     def _Barrier(self, context, q, v, total, pairs: FieldPairs, normals) -> np.ndarray:
         """The safety barrier's force (:mod:`mobee_drake.mobee.barrier`) for the pairs inside

@@ -178,16 +178,3 @@ def FreezeJoints(
         plant.WeldFrames(frame_on_parent, frame_on_child, X_FM)
         frozen[name] = angle
     return frozen
-
-
-def JointStateSelector(
-    plant: MultibodyPlant, joints: list[str], instance: ModelInstanceIndex
-) -> np.ndarray:
-    """The matrix S with ``x_plant = S [q; v]`` for (q, v) of one-DOF ``joints`` of model
-    ``instance``, in that order: Drake's state selector, transposed.
-
-    Its transpose selects those joints' (q, v) from the plant's state; its upper-left block maps
-    their positions into the plant's positions.
-    """
-    indices = [plant.GetJointByName(name, instance).index() for name in joints]
-    return plant.MakeStateSelectorMatrix(indices).T

@@ -47,7 +47,6 @@ from mobee_drake.mobee.barrier import JointTracking, StepModel
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.mobee.reflex import ReflexController
 from mobee_drake.mobee.system import Mobee
-from mobee_drake.robots.assembly import JointStateSelector
 from mobee_drake.robots.couplings import LinearMapSystem
 from mobee_drake.robots.overlay import RobotOverlay
 from mobee_drake.robots.scenario_robot import AddScenarioRobot
@@ -149,10 +148,19 @@ def _AddMobee(
     step = None
     if not isinstance(mover_config, Reflex):
         step = _StepModel(mover_config, time_step)
-    mobee = builder.AddNamedSystem(
-        f"{prefix}mobee", Mobee(plant, robot, joints=joints, params=params, step=step)
+    mobee = Mobee.AddToBuilder(
+        builder,
+        plant=plant,
+        scene_graph=scene_graph,
+        robot=robot,
+        joints=joints,
+        params=params,
+        step=step,
+        name=f"{prefix}mobee",
+        # The dynamic robot's MoBeE sees the plant's measured state; the kinematic one's is its
+        # virtual dynamics' (connected by the caller).
+        measured_state=isinstance(mover_config, Dynamic),
     )
-    builder.Connect(scene_graph.get_query_output_port(), mobee.GetInputPort("geometry_query"))
     if isinstance(mover_config, Reflex):
         mover = builder.AddNamedSystem(
             f"{prefix}reflex",
@@ -367,11 +375,9 @@ def MakeMobeeStation(
         builder, plant, scene_graph, world, config, companions
     )
     if isinstance(mover_config, Dynamic):
-        # The controlled joints' (q, v), read from the plant (followers left out).
-        selector = JointStateSelector(plant, mobee.joints, robot.instance).T
-        from_plant = builder.AddNamedSystem("from_plant_state", MatrixGain(selector))
-        builder.Connect(plant.get_state_output_port(), from_plant.get_input_port())
-        robot_state = from_plant.get_output_port()
+        # The controlled joints' (q, v), read from the plant (followers left out) by MoBeE's
+        # state selector.
+        robot_state = builder.GetSubsystemByName("mobee_state_selector").get_output_port()
         _AddJointController(
             builder, plant, mobee, state_map, to_plant, mover_config, config.time_step
         )
@@ -383,7 +389,7 @@ def MakeMobeeStation(
             builder, plant, scene_graph, [to_plant.get_output_port()] + companion_positions
         )
         robot_state = mover.GetOutputPort("state")
-    builder.Connect(robot_state, mobee.GetInputPort("state"))
+        builder.Connect(robot_state, mobee.GetInputPort("state"))
 
     monitor = builder.AddNamedSystem(
         "safety_monitor",
