@@ -363,6 +363,12 @@ class TestExperimentsSmoke(unittest.TestCase):
             )
             self.assertEqual(result["strategy"], strategy)
             self.assertGreaterEqual(result["actions"][0], 3)  # the run's stop condition
+            # The report's row holds the run's own numbers (issue 32: wrong numbers passed).
+            transitions, tried = result["coverage"][-1]
+            self.assertIn(
+                f"| {strategy} | 0 | {transitions} | {tried} | -",
+                (output / "report_7.2.md").read_text(),
+            )
         self.assertTrue((output / "7.2_coverage.png").is_file())
         experiments.main(["--experiment", "7.3", "--output", str(output), "--transitions", "2"])
         report = (output / "report_7.3.md").read_text()
@@ -370,7 +376,14 @@ class TestExperimentsSmoke(unittest.TestCase):
         self.assertIn("| 12.5-87.5 |", report)
         experiments.main(["--experiment", "7.4", "--output", str(output), "--transitions", "6"])
         report = (output / "report_7.4.md").read_text()
-        self.assertIn("correlation of the right and the left arm", report)
+        three = json.loads(next((output / "runs").glob("7.4*/result.json")).read_text())
+        right, left = (np.array(t, dtype=float) for t in three["tries"][:2])
+        self.assertIn(
+            "correlation of the right and the left arm's tries per state-action: "
+            f"{np.corrcoef(right, left)[0, 1]:.3f}",
+            report,
+        )
+        self.assertIn(f"- transitions: {sum(three['actions'])} ({three['actions']}", report)
         self.assertIn("hand-table contact", report)
         self.assertTrue((output / "7.4_three_agents.png").is_file())
         experiments.main(

@@ -647,124 +647,141 @@ def ThreeAgentsFigure(results: dict) -> Figure:
     return figure
 
 
-def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
-    """Writes ``experiment``'s figures into ``output``; returns its report's lines."""
+def _HypercubeReport(output: pathlib.Path, results) -> list[str]:
+    """The hypercube of ch. 7.1: tries and values after 320 actions, per gamma."""
     lines = []
-    if experiment == "7.1":
-        SaveFigure(HypercubeFigure(results), output / "7.1_hypercube.png")
+    SaveFigure(HypercubeFigure(results), output / "7.1_hypercube.png")
+    for gamma in sorted({r["gamma"] for r in results}):
+        mine = [r for r in results if r["gamma"] == gamma]
+        tries = np.array([r["snapshots"]["320"]["tries"] for r in mine])
+        values = np.array([r["snapshots"]["320"]["values"] for r in mine])
+        lines.append(
+            f"| {gamma} | {len(mine)} | {tries.mean():.2f} | "
+            f"{tries.std(axis=1).mean():.2f} | {values.mean():.4f} | "
+            f"{np.mean([r['wall_seconds'] for r in mine]):.1f} |"
+        )
+    header = [
+        "| gamma | runs | mean tries per state-action after 320 actions | "
+        "spread of tries (std over state-actions, mean over runs) | mean V(s, a) | "
+        "wall s per run |",
+        "|---:|---:|---:|---:|---:|---:|",
+    ]
+    return header + lines
+
+
+def _CoverageReport(output: pathlib.Path, results) -> list[str]:
+    """Coverage (ch. 7.2): transitions until every state-action was tried."""
+    lines = []
+    SaveFigure(CoverageFigure(results), output / "7.2_coverage.png")
+    for strategy in ("curious", "random", "least_tried"):
+        for r in [r for r in results if r["strategy"] == strategy]:
+            coverage = np.array(r["coverage"])
+            full = coverage[coverage[:, 1] >= COVERAGE_STATE_ACTIONS, 0]
+            lines.append(
+                f"| {strategy} | {r['run']} | {coverage[-1, 0]} | "
+                f"{coverage[-1, 1]} | {full[0] if len(full) else '-'} |"
+            )
+    return [
+        "| strategy | run | transitions | state-actions tried | transitions to try all |",
+        "|---|---:|---:|---:|---:|",
+    ] + lines
+
+
+def _Rank4Report(output: pathlib.Path, results) -> list[str]:
+    """The rank-4 lattices (ch. 7.3): states never entered, several outcomes."""
+    lines = []
+    header = [
+        "| lattice | actions | states never entered (clearance of the tightest "
+        "constraint clause at their centres, deg of joint space) | state-actions with "
+        "several outcomes (tried >= 3 times) | most-tried state-action: tries, share "
+        "ending in its goal |",
+        "|---|---:|---|---:|---|",
+    ]
+    for r in results:
+        space = Lattice(r["levels"], 4)
+        tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
+        entered = np.zeros(space.num_states, dtype=bool)
+        entered[space.action_state[tries > 0]] = True  # an action was tried from it
+        never = np.flatnonzero(~entered)
+        clearance = _ConstraintClearances(space.centres[never])
+        clearances = [f"{s_}: {c:.0f}" for s_, c in zip(never, clearance)]
+        several = int(np.sum((misses > 0) & (misses < 1) & (tries >= 3)))
+        top = int(np.argmax(tries))
+        lines.append(
+            f"| {r['lattice']} | {r['actions'][0]} | {len(never)}: "
+            f"{', '.join(clearances) or '-'} | {several} | "
+            f"{space.action_state[top]}->{space.action_goal[top]}: {tries[top]}, "
+            f"{100 * (1 - misses[top]):.0f} % |"
+        )
+        SaveFigure(Rank4Figure(r, space, never), output / f"7.3_{r['lattice']}.png")
+    return header + lines
+
+
+def _InitializationReport(output: pathlib.Path, results) -> list[str]:
+    """The initialisations (ch. 7.2): state-actions that miss their goal."""
+    lines = []
+    space = Lattice([0.25, 0.5, 0.75], 4)
+    header = [
+        "| initialisation | gamma | run | actions | state-actions missing their goal "
+        "in more than 10 % of >= 3 tries (state -> goal: misses/tries) |",
+        "|---|---:|---:|---:|---|",
+    ]
+    for initialization in ("50-50", "60-40"):
+        SaveFigure(
+            InitializationFigure(results, initialization),
+            output / f"7.2i_{initialization}.png",
+        )
         for gamma in sorted({r["gamma"] for r in results}):
-            mine = [r for r in results if r["gamma"] == gamma]
-            tries = np.array([r["snapshots"]["320"]["tries"] for r in mine])
-            values = np.array([r["snapshots"]["320"]["values"] for r in mine])
-            lines.append(
-                f"| {gamma} | {len(mine)} | {tries.mean():.2f} | "
-                f"{tries.std(axis=1).mean():.2f} | {values.mean():.4f} | "
-                f"{np.mean([r['wall_seconds'] for r in mine]):.1f} |"
-            )
-        header = [
-            "| gamma | runs | mean tries per state-action after 320 actions | "
-            "spread of tries (std over state-actions, mean over runs) | mean V(s, a) | "
-            "wall s per run |",
-            "|---:|---:|---:|---:|---:|---:|",
-        ]
-        return header + lines
-    if experiment == "7.2":
-        SaveFigure(CoverageFigure(results), output / "7.2_coverage.png")
-        for strategy in ("curious", "random", "least_tried"):
-            for r in [r for r in results if r["strategy"] == strategy]:
-                coverage = np.array(r["coverage"])
-                full = coverage[coverage[:, 1] >= COVERAGE_STATE_ACTIONS, 0]
-                lines.append(
-                    f"| {strategy} | {r['run']} | {coverage[-1, 0]} | "
-                    f"{coverage[-1, 1]} | {full[0] if len(full) else '-'} |"
+            for r in results:
+                if r["initialization"] != initialization or r["gamma"] != gamma:
+                    continue
+                tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
+                unreliable = np.flatnonzero((misses > 0.1) & (tries >= 3))
+                listed = ", ".join(
+                    f"{space.action_state[i]}->{space.action_goal[i]}: "
+                    f"{round(misses[i] * tries[i])}/{tries[i]}"
+                    for i in unreliable
                 )
-        return [
-            "| strategy | run | transitions | state-actions tried | transitions to try all |",
-            "|---|---:|---:|---:|---:|",
-        ] + lines
-    if experiment == "7.3":
-        header = [
-            "| lattice | actions | states never entered (clearance of the tightest "
-            "constraint clause at their centres, deg of joint space) | state-actions with "
-            "several outcomes (tried >= 3 times) | most-tried state-action: tries, share "
-            "ending in its goal |",
-            "|---|---:|---|---:|---|",
-        ]
-        for r in results:
-            space = Lattice(r["levels"], 4)
-            tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
-            entered = np.zeros(space.num_states, dtype=bool)
-            entered[space.action_state[tries > 0]] = True  # an action was tried from it
-            never = np.flatnonzero(~entered)
-            clearance = _ConstraintClearances(space.centres[never])
-            clearances = [f"{s_}: {c:.0f}" for s_, c in zip(never, clearance)]
-            several = int(np.sum((misses > 0) & (misses < 1) & (tries >= 3)))
-            top = int(np.argmax(tries))
-            lines.append(
-                f"| {r['lattice']} | {r['actions'][0]} | {len(never)}: "
-                f"{', '.join(clearances) or '-'} | {several} | "
-                f"{space.action_state[top]}->{space.action_goal[top]}: {tries[top]}, "
-                f"{100 * (1 - misses[top]):.0f} % |"
-            )
-            SaveFigure(Rank4Figure(r, space, never), output / f"7.3_{r['lattice']}.png")
-        return header + lines
-    if experiment == "7.2i":
-        space = Lattice([0.25, 0.5, 0.75], 4)
-        header = [
-            "| initialisation | gamma | run | actions | state-actions missing their goal "
-            "in more than 10 % of >= 3 tries (state -> goal: misses/tries) |",
-            "|---|---:|---:|---:|---|",
-        ]
-        for initialization in ("50-50", "60-40"):
-            SaveFigure(
-                InitializationFigure(results, initialization),
-                output / f"7.2i_{initialization}.png",
-            )
-            for gamma in sorted({r["gamma"] for r in results}):
-                for r in results:
-                    if r["initialization"] != initialization or r["gamma"] != gamma:
-                        continue
-                    tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
-                    unreliable = np.flatnonzero((misses > 0.1) & (tries >= 3))
-                    listed = ", ".join(
-                        f"{space.action_state[i]}->{space.action_goal[i]}: "
-                        f"{round(misses[i] * tries[i])}/{tries[i]}"
-                        for i in unreliable
-                    )
-                    lines.append(
-                        f"| {initialization} | {gamma} | {r['run']} | "
-                        f"{r['actions'][0]} | {listed or '-'} |"
-                    )
-        return header + lines
-    if experiment == "7.4.1":
-        SaveFigure(MovingBoxFigure(results), output / "7.4.1_moving_box.png")
-        unreliable = np.array(results["unreliable"], dtype=int)
-        risky = {(results["action_state"][sa], results["action_goal"][sa]) for sa in unreliable}
-        header = [
-            f"- unreliable state-actions learned among the moving box (reached their goal "
-            f"in < {UNRELIABLE:.0%} of >= 5 tries), state -> goal: "
-            + (", ".join(f"{s_}->{g}" for s_, g in sorted(risky)) or "none"),
-            f"- problems with one risky and one safe shortest route: {len(results['problems'])}",
-            "",
-            "| trained | greedy plans over a risky step | executed problems | actions per "
-            "problem | failed transitions per problem | problems that tried a risky "
-            "state-action | penetrating control periods |",
-            "|---|---:|---:|---:|---:|---:|---:|",
-        ]
-        for trained in ("moving_box", "no_box"):
-            r = results[trained]
-            crossing = sum(
-                any(step in risky for step in zip(path, path[1:])) for path in r["plans"]
-            )
-            episodes = r["episodes"] or [dict(actions=0, failed=0, tried=[])]
-            lines.append(
-                f"| {trained} | {crossing} of {len(r['plans'])} | {len(r['episodes'])} | "
-                f"{np.mean([e['actions'] for e in episodes]):.2f} | "
-                f"{np.mean([e['failed'] for e in episodes]):.2f} | "
-                f"{np.mean([bool(set(e['tried']) & set(unreliable)) for e in episodes]):.0%} | "
-                f"{r.get('penetrating_steps', 0)} |"
-            )
-        return header + lines
+                lines.append(
+                    f"| {initialization} | {gamma} | {r['run']} | "
+                    f"{r['actions'][0]} | {listed or '-'} |"
+                )
+    return header + lines
+
+
+def _MovingBoxReport(output: pathlib.Path, results) -> list[str]:
+    """The moving box (ch. 7.4.1): plans and executions over risky steps."""
+    lines = []
+    SaveFigure(MovingBoxFigure(results), output / "7.4.1_moving_box.png")
+    unreliable = np.array(results["unreliable"], dtype=int)
+    risky = {(results["action_state"][sa], results["action_goal"][sa]) for sa in unreliable}
+    header = [
+        f"- unreliable state-actions learned among the moving box (reached their goal "
+        f"in < {UNRELIABLE:.0%} of >= 5 tries), state -> goal: "
+        + (", ".join(f"{s_}->{g}" for s_, g in sorted(risky)) or "none"),
+        f"- problems with one risky and one safe shortest route: {len(results['problems'])}",
+        "",
+        "| trained | greedy plans over a risky step | executed problems | actions per "
+        "problem | failed transitions per problem | problems that tried a risky "
+        "state-action | penetrating control periods |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for trained in ("moving_box", "no_box"):
+        r = results[trained]
+        crossing = sum(any(step in risky for step in zip(path, path[1:])) for path in r["plans"])
+        episodes = r["episodes"] or [dict(actions=0, failed=0, tried=[])]
+        lines.append(
+            f"| {trained} | {crossing} of {len(r['plans'])} | {len(r['episodes'])} | "
+            f"{np.mean([e['actions'] for e in episodes]):.2f} | "
+            f"{np.mean([e['failed'] for e in episodes]):.2f} | "
+            f"{np.mean([bool(set(e['tried']) & set(unreliable)) for e in episodes]):.0%} | "
+            f"{r.get('penetrating_steps', 0)} |"
+        )
+    return header + lines
+
+
+def _ThreeAgentsReport(output: pathlib.Path, results) -> list[str]:
+    """Three agents (ch. 7.4): tries, contacts and surprises per agent."""
     SaveFigure(ThreeAgentsFigure(results), output / "7.4_three_agents.png")
     right, left = (np.array(t, dtype=float) for t in results["tries"][:2])
     correlation = float(np.corrcoef(right, left)[0, 1])
@@ -811,6 +828,17 @@ def _Plots(output: pathlib.Path, experiment: str, results) -> list[str]:
     return lines
 
 
+# Each experiment's figures, written into the output folder; each returns its report's lines.
+_REPORTS = {
+    "7.1": _HypercubeReport,
+    "7.2": _CoverageReport,
+    "7.3": _Rank4Report,
+    "7.2i": _InitializationReport,
+    "7.4.1": _MovingBoxReport,
+    "7.4": _ThreeAgentsReport,
+}
+
+
 def main(argv=None) -> None:
     parser = CommandParser(
         prog="mobee-drake experiment ch7",
@@ -850,7 +878,7 @@ def main(argv=None) -> None:
         results = RunThreeAgents(output, args.transitions or 18000, backend)
     else:
         results = RunDynamicPlanning(output, args.transitions or 1000, args.runs, backend)
-    table = _Plots(output, args.experiment, results)
+    table = _REPORTS[args.experiment](output, results)
     report = output / f"report_{args.experiment}.md"
     report.write_text(
         f"# Experiment {args.experiment}\n\n`mobee-drake experiment ch7 "

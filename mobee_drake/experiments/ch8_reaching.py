@@ -751,17 +751,35 @@ def StoredResults(output: pathlib.Path) -> list[dict]:
 def _SettingReport(output: pathlib.Path, results: list[dict]) -> str:
     """Plots and the report of one setting's runs."""
     by_strategy = _Group(results)
-    strategies = list(by_strategy)
     stages = sorted({int(k) for r in results for k in r["evaluations"]})
     k, m = results[0]["num_transitions"], results[0]["num_states"]
+    _SaveSettingFigures(output, by_strategy, stages, k, m)
+    prints = {s: [Fingerprints(r) for r in runs] for s, runs in by_strategy.items()}
+    sections = (
+        _RewardSection(results, by_strategy, stages),
+        _EffortSection(by_strategy, k),
+        _MdpSection(results, by_strategy, k),
+        _FingerprintSection(results, prints, stages, m),
+        _ClaimsSection(by_strategy, prints, stages),
+    )
+    return "\n".join(line for section in sections for line in section)
+
+
+def _SaveSettingFigures(output: pathlib.Path, by_strategy: dict, stages, k: int, m: int) -> None:
+    """Fig. 8.2, 8.4-8.6 (per strategy), 8.7 and 8.8 of one setting's runs."""
     SaveFigure(CumulativeRewardFigure(by_strategy, stages), output / "8.2_cumulative_reward.png")
-    for strategy in strategies:
+    for strategy in by_strategy:
         SaveFigure(
             ReachesFigure(strategy, by_strategy[strategy], stages, k, m),
             output / f"8.4-8.6_reaches_{strategy}.png",
         )
     SaveFigure(ProblemTriesFigure(by_strategy, stages, k, m), output / "8.7_problem_tries.png")
     SaveFigure(FailedTransitionsFigure(by_strategy, k), output / "8.8_failed_transitions.png")
+
+
+def _RewardSection(results: list[dict], by_strategy: dict, stages) -> list[str]:
+    """Fig. 8.2's cumulative reward per strategy and stage, with and without the penalties."""
+    strategies = list(by_strategy)
     lines = [
         "## Cumulative reward of the exploitation evaluations (Fig. 8.2)",
         "",
@@ -793,7 +811,13 @@ def _SettingReport(output: pathlib.Path, results: list[dict]) -> str:
                 + " | ".join(_MeanSd(_RunSums(runs, s, penalties)) for s in stages)
                 + " |"
             )
-    lines += [
+    return lines
+
+
+def _EffortSection(by_strategy: dict, k: int) -> list[str]:
+    """Robot time, failed transitions, timed-out problem-tries and safety per strategy."""
+    strategies = list(by_strategy)
+    lines = [
         "",
         "## Robot time, failed transitions and reaches",
         "",
@@ -821,31 +845,39 @@ def _SettingReport(output: pathlib.Path, results: list[dict]) -> str:
             f"{_BarrierPeriods(by_strategy[strategy])} |"
         )
 
-    if all("mdp" in r for r in results):
-        lines += [
-            "",
-            "## The MDP learned with the reaches (ch. 9.4.1)",
-            "",
-            f"State-actions (of {k}) whose model was updated (tried without the fields "
-            "feeling the target), and their learned probability of reaching their goal "
-            "state (the optimistic initialisation says 0.5), mean over seeds.",
-            "",
-            "| strategy | state-actions updated | P(goal) |",
-            "|---|---:|---:|",
-        ]
-        for strategy in strategies:
-            runs = [r["mdp"] for r in by_strategy[strategy]]
-            success = [
-                r["success_probability"] for r in runs if r["success_probability"] is not None
-            ]
-            lines.append(
-                f"| {strategy} | "
-                f"{np.mean([r['updated_state_actions'] for r in runs]):.0f} | "
-                + (f"{np.mean(success):.2f} |" if success else "- |")
-            )
+    return lines
 
-    prints = {s: [Fingerprints(r) for r in by_strategy[s]] for s in strategies}
-    lines += [
+
+def _MdpSection(results: list[dict], by_strategy: dict, k: int) -> list[str]:
+    """The MDP learned with the reaches (ch. 9.4.1), when the runs recorded it."""
+    if not all("mdp" in r for r in results):
+        return []
+    lines = [
+        "",
+        "## The MDP learned with the reaches (ch. 9.4.1)",
+        "",
+        f"State-actions (of {k}) whose model was updated (tried without the fields "
+        "feeling the target), and their learned probability of reaching their goal "
+        "state (the optimistic initialisation says 0.5), mean over seeds.",
+        "",
+        "| strategy | state-actions updated | P(goal) |",
+        "|---|---:|---:|",
+    ]
+    for strategy, strategy_runs in by_strategy.items():
+        runs = [r["mdp"] for r in strategy_runs]
+        success = [r["success_probability"] for r in runs if r["success_probability"] is not None]
+        lines.append(
+            f"| {strategy} | "
+            f"{np.mean([r['updated_state_actions'] for r in runs]):.0f} | "
+            + (f"{np.mean(success):.2f} |" if success else "- |")
+        )
+    return lines
+
+
+def _FingerprintSection(results: list[dict], prints: dict, stages, m: int) -> list[str]:
+    """The behavioural fingerprints of ch. 8.4.2-8.4.4 per strategy."""
+    strategies = list(prints)
+    lines = [
         "",
         "## Behavioural fingerprints (ch. 8.4.2-8.4.4), mean ± sd over runs",
         "",
@@ -884,7 +916,13 @@ def _SettingReport(output: pathlib.Path, results: list[dict]) -> str:
                 i = [f["line_share"][s] for f in prints["intrinsic"]]
                 lines.append(f"- problem-tries up to {s}: {_Compare(g, i)}")
 
-    lines += [
+    return lines
+
+
+def _ClaimsSection(by_strategy: dict, prints: dict, stages) -> list[str]:
+    """Intrinsic motivation against the other strategies: the source's claims (ch. 8.4)."""
+    strategies = list(by_strategy)
+    lines = [
         "",
         "## The source's claims (ch. 8.4)",
         "",
@@ -923,7 +961,7 @@ def _SettingReport(output: pathlib.Path, results: list[dict]) -> str:
             + _Compare(hours["random"], hours["greedy"] + hours["intrinsic"])
             + ".",
         ]
-    return "\n".join(lines)
+    return lines
 
 
 def main(argv=None) -> None:
