@@ -331,26 +331,17 @@ def _ConnectClient(
     return attractor, client.marker_forces
 
 
-def MakeMobeeStation(
-    config: StationConfig, meshcat: Meshcat | None = None, *, prebuild_callback=None
-) -> Station:
-    """Builds the station of ``config``; with ``meshcat``, also the viewer.
-
-    ``prebuild_callback(parts: StationParts) -> ClientPorts | None``, if given, adds the client
-    (see :mod:`mobee_drake.station.parts`) and any other systems of the user's (a logger, a
-    supervisor). What the client offers, its world-event requests among it, is what its
-    :class:`~mobee_drake.station.parts.ClientPorts` declares, checked here; simulate the station
-    with :func:`~mobee_drake.station.world_events.MakeSimulator`, which applies the requests.
-    """
-    builder = DiagramBuilder()
-    mover_config = config.mover
-    if isinstance(mover_config, Dynamic):
-        plant, scene_graph = AddMultibodyPlant(mover_config.plant_config, builder)
+def _AddPlantAndWorld(builder: DiagramBuilder, config: StationConfig):
+    """The plant (simulated for the dynamic robot; kinematics and geometry only otherwise) and
+    SceneGraph, the robot and its companions in it, and the world's objects; returns (plant,
+    scene_graph, (robot overlay, controlled joints), the companions' likewise, the live world)."""
+    if isinstance(config.mover, Dynamic):
+        plant, scene_graph = AddMultibodyPlant(config.mover.plant_config, builder)
     else:
         scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
         plant = MultibodyPlant(0.0)
         plant.RegisterAsSourceForSceneGraph(scene_graph)
-    robot, joints = AddScenarioRobot(plant, scene_graph, config.robot)
+    robot = AddScenarioRobot(plant, scene_graph, config.robot)
     companions = [
         AddScenarioRobot(
             plant,
@@ -365,7 +356,61 @@ def MakeMobeeStation(
     for obj in config.objects:
         world.Register(obj)
     plant.Finalize()
+    return plant, scene_graph, robot, companions, world
 
+
+def _ConnectRobotState(
+    builder, plant, scene_graph, config, mobee, mover, state_map, to_plant, companion_positions
+) -> OutputPort:
+    """What MoBeE sees of the robot: the dynamic robot's plant (through MoBeE's state selector),
+    with its joint controller, or the kinematic robots' virtual dynamics, which pose their
+    geometry; returns the robot's (q, v) in MoBeE's joint order."""
+    if isinstance(config.mover, Dynamic):
+        # The controlled joints' (q, v), read from the plant (followers left out).
+        robot_state = builder.GetSubsystemByName("mobee_state_selector").get_output_port()
+        _AddJointController(
+            builder, plant, mobee, state_map, to_plant, config.mover, config.time_step
+        )
+        if config.mover.control != "force":
+            # The barrier predicts the plant's lag behind the virtual trajectory it tracks.
+            builder.Connect(mover.GetOutputPort("state"), mobee.GetInputPort("reference_state"))
+        return robot_state
+    _PoseKinematicRobots(
+        builder, plant, scene_graph, [to_plant.get_output_port()] + companion_positions
+    )
+    robot_state = mover.GetOutputPort("state")
+    builder.Connect(robot_state, mobee.GetInputPort("state"))
+    return robot_state
+
+
+def _AddSafetyMonitor(
+    builder: DiagramBuilder, scene_graph: SceneGraph, world: LiveWorld, mobee: Mobee, period: float
+) -> SafetyMonitor:
+    """The monitor of the robot's safety: clearances, penetrations, the barrier's periods."""
+    monitor = builder.AddNamedSystem(
+        "safety_monitor",
+        SafetyMonitor(names=world.names, period=period, num_joints=len(mobee.joints)),
+    )
+    builder.Connect(mobee.GetOutputPort("f_barrier"), monitor.GetInputPort("f_barrier"))
+    builder.Connect(mobee.GetOutputPort("field_pairs"), monitor.GetInputPort("field_pairs"))
+    builder.Connect(scene_graph.get_query_output_port(), monitor.GetInputPort("geometry_query"))
+    return monitor
+
+
+def MakeMobeeStation(
+    config: StationConfig, meshcat: Meshcat | None = None, *, prebuild_callback=None
+) -> Station:
+    """Builds the station of ``config``; with ``meshcat``, also the viewer.
+
+    ``prebuild_callback(parts: StationParts) -> ClientPorts | None``, if given, adds the client
+    (see :mod:`mobee_drake.station.parts`) and any other systems of the user's (a logger, a
+    supervisor). What the client offers, its world-event requests among it, is what its
+    :class:`~mobee_drake.station.parts.ClientPorts` declares, checked here; simulate the station
+    with :func:`~mobee_drake.station.world_events.MakeSimulator`, which applies the requests.
+    """
+    builder = DiagramBuilder()
+    mover_config = config.mover
+    plant, scene_graph, (robot, joints), companions, world = _AddPlantAndWorld(builder, config)
     mobee, mover, state_map, to_plant = _AddMobee(
         builder, plant, scene_graph, robot, joints, config.mobee, config.time_step, mover_config
     )
@@ -374,30 +419,10 @@ def MakeMobeeStation(
     companion_positions, companion_ports = _AddCompanions(
         builder, plant, scene_graph, world, config, companions
     )
-    if isinstance(mover_config, Dynamic):
-        # The controlled joints' (q, v), read from the plant (followers left out) by MoBeE's
-        # state selector.
-        robot_state = builder.GetSubsystemByName("mobee_state_selector").get_output_port()
-        _AddJointController(
-            builder, plant, mobee, state_map, to_plant, mover_config, config.time_step
-        )
-        if mover_config.control != "force":
-            # The barrier predicts the plant's lag behind the virtual trajectory it tracks.
-            builder.Connect(mover.GetOutputPort("state"), mobee.GetInputPort("reference_state"))
-    else:
-        _PoseKinematicRobots(
-            builder, plant, scene_graph, [to_plant.get_output_port()] + companion_positions
-        )
-        robot_state = mover.GetOutputPort("state")
-        builder.Connect(robot_state, mobee.GetInputPort("state"))
-
-    monitor = builder.AddNamedSystem(
-        "safety_monitor",
-        SafetyMonitor(names=world.names, period=config.time_step, num_joints=len(mobee.joints)),
+    robot_state = _ConnectRobotState(
+        builder, plant, scene_graph, config, mobee, mover, state_map, to_plant, companion_positions
     )
-    builder.Connect(mobee.GetOutputPort("f_barrier"), monitor.GetInputPort("f_barrier"))
-    builder.Connect(mobee.GetOutputPort("field_pairs"), monitor.GetInputPort("field_pairs"))
-    builder.Connect(scene_graph.get_query_output_port(), monitor.GetInputPort("geometry_query"))
+    monitor = _AddSafetyMonitor(builder, scene_graph, world, mobee, config.time_step)
 
     parts = StationParts(
         builder=builder,
@@ -451,11 +476,14 @@ def MakeMobeeStation(
             request_ports=request_ports,
             client=client.data_log if client is not None else None,
         )
+    for port, name in (
+        (robot_state, "robot_state"),
+        (attractor, "attractor"),
+        (mobee.GetOutputPort("marker_positions"), "marker_positions"),
+        (mobee.GetOutputPort("field_pairs"), "field_pairs"),
+    ):
+        builder.ExportOutput(port, name)
 
-    builder.ExportOutput(robot_state, "robot_state")
-    builder.ExportOutput(attractor, "attractor")
-    builder.ExportOutput(mobee.GetOutputPort("marker_positions"), "marker_positions")
-    builder.ExportOutput(mobee.GetOutputPort("field_pairs"), "field_pairs")
     diagram = builder.Build()
     diagram.set_name("mobee_station")
     return Station(

@@ -168,6 +168,18 @@ class StationConfig:
 
 def StationConfigErrors(config: StationConfig) -> list[str]:
     """What is wrong with ``config`` that its types cannot say (empty: nothing)."""
+    names = [obj.name for obj in config.objects]
+    return (
+        _MoverErrors(config)
+        + _TimingAndViewErrors(config)
+        + _ObjectErrors(config.objects)
+        + _WorldEventErrors(config.world_events, set(names))
+        + _CompanionErrors(config, set(names))
+    )
+
+
+def _MoverErrors(config: StationConfig) -> list[str]:
+    """The dynamic robot's control and plant, MoBeE 1.0's reflex."""
     errors = []
     mover = config.mover
     if isinstance(mover, Dynamic):
@@ -194,6 +206,12 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
         and mover.tolerance_deg > 0
     ):
         errors.append("reflex: speed_deg and tolerance_deg must be finite and > 0, history >= 2")
+    return errors
+
+
+def _TimingAndViewErrors(config: StationConfig) -> list[str]:
+    """The robot's joints, MoBeE's period, the viewer and the data log."""
+    errors = []
     if isinstance(config.robot, IcubConfig) and not config.robot.controlled_joints:
         errors.append("robot controlled_joints must name at least one joint")
     if not (math.isfinite(config.time_step) and MIN_TIME_STEP <= config.time_step <= MAX_TIME_STEP):
@@ -217,13 +235,19 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
         errors.append(f"data_log max_rows must be >= 1, got {log.max_rows}")
     if not (math.isfinite(log.period) and log.period >= 0):
         errors.append(f"data_log period must be >= 0 s (0: every control period), got {log.period}")
+    return errors
+
+
+def _ObjectErrors(objects: list[SceneObject]) -> list[str]:
+    """Their number, names, roles, poses and shapes."""
+    errors = []
     names = set()
-    if len(config.objects) > MAX_OBJECTS:
+    if len(objects) > MAX_OBJECTS:
         errors.append(
             f"objects: at most {MAX_OBJECTS} (SceneGraph's collision filter grows with their "
-            f"square), got {len(config.objects)}"
+            f"square), got {len(objects)}"
         )
-    for obj in config.objects:
+    for obj in objects:
         if not obj.name or obj.name in names:
             errors.append(f"every object needs a unique name, got '{obj.name}'")
         names.add(obj.name)
@@ -241,7 +265,13 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
                 f"world's origin, got {obj.position}"
             )
         errors += _ShapeErrors(obj.name, obj.shape)
-    for event in config.world_events:
+    return errors
+
+
+def _WorldEventErrors(events: list[WorldEvent], names: set[str]) -> list[str]:
+    """Each scripted event's object, role, position and time."""
+    errors = []
+    for event in events:
         where = f"world event at {event.time} s"
         if event.object not in names:
             errors.append(f"{where} names unknown object '{event.object}'")
@@ -253,6 +283,12 @@ def StationConfigErrors(config: StationConfig) -> list[str]:
             errors.append(f"{where}: its time must be >= 0 and its numbers finite")
         elif event.position and max(map(abs, event.position)) > MAX_WORLD_EXTENT:
             errors.append(f"{where}: position must lie within {MAX_WORLD_EXTENT:g} m of the origin")
+    return errors
+
+
+def _CompanionErrors(config: StationConfig, names: set[str]) -> list[str]:
+    """Each companion's mover, name (not an object's), pose and attractor."""
+    errors, mover = [], config.mover
     for companion in config.companions:
         if isinstance(mover, Dynamic):
             errors.append(
