@@ -12,7 +12,7 @@ from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake import __version__
-from mobee_drake.atomic_files import WriteJsonAtomically
+from mobee_drake.atomic_files import WriteJsonAtomically, WriteTextAtomically
 from mobee_drake.experiments.arguments import CommandParser, NonEmpty, PositiveFloat
 from mobee_drake.experiments.battery import BatteryError, BatteryRefused, TerminationInterrupts
 from mobee_drake.mobee.system import Mobee
@@ -52,8 +52,8 @@ def _Fail(message: str) -> None:
     sys.exit(2)
 
 
-def _Run(args: list[str]) -> None:
-    """Runs a scenario and prints its summary."""
+def _RunParser() -> CommandParser:
+    """The command line of ``mobee-drake run``."""
     parser = CommandParser(
         prog="mobee-drake run",
         description="Simulate a scenario: a file, or the name of a shipped one ("
@@ -104,6 +104,31 @@ def _Run(args: list[str]) -> None:
     parser.add_argument(
         "--graphviz", type=NonEmpty, help="write the diagram's Graphviz (dot) text to this file"
     )
+    return parser
+
+
+def _RunOutputs(known) -> tuple[str | None, str | None, pathlib.Path]:
+    """Where ``run`` writes its recording, data log and summary (the summary and the log beside
+    the recording, or where it would be), each checked before the run."""
+    default_record = pathlib.Path("results") / (pathlib.Path(known.scenario).stem + ".html")
+    record = None
+    if not (known.no_record or known.no_meshcat):
+        record = known.record or str(default_record)
+    summary_file = pathlib.Path(record or default_record).with_suffix(".summary.json")
+    data_log = None
+    if not known.no_log:
+        data_log = known.log or str(
+            pathlib.Path(record or default_record).with_suffix(".log.parquet")
+        )
+    for output in (record, data_log, known.graphviz, summary_file):
+        if output and not CanWrite(output):
+            _Fail(f"{output}: cannot be written (its folder is missing, read-only or full?)")
+    return record, data_log, summary_file
+
+
+def _Run(args: list[str]) -> None:
+    """Runs a scenario and prints its summary."""
+    parser = _RunParser()
     known = parser.parse_args(args)
 
     overrides = list(known.set)
@@ -111,20 +136,7 @@ def _Run(args: list[str]) -> None:
         overrides.append(f"{{duration: {known.duration}}}")
     if known.no_log:
         overrides.append("{data_log: {enabled: false}}")
-    default_record = pathlib.Path("results") / (pathlib.Path(known.scenario).stem + ".html")
-    record = None
-    if not (known.no_record or known.no_meshcat):
-        record = known.record or str(default_record)
-    # The summary and the log go beside the recording (or where it would be).
-    summary_file = pathlib.Path(record or default_record).with_suffix(".summary.json")
-    data_log = None
-    if not known.no_log:
-        data_log = known.log or str(
-            pathlib.Path(record or default_record).with_suffix(".log.parquet")
-        )
-    for output in (record, data_log, known.graphviz, summary_file):  # Checked before the run.
-        if output and not CanWrite(output):
-            _Fail(f"{output}: cannot be written (its folder is missing, read-only or full?)")
+    record, data_log, summary_file = _RunOutputs(known)
     meshcat = None
     if known.meshcat and not known.no_meshcat:
         meshcat = StartMeshcat()
@@ -138,7 +150,7 @@ def _Run(args: list[str]) -> None:
     except ValueError as e:  # YamlFileError included
         _Fail(str(e))
     if known.graphviz:
-        pathlib.Path(known.graphviz).write_text(station.diagram.GetGraphvizString())
+        WriteTextAtomically(known.graphviz, station.diagram.GetGraphvizString())
     try:
         summary = RunStation(
             station,

@@ -292,7 +292,8 @@ def ScalabilityFigure(curves: dict[str, list[tuple]], churn: bool) -> Figure:
     return figure
 
 
-def main(argv=None) -> None:
+def _Parser() -> CommandParser:
+    """The command line of ``mobee-drake bench forces``."""
     parser = CommandParser(
         prog="mobee-drake bench forces",
         description=__doc__,
@@ -336,6 +337,11 @@ def main(argv=None) -> None:
         action="store_true",
         help="instead, time each stage of one evaluation: " + ", ".join(STAGES),
     )
+    return parser
+
+
+def main(argv=None) -> None:
+    parser = _Parser()
     args = parser.parse_args(argv)
     if args.plot and not CanWrite(args.plot):  # (checked before the work)
         parser.error(f"--plot {args.plot}: cannot be written (its folder is missing, read-only?)")

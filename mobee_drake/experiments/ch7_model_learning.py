@@ -39,6 +39,7 @@ from pydrake.geometry import SceneGraph
 from pydrake.multibody.plant import MultibodyPlant
 from scipy.stats import spearmanr
 
+from mobee_drake.atomic_files import WriteTextAtomically
 from mobee_drake.experiments.arguments import CommandParser, PositiveInt
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
@@ -839,7 +840,8 @@ _REPORTS = {
 }
 
 
-def main(argv=None) -> None:
+def _Parser() -> CommandParser:
+    """The command line of ``mobee-drake experiment ch7``."""
     parser = CommandParser(
         prog="mobee-drake experiment ch7",
         description=__doc__,
@@ -862,6 +864,11 @@ def main(argv=None) -> None:
         "source's 14,597 and 26,963); 7.4: in all (default 18,000)",
     )
     AddBackendArguments(parser)
+    return parser
+
+
+def main(argv=None) -> None:
+    parser = _Parser()
     argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(argv)
     output = ClaimFolder(args.output, "battery")  # (a file or a user's folder refused)
@@ -879,12 +886,12 @@ def main(argv=None) -> None:
     else:
         results = RunDynamicPlanning(output, args.transitions or 1000, args.runs, backend)
     table = _REPORTS[args.experiment](output, results)
-    report = output / f"report_{args.experiment}.md"
-    report.write_text(
+    text = (
         f"# Experiment {args.experiment}\n\n`mobee-drake experiment ch7 "
         f"{' '.join(argv)}` ({Provenance(output)})\n\n" + "\n".join(table) + "\n"
     )
-    print(report.read_text())
+    WriteTextAtomically(output / f"report_{args.experiment}.md", text)
+    print(text)
 
 
 if __name__ == "__main__":

@@ -52,7 +52,8 @@ def ReachMisses(space, force: float, states, problems: np.ndarray, radius: float
     return misses
 
 
-def main(argv=None) -> None:
+def _Parser() -> CommandParser:
+    """The command line of ``mobee-drake experiment ch8-discounting``."""
     parser = CommandParser(prog="mobee-drake experiment ch8-discounting", description=__doc__)
     parser.add_argument("--model", required=True, help="the MDP's folder (runs/mdp_tries5/model)")
     parser.add_argument(
@@ -97,6 +98,11 @@ def main(argv=None) -> None:
     parser.add_argument("--probe-states", type=PositiveInt, default=12, help="start states drawn")
     parser.add_argument("--probe-problems", type=PositiveInt, default=9, help="problems drawn")
     parser.add_argument("--seed", type=NonNegativeInt, default=0, help="seed of the draws")
+    return parser
+
+
+def main(argv=None) -> None:
+    parser = _Parser()
     args = parser.parse_args(argv)
     if args.misses[0] >= args.misses[1]:
         parser.error(f"--misses: the first must be the smaller, got {args.misses}")
@@ -113,6 +119,17 @@ def main(argv=None) -> None:
     learner = ReachLearner(
         space, counts, np.zeros((1, 3)), ReachLearningConfig(gamma=args.gamma, delta=1e-10)
     )
+    p, thresholds = _PrintModelRatios(args, model, learner)
+    _PrintReplays(args, model)
+    _PrintUnits(args)
+    _PrintReachForces(args, model, StepRatio(args.gamma, p), float(thresholds.mean()))
+
+
+def _PrintModelRatios(args, model, learner) -> tuple[float, np.ndarray]:
+    """The learned MDP's success probability, and the value ratio a move needs, closed form
+    against value iteration, per number of steps to the favourites; returns (p, the needed
+    ratio of each state)."""
+    space = model.space
     probabilities = model.transitions.Probabilities()
     rows = np.arange(space.num_state_actions)
     success = probabilities[rows, space.action_goal]
@@ -145,7 +162,12 @@ def main(argv=None) -> None:
         f"{np.median(thresholds):.3f}; closed form at the mean steps "
         f"{StepRatio(args.gamma, p) ** steps.mean():.3f}"
     )
-    low, high = args.misses
+    return p, thresholds
+
+
+def _PrintReplays(args, model) -> None:
+    """Each run of ``--runs`` replayed: its rewards, eq. 8.5's spread and where greedy moves."""
+    space, counts = model.space, model.transitions.counts
     for path in args.runs:
         run = json.loads(pathlib.Path(path).read_text())
         settings = run["settings"]
@@ -167,13 +189,23 @@ def main(argv=None) -> None:
             f"start states from which the greedy policy moves: {100 * moving.mean():.1f} % "
             f"(at most {100 * moving.max():.1f} % for a problem)"
         )
+
+
+def _PrintUnits(args) -> None:
+    """The rewards of the misses ``--misses`` in each unit of ``--units``."""
+    low, high = args.misses
     for unit in args.units:
         print(
             f"misses {100 * low:g}-{100 * high:g} cm in units of {unit:g} m: rewards "
             f"{1 / (1 + high / unit):.3f}-{1 / (1 + low / unit):.3f}, ratio at most "
             f"{RewardRatio(low, high, unit):.2f}"
         )
-    step, start = StepRatio(args.gamma, p), float(thresholds.mean())
+
+
+def _PrintReachForces(args, model, step: float, start: float) -> None:
+    """Per reach force: the misses from probe start states, and how often the best state's
+    reward beats one step's and a random start's needed ratio."""
+    space = model.space
     rng = np.random.default_rng(args.seed)
     grid = LoadTargetGrid()
     targets = grid.Centres()

@@ -51,7 +51,12 @@ import time
 import numpy as np
 from pydrake.geometry import StartMeshcat
 
-from mobee_drake.atomic_files import CurrentGeneration, StrictJson, WriteGeneration
+from mobee_drake.atomic_files import (
+    CurrentGeneration,
+    StrictJson,
+    WriteGeneration,
+    WriteTextAtomically,
+)
 from mobee_drake.experiments.arguments import (
     CommandParser,
     InRange,
@@ -964,7 +969,8 @@ def _ClaimsSection(by_strategy: dict, prints: dict, stages) -> list[str]:
     return lines
 
 
-def main(argv=None) -> None:
+def _Parser() -> CommandParser:
+    """The command line of ``mobee-drake experiment ch8``."""
     parser = CommandParser(
         prog="mobee-drake experiment ch8",
         description=__doc__,
@@ -1069,6 +1075,11 @@ def main(argv=None) -> None:
         "(runs/*/result.json; batteries of earlier versions too)",
     )
     AddBackendArguments(parser, workers=2)
+    return parser
+
+
+def main(argv=None) -> None:
+    parser = _Parser()
     argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(argv)
     stages = args.stages or [s for s in SOURCE_STAGES if s <= args.problem_tries]
@@ -1121,12 +1132,12 @@ def main(argv=None) -> None:
             args.mdp_tries,
             BackendOf(args),
         )
-    report = output / "report.md"
-    report.write_text(
+    text = (
         f"# Reach learning (ch. 8.4)\n\n`mobee-drake experiment ch8 "
         f"{' '.join(argv)}` ({Provenance(output)})\n\n" + Report(output, results) + "\n"
     )
-    print(report.read_text())
+    WriteTextAtomically(output / "report.md", text)
+    print(text)
 
 
 if __name__ == "__main__":

@@ -943,12 +943,8 @@ def Analyse(specs: list[RunSpec], output: pathlib.Path, command: str) -> None:
     WriteReport(all_runs, statistics, groups, command, output / "report.md")
 
 
-def main(argv=None) -> None:
-    """Command line: runs the missing runs, then analyses.
-
-    Args:
-        argv: Arguments (default: sys.argv[1:]).
-    """
+def _Parser() -> CommandParser:
+    """The command line of ``mobee-drake experiment saggriac``."""
     parser = CommandParser(
         prog="mobee-drake experiment saggriac",
         description=__doc__,
@@ -1020,6 +1016,16 @@ def main(argv=None) -> None:
         + ", ".join(f"--{name.replace('_', '-')} {value}" for name, value in SMOKE.items()),
     )
     AddBackendArguments(parser)
+    return parser
+
+
+def main(argv=None) -> None:
+    """Command line: runs the missing runs, then analyses.
+
+    Args:
+        argv: Arguments (default: sys.argv[1:]).
+    """
+    parser = _Parser()
     args = parser.parse_args(argv)
     # --smoke's sizes, or the paper's, for what the command line does not give.
     for name, value in (SMOKE if args.smoke else FULL).items():

@@ -97,7 +97,7 @@ def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) ->
     path = roadmap.Path(start, goal)
     ShowRoadmap(meshcat, points, roadmap)
     RecordMotion(example.model, PathMotion(roadmap, path))
-    (output / f"{name}.html").write_text(meshcat.StaticHtml())
+    WriteTextAtomically(output / f"{name}.html", meshcat.StaticHtml())
     colliding = EdgeCollisions(example, roadmap)
     seconds = roadmap.build_seconds
     extent = roadmap.y.max(axis=0) - roadmap.y.min(axis=0)
