@@ -223,21 +223,10 @@ def _Checkpoint(
     WriteGeneration(folder, Write)
 
 
-def RunOne(
-    run_dir: pathlib.Path,
-    mdp_dir: pathlib.Path,
-    settings: RunSettings,
-    meshcat=None,
-    progress=None,
-    should_stop=None,
-) -> dict:
-    """One run of the battery (resumes from ``run_dir/checkpoint``); returns its result. With
-    ``meshcat``, the run is shown there in real time; ``progress(n)``, if given, is told the
-    problem-tries done at every checkpoint; ``should_stop()``, if given, is asked after every
-    problem-try, and when True the run saves its checkpoint and raises JobStopped."""
-    run_dir.mkdir(parents=True, exist_ok=True)
+def _NewLearner(settings: RunSettings, mdp_dir: pathlib.Path):
+    """(the MDP's model, a new reach learner on it, the target grid): the model is the
+    optimistic initial one of the lattice, learned with the reaches, or the one learned first."""
     simultaneous = settings.mdp == "simultaneous"
-    # The optimistic initial model of the MDP's lattice, or the model learned first.
     model = (
         Explorer(Lattice(LEVELS, len(RIGHT_ARM)))
         if simultaneous
@@ -256,6 +245,36 @@ def RunOne(
             tie_break=settings.tie_break,
         ),
     )
+    return model, learner, grid
+
+
+def _LearnedMdp(run_dir: pathlib.Path, learner: ReachLearner, model: Explorer) -> dict:
+    """Saves the MDP learned with the reaches (``mdp.npz``); the state-actions it learned about
+    and their learned chance of reaching their goal."""
+    counts = learner.model.counts
+    np.savez(run_dir / "mdp.npz", counts=counts)
+    updated = np.flatnonzero(np.any(counts != model.transitions.counts, axis=1))
+    success = learner.model.Probabilities()[updated, model.space.action_goal[updated]]
+    return dict(
+        updated_state_actions=len(updated),
+        success_probability=float(success.mean()) if len(updated) else None,
+    )
+
+
+def RunOne(
+    run_dir: pathlib.Path,
+    mdp_dir: pathlib.Path,
+    settings: RunSettings,
+    meshcat=None,
+    progress=None,
+    should_stop=None,
+) -> dict:
+    """One run of the battery (resumes from ``run_dir/checkpoint``); returns its result. With
+    ``meshcat``, the run is shown there in real time; ``progress(n)``, if given, is told the
+    problem-tries done at every checkpoint; ``should_stop()``, if given, is asked after every
+    problem-try, and when True the run saves its checkpoint and raises JobStopped."""
+    run_dir.mkdir(parents=True, exist_ok=True)
+    model, learner, grid = _NewLearner(settings, mdp_dir)
     robot = ReachRobot(model.space, grid.radius, settings.reach_force, meshcat)
     checkpoint = run_dir / "checkpoint"
     data = dict(evaluations={}, wall_seconds=0.0, target=None)
@@ -295,18 +314,8 @@ def RunOne(
     Save()
     arrays, _ = learner.ToArrays()
     extra = {}
-    if simultaneous:
-        counts = learner.model.counts
-        np.savez(run_dir / "mdp.npz", counts=counts)
-        # The state-actions the model learned about, and their learned chance of success.
-        updated = np.flatnonzero(np.any(counts != model.transitions.counts, axis=1))
-        success = learner.model.Probabilities()[updated, model.space.action_goal[updated]]
-        extra = dict(
-            mdp=dict(
-                updated_state_actions=len(updated),
-                success_probability=float(success.mean()) if len(updated) else None,
-            )
-        )
+    if settings.mdp == "simultaneous":
+        extra = dict(mdp=_LearnedMdp(run_dir, learner, model))
     safety = robot.Safety()
     result = dict(
         settings=dc.asdict(settings),

@@ -205,25 +205,32 @@ def RunStation(
         if checkpoint:
             Save(context)
         wall = time.perf_counter() - start
-        recording = None
-        if record:
-            station.meshcat.StopRecording()
-            station.meshcat.PublishRecording()
-            path = pathlib.Path(record)
-            WriteTextAtomically(path, station.meshcat.StaticHtml())
-            recording = str(path.resolve())
-        written_log = None
-        if data_log and station.data_log is not None:
-            table = log.Table(context) if log is not None else station.data_log.Table(context)
-            WriteTable(data_log, table)
-            written_log = str(pathlib.Path(data_log).resolve())
         report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
         return RunSummary(
             simulated_time=context.get_time() - (resumed or 0.0),
             wall_time=wall,
             safety=report,
-            recording=recording,
-            data_log=written_log,
+            recording=_SaveRecording(station, record) if record else None,
+            data_log=_WriteLog(station, context, data_log, log) if data_log else None,
             resumed_at=resumed,
             outcome=RunOutcome(station, context),
         )
+
+
+def _SaveRecording(station: Station, record: str) -> str:
+    """Stops the station's Meshcat recording and writes it to ``record`` (HTML); its path."""
+    station.meshcat.StopRecording()
+    station.meshcat.PublishRecording()
+    path = pathlib.Path(record)
+    WriteTextAtomically(path, station.meshcat.StaticHtml())
+    return str(path.resolve())
+
+
+def _WriteLog(station: Station, context, data_log: str, log: CheckpointedLog | None) -> str | None:
+    """Writes the run's data log (the checkpoints' segments first, if any) to ``data_log``;
+    its path (None: the station keeps no log)."""
+    if station.data_log is None:
+        return None
+    table = log.Table(context) if log is not None else station.data_log.Table(context)
+    WriteTable(data_log, table)
+    return str(pathlib.Path(data_log).resolve())
