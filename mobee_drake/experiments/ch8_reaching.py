@@ -1032,6 +1032,20 @@ def _Parser() -> CommandParser:
         help="run only the first strategy's seed 0, in this process, shown in "
         "Meshcat in real time (the address is printed)",
     )
+    _AddSettingArguments(parser)
+    parser.add_argument(
+        "--report-only",
+        action="store_true",
+        help="run nothing: write the plots and report.md of the finished runs in --output "
+        "(runs/*/result.json; batteries of earlier versions too)",
+    )
+    AddBackendArguments(parser, workers=2)
+    return parser
+
+
+def _AddSettingArguments(parser: CommandParser) -> None:
+    """The reach learner's settings: its predictor, its MDP, the distance unit and reach force
+    (a preset or swept values) and how the greedy policy breaks ties."""
     parser.add_argument(
         "--predictor",
         choices=PREDICTORS,
@@ -1077,14 +1091,6 @@ def _Parser() -> CommandParser:
         help="how the greedy policy picks among state-actions of equal value: the first "
         "(transitions before the reach) or a random one (use another --output)",
     )
-    parser.add_argument(
-        "--report-only",
-        action="store_true",
-        help="run nothing: write the plots and report.md of the finished runs in --output "
-        "(runs/*/result.json; batteries of earlier versions too)",
-    )
-    AddBackendArguments(parser, workers=2)
-    return parser
 
 
 def main(argv=None) -> None:

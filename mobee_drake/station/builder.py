@@ -308,14 +308,15 @@ def _PoseKinematicRobots(
 def _ConnectClient(
     builder: DiagramBuilder, client: ClientPorts | None, mobee: Mobee, mover, reflex: bool
 ) -> tuple[OutputPort, OutputPort | str]:
-    """Wires the client's ports into MoBeE (and MoBeE 1.0's mover); without a client, the
-    attractor and the client's forces are inputs of the diagram. Returns the attractor's port and
-    the marker forces' port or diagram input name."""
+    """Checks what the client declares and wires its ports into MoBeE (and MoBeE 1.0's mover);
+    without a client, the attractor and the client's forces are inputs of the diagram. Returns
+    the attractor's port and the marker forces' port or diagram input name."""
     if client is None:
         attractor_input = builder.AddNamedSystem("attractor_input", PassThrough(len(mobee.joints)))
         builder.ExportInput(attractor_input.get_input_port(), "attractor")
         attractor = attractor_input.get_output_port()
     else:
+        CheckClientPorts(client)
         attractor = client.attractor
     builder.Connect(attractor, mobee.GetInputPort("attractor"))
     if reflex:  # MoBeE 1.0: the attractor is the position move command.
@@ -435,8 +436,6 @@ def MakeMobeeStation(
         random_seed=config.random_seed,
     )
     client = prebuild_callback(parts) if prebuild_callback else None
-    if client is not None:
-        CheckClientPorts(client)
     attractor, marker_forces = _ConnectClient(
         builder, client, mobee, mover, isinstance(mover_config, Reflex)
     )
