@@ -216,7 +216,7 @@ def _Experiment(args: list[str]) -> None:
         args,
         {
             "ch7": "mobee_drake.experiments.ch7_model_learning",
-            "ch8": "mobee_drake.experiments.ch8_reaching",
+            "ch8": "mobee_drake.experiments.ch8_command",
             "ch8-discounting": "mobee_drake.experiments.ch8_discounting",
             "saggriac": "mobee_drake.experiments.saggriac",
             "roadmaps": "mobee_drake.experiments.ch4_roadmaps",

@@ -13,7 +13,7 @@ import numpy as np
 from mobee_drake.experiments import (
     bench_forces,
     ch7_model_learning,
-    ch8_reaching,
+    ch8_figures,
     saggriac,
     trm_roadmaps,
 )
@@ -193,21 +193,19 @@ class TestCh8Figures(FigureTest):
 
     def test_figures(self):
         by_strategy = {s: [self.Run(s, seed) for seed in range(2)] for s in ("random", "intrinsic")}
-        self.assertReadable(ch8_reaching.CumulativeRewardFigure(by_strategy, self.STAGES), "8.2")
+        self.assertReadable(ch8_figures.CumulativeRewardFigure(by_strategy, self.STAGES), "8.2")
         self.assertReadable(
-            ch8_reaching.ReachesFigure(
-                "random", by_strategy["random"], self.STAGES, self.K, self.M
-            ),
+            ch8_figures.ReachesFigure("random", by_strategy["random"], self.STAGES, self.K, self.M),
             "8.4-8.6",
         )
         self.assertReadable(
-            ch8_reaching.ProblemTriesFigure(by_strategy, self.STAGES, self.K, self.M), "8.7"
+            ch8_figures.ProblemTriesFigure(by_strategy, self.STAGES, self.K, self.M), "8.7"
         )
-        self.assertReadable(ch8_reaching.FailedTransitionsFigure(by_strategy, self.K), "8.8")
+        self.assertReadable(ch8_figures.FailedTransitionsFigure(by_strategy, self.K), "8.8")
 
     def test_each_seed_of_a_stacked_bar_has_its_colour(self):
         by_strategy = {"greedy": [self.Run("greedy", seed) for seed in range(3)]}
-        figure = ch8_reaching.CumulativeRewardFigure(by_strategy, self.STAGES)
+        figure = ch8_figures.CumulativeRewardFigure(by_strategy, self.STAGES)
         legend = figure.axes[0].get_legend()
         self.assertEqual([t.get_text() for t in legend.get_texts()], ["seed 0", "seed 1", "seed 2"])
         self.assertEqual(len(_LegendColours(legend)), 3)

@@ -569,7 +569,7 @@ def _SyntheticRun(strategy, seed, log, evaluations, hours=1.0, problems=3):
 
 def _BatteryArguments(*argv):
     """The settings and seeds ``mobee-drake experiment ch8 ARGV`` would run (nothing runs)."""
-    from mobee_drake.experiments import ch8_reaching as ch8
+    from mobee_drake.experiments import ch8_command as ch8
 
     captured = {}
 
@@ -590,14 +590,14 @@ class TestEvaluationSums(unittest.TestCase):
     """Issue 23, points 7 and 8: the source's sum, fingerprints and run-level report."""
 
     def test_sum_with_and_without_penalties(self):
-        from mobee_drake.experiments.ch8_reaching import EvaluationSum
+        from mobee_drake.experiments.ch8_figures import EvaluationSum
 
         evaluation = [_Try(0, 0.5, 4, 0), _Try(1, None, -1, 2, actions=10), _Try(2, 0.25, 5, 1)]
         self.assertAlmostEqual(EvaluationSum(evaluation, penalties=False), 0.75)
         self.assertAlmostEqual(EvaluationSum(evaluation), 0.75 - 30.0)
 
     def test_fingerprints_closed_form(self):
-        from mobee_drake.experiments.ch8_reaching import FAVOURITES, Fingerprints
+        from mobee_drake.experiments.ch8_report import FAVOURITES, Fingerprints
 
         self.assertEqual(FAVOURITES, 2)
         # try, problem, state-action: tries 0-1 reach from states 0 and 1 (problems 0, 1), try 2
@@ -616,7 +616,7 @@ class TestEvaluationSums(unittest.TestCase):
         self.assertEqual(f["robot_hours"], 2.0)
 
     def test_report_tests_runs_not_evaluations(self):
-        from mobee_drake.experiments.ch8_reaching import Report
+        from mobee_drake.experiments.ch8_report import Report
         from mobee_drake.experiments.statistics import CompareRuns
 
         log = [(0, 0, 4), (1, 1, 5)]
@@ -648,7 +648,7 @@ class TestEvaluationSums(unittest.TestCase):
         self.assertIn("1.00 times the robot time", report)
 
     def test_report_tests_each_runs_trend(self):
-        from mobee_drake.experiments.ch8_reaching import Report
+        from mobee_drake.experiments.ch8_report import Report
         from mobee_drake.experiments.statistics import CompareRuns, CompareToZero
 
         log = [(0, 0, 4), (1, 1, 5)]
@@ -680,6 +680,7 @@ class TestEvaluationSums(unittest.TestCase):
 
     def test_sweep_names_and_report(self):
         from mobee_drake.experiments import ch8_reaching as ch8
+        from mobee_drake.experiments.ch8_report import Report
 
         settings = [
             ch8.RunSettings("random", 0, 4, [4], 1, 2, distance_unit=unit) for unit in (0.01, 0.1)
@@ -709,7 +710,7 @@ class TestEvaluationSums(unittest.TestCase):
             for r in results
         ]
         with tempfile.TemporaryDirectory() as folder:
-            report = ch8.Report(pathlib.Path(folder), swept)
+            report = Report(pathlib.Path(folder), swept)
             self.assertTrue(
                 (pathlib.Path(folder) / "unit0.01_force300" / "8.7_problem_tries.png").is_file()
             )
@@ -741,7 +742,7 @@ class TestEvaluationSums(unittest.TestCase):
     def test_report_only(self):
         import json
 
-        from mobee_drake.experiments import ch8_reaching as ch8
+        from mobee_drake.experiments import ch8_command as ch8
 
         log = [(0, 0, 4), (1, 1, 5)]
         with tempfile.TemporaryDirectory() as folder:
