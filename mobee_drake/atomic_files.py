@@ -28,6 +28,14 @@ def _Umask() -> int:
     return mask
 
 
+def _Named(error: BaseException, path: pathlib.Path) -> BaseException:
+    """``error`` as the caller should see it: a failed write of the system's (a full disk) named
+    by the file or folder meant, not by a staging file or by nothing; anything else as it is."""
+    if isinstance(error, OSError) and error.errno is not None:
+        return OSError(error.errno, error.strerror, str(path))  # (the errno's subclass)
+    return error
+
+
 def WriteFileAtomically(path: str | pathlib.Path, write) -> None:
     """Writes ``path`` through a staging file in the same folder: ``write(staging)`` writes the
     staging file (a path), which then replaces ``path``."""
@@ -39,12 +47,9 @@ def WriteFileAtomically(path: str | pathlib.Path, write) -> None:
         write(staging)
         os.chmod(staging, 0o666 & ~_Umask())  # As open() would have made it (mkstemp: 0o600).
         os.replace(staging, path)
-    except OSError as error:  # (named by the file meant, not the staging file or nothing)
+    except BaseException as error:
         pathlib.Path(staging).unlink(missing_ok=True)
-        raise OSError(error.errno, error.strerror, str(path)) from error
-    except BaseException:
-        pathlib.Path(staging).unlink(missing_ok=True)
-        raise
+        raise _Named(error, path) from error
     # What a kill left of earlier writes of this file (one writer a file: folders are locked).
     for leftover in path.parent.glob(f".{glob.escape(path.name)}.*.tmp"):
         leftover.unlink(missing_ok=True)
@@ -125,9 +130,9 @@ def WriteGeneration(folder: str | pathlib.Path, write) -> pathlib.Path:
     staging = pathlib.Path(tempfile.mkdtemp(dir=folder, prefix=".staging-"))
     try:
         write(staging)
-    except BaseException:
+    except BaseException as error:
         shutil.rmtree(staging, ignore_errors=True)
-        raise
+        raise _Named(error, folder) from error
     _Step("staged")
     os.rename(staging, generation)
     _Step("renamed")

@@ -33,6 +33,7 @@ from mobee_drake.station.runner import RunStation, RunSummary
 from mobee_drake.station.viewer import RecordingMeshcat
 from mobee_drake.yaml_io import (
     CheckYamlStructure,
+    InvalidYaml,
     LoadYamlFile,
     LoadYamlOverride,
     TaggedData,
@@ -124,7 +125,7 @@ def LoadScenario(
         except YamlFileError:
             raise
         except yaml.YAMLError as e:
-            raise YamlFileError(f"{source}: invalid YAML: {e.problem}") from None
+            raise YamlFileError(InvalidYaml(source, e)) from None
         except (RuntimeError, ValueError, TypeError) as e:
             raise YamlFileError(f"{source}: {e}") from e
         ValidateScenario(scenario, source)

@@ -78,6 +78,20 @@ def CheckYamlStructure(text: str, source: str) -> None:
             open_nodes[-1][1] += size
 
 
+def InvalidYaml(source: str, error: yaml.YAMLError) -> str:
+    """The one-line message of a YAML text that PyYAML could not read: where (the line, when
+    PyYAML knows it) and why (a syntax error, or a character YAML does not allow)."""
+    mark = getattr(error, "problem_mark", None)
+    where = f"{source}:{mark.line + 1}" if mark is not None else source
+    if isinstance(error, yaml.reader.ReaderError):
+        character = error.character
+        character = chr(character) if isinstance(character, int) else character
+        problem = f"character {character!r} is not allowed in YAML ({error.reason})"
+    else:
+        problem = getattr(error, "problem", None) or str(error).splitlines()[0]
+    return f"{where}: invalid YAML: {problem}"
+
+
 def _Events(text: str, source: str):
     """The parser's events of ``text``; libyaml's own depth limit (deeper than ours) reported
     as ours."""
@@ -159,9 +173,8 @@ def LoadYamlFile(*, schema, filename, child_name: str | None = None, defaults=No
         return yaml_load_typed(**kwargs)
     except YamlFileError:
         raise
-    except yaml.MarkedYAMLError as e:
-        mark = e.problem_mark
-        raise YamlFileError(f"{path}:{mark.line + 1}: invalid YAML: {e.problem}") from e
+    except yaml.YAMLError as e:
+        raise YamlFileError(InvalidYaml(str(path), e)) from e
     except (RuntimeError, ValueError, TypeError, KeyError) as e:
         # Drake's messages quote the offending names: ['shap'], 'x'.
         line = LineOf(text, re.findall(r"'([^']+)'", str(e)))

@@ -169,6 +169,7 @@ def _Issue31Trials(folder: pathlib.Path, thesis_folder: pathlib.Path) -> list:
     (folder / "many_objects.yaml").write_text("objects:\n" + objects)
     os.mkfifo(folder / "fifo.yaml")
     (folder / "huge.yaml").write_text("duration: " + "x" * 10_000_000 + "\n")
+    (folder / "bell.yaml").write_text("duration: 1\x07\n")
     run = ["run", "reach_around_ball", "--no-meshcat", "--no-log", "--duration", "0.1", "--set"]
     agent = "{{attractor: !ExploreAttractor {{agents: [{{name: a, joints: [r_elbow], {}}}]}}}}"
     return [
@@ -215,6 +216,7 @@ def _Issue31Trials(folder: pathlib.Path, thesis_folder: pathlib.Path) -> list:
         ("a folder as the scenario", ["run", str(thesis_folder)]),
         ("a FIFO as the scenario", ["run", str(folder / "fifo.yaml")]),
         ("a 10 MB value in a scenario file", ["run", str(folder / "huge.yaml")]),
+        ("a control character in a scenario file", ["run", str(folder / "bell.yaml")]),
     ]  # fmt: skip
 
 

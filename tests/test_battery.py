@@ -2,6 +2,7 @@
 processes and on Ray (and across them), strict JSON, the display, and no worker outliving its
 battery when the parent is interrupted or killed."""
 
+import argparse
 import contextlib
 import importlib.util
 import io
@@ -10,6 +11,7 @@ import pathlib
 import re
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -141,6 +143,28 @@ class LocalBatteryTest(TemporaryFolder):
         # Standard error is not a terminal here: plain lines, the battery's and the runs'.
         self.assertIn("walks: 2/2 run", stream.getvalue())
         self.assertRegex(stream.getvalue(), r"walk0: \d+/8 it")
+
+    def test_the_ray_flag_bare_auto_or_an_address_that_answers(self):
+        """Issue 31: an address nobody answers was waited on for minutes; the bare flag (a
+        local Ray instance) and ``auto`` need no address."""
+        parser = argparse.ArgumentParser()
+        battery.AddBackendArguments(parser)
+        for argv, expected in (
+            ([], LocalProcesses(1)),
+            (["--ray"], Ray(address=None)),
+            (["--ray", "auto"], Ray(address="auto")),
+        ):
+            with self.subTest(argv):
+                self.assertEqual(battery.BackendOf(parser.parse_args(argv)), expected)
+        with socket.socket() as listening:  # an address that answers
+            listening.bind(("127.0.0.1", 0))
+            listening.listen()
+            address = f"127.0.0.1:{listening.getsockname()[1]}"
+            self.assertEqual(battery.BackendOf(parser.parse_args(["--ray", address])).address,
+                             address)  # fmt: skip
+        for bad in ("127.0.0.1:1", "bogus", "host:99999"):
+            with self.subTest(bad), self.assertRaises(argparse.ArgumentTypeError):
+                battery.RayAddress(bad)
 
     def test_without_ray_the_error_says_how_to_install_it(self):
         with mock.patch.dict(sys.modules, {"ray": None}):

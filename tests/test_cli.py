@@ -6,6 +6,7 @@ import io
 import logging
 import pathlib
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -65,6 +66,12 @@ class TestHelp(unittest.TestCase):
 
 class TestMistakes(unittest.TestCase):
     def test_a_mistake_is_one_line_and_exit_code_2(self):
+        # A file and a folder of the user's (never the repository's: a test may run anywhere).
+        scratch = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, scratch)
+        notes, folder = scratch / "notes.md", scratch / "folder"
+        notes.write_text("mine")
+        folder.mkdir()
         for args, message in (
             (["info", "--model", "iCubMars"], "unknown iCub model 'iCubMars'"),
             (["run", "reach_around_ball", "--duration", "-5"], "--duration: must be a finite"),
@@ -91,7 +98,7 @@ class TestMistakes(unittest.TestCase):
                 ],
                 "the robot starts in penetration: the robot: 'r_hand'",
             ),  # fmt: skip
-            (["bench", "safety", "--doc", "README.md"], "no generated block 'safety scenes'"),
+            (["bench", "safety", "--doc", str(notes)], "no generated block 'safety scenes'"),
             (["bench", "safety", "--report-only"], "--report-only needs --output"),
             # Issue 31, item 11: nonsense that ran silently, or ended in a Python type error.
             (["run", "reach_around_ball", "--set", ""], "overrides '': not a YAML mapping"),
@@ -114,7 +121,7 @@ class TestMistakes(unittest.TestCase):
                 ["experiment", "ch8-discounting", "--model", "m", "--runs", "/no/such.json"],
                 "--runs: /no/such.json is not a file",
             ),
-            (["bench", "forces", "--plot", "README.md/x.png"], "--plot README.md/x.png: cannot be"),
+            (["bench", "forces", "--plot", f"{notes}/x.png"], f"--plot {notes}/x.png: cannot be"),
             (
                 ["experiment", "ch8", "--report-only", "--output", "/missing/ch8"],
                 "--report-only: /missing/ch8 is not a folder",
@@ -134,11 +141,11 @@ class TestMistakes(unittest.TestCase):
             ),  # fmt: skip
             (["experiment", "ch8", "--reach-force", "1e300"], "--reach-force: must be a number in"),
             (["experiment", "ch8", "--distance-unit", "1e-300"], "--distance-unit: must be a num"),
-            (["run", "tests"], "tests: a folder, not a file"),
-            (["experiment", "ch8", "--output", "README.md"], "README.md: is a file, not a folder"),
+            (["run", str(folder)], f"{folder}: a folder, not a file"),
+            (["experiment", "ch8", "--output", str(notes)], f"{notes}: is a file, not a folder"),
             (
-                ["experiment", "ch7", "--experiment", "7.1", "--output", "README.md"],
-                "README.md: is a file, not a folder",
+                ["experiment", "ch7", "--experiment", "7.1", "--output", str(notes)],
+                f"{notes}: is a file, not a folder",
             ),
             # Issue 31, item 8: a bad --ray address hung for minutes.
             (
@@ -191,6 +198,18 @@ class TestMistakes(unittest.TestCase):
             code, _, err = _Call("experiment", "ch8")
         self.assertEqual((code, err), (1, "error: /results/runs/a/result.json: No space left on "
                                           "device\n"))  # fmt: skip
+
+    def test_a_control_character_is_named_not_a_traceback(self):
+        """A review of issue 31: PyYAML's ReaderError is no MarkedYAMLError."""
+        with tempfile.TemporaryDirectory() as folder:
+            scenario = pathlib.Path(folder) / "bell.yaml"
+            scenario.write_text("duration: 1\x07\n")
+            for args in ([str(scenario)], ["reach_around_ball", "--set", "{duration: 1\x07}"]):
+                with self.subTest(args):
+                    code, _, err = _Call("run", *args)
+                    self.assertEqual(code, 2)
+                    self.assertIn("invalid YAML: character '\\x07' is not allowed", err)
+                    self.assertEqual(len(err.splitlines()), 1)
 
     def test_a_huge_value_is_cut_in_the_error_line(self):
         """Issue 31, item 11: a 10 MB value in a file made a 10 MB error line."""

@@ -51,6 +51,20 @@ class CountsTwo(Home):
         return 2
 
 
+class WrongLog(Home):
+    def __init__(self, home):
+        super().__init__(home)
+        self.DeclareVectorOutputPort("data_log", 3, lambda context, output: None)
+
+    def DataLogColumns(self) -> list[tuple[str, str]]:
+        return [("a", "m"), ("b", "m")]
+
+
+class Lenient(Home):
+    def CompletedActions(self, context, scale: int = 5) -> int:
+        return scale
+
+
 def _Station(client_class, **hooks):
     """reach_around_ball with a client of ``client_class``, declared with ``hooks`` (each
     "self" for the client's system, or "requests" for its port of that name)."""
@@ -62,6 +76,8 @@ def _Station(client_class, **hooks):
         for hook, value in hooks.items():
             if value == "requests":
                 declared[hook] = [system.GetOutputPort("requests")]
+            elif isinstance(value, tuple):
+                declared[hook] = tuple(named[v] for v in value)
             else:
                 declared[hook] = [named[value]] if hook.endswith("s") else named[value]
         return ClientPorts(system=system, attractor=system.GetOutputPort("attractor"), **declared)
@@ -89,11 +105,20 @@ class TestClientContract(unittest.TestCase):
             _Station(CountsTwo, data_log="self")
         with self.assertRaisesRegex(ClientContractError, "must be abstract"):
             _Station(VectorRequests, world_events="requests")
+        with self.assertRaisesRegex(ClientContractError, "its 'data_log' port must be a vector"):
+            _Station(WrongLog, data_log="self")
+        # A tuple of counters, and a method with an extra optional parameter, are fine.
+        station = _Station(Lenient, action_counters=("self",))
+        context = station.diagram.CreateDefaultContext()
+        self.assertEqual(CompletedActions(station, context), 5)
 
     def test_only_declared_hooks_are_read(self):
-        """A system that implements a hook counts only when its client declares it."""
+        """A system that implements a hook counts only when its client declares it; one left
+        undeclared is named in a warning."""
         declared = _Station(CountsTwo, action_counters="self", world_events="requests")
-        undeclared = _Station(CountsTwo)
+        with self.assertLogs("mobee_drake.station.parts", "WARNING") as logs:
+            undeclared = _Station(CountsTwo)
+        self.assertIn("implements the action_counters hook, but no client declares", logs.output[0])
         for station, actions, ports in ((declared, 2, 1), (undeclared, 0, 0)):
             context = station.diagram.CreateDefaultContext()
             self.assertEqual(CompletedActions(station, context), actions)

@@ -117,12 +117,18 @@ class TestAtomicFiles(TemporaryFolder):
         def FullDisk(staging):
             raise OSError(errno.ENOSPC, "No space left on device")
 
-        target = self.folder / "result.json"
-        with self.assertRaises(OSError) as failed:
-            WriteFileAtomically(target, FullDisk)
-        self.assertEqual(failed.exception.errno, errno.ENOSPC)
-        self.assertEqual(failed.exception.filename, str(target))
-        self.assertEqual(list(self.folder.iterdir()), [])
+        target, checkpoint = self.folder / "result.json", self.folder / "checkpoint"
+        for write, named in ((WriteFileAtomically, target), (WriteGeneration, checkpoint)):
+            with self.subTest(write.__name__), self.assertRaises(OSError) as failed:
+                write(named, FullDisk)
+            self.assertEqual(failed.exception.errno, errno.ENOSPC)
+            self.assertEqual(failed.exception.filename, str(named))
+        # Nothing staged is left: no file, and a checkpoint folder without a generation.
+        self.assertEqual([p.name for p in self.folder.iterdir()], ["checkpoint"])
+        self.assertEqual(list(checkpoint.iterdir()), [])
+        with self.assertRaisesRegex(ValueError, "not a write of the system's"):
+            WriteFileAtomically(target, lambda staging: (_ for _ in ()).throw(
+                ValueError("not a write of the system's")))  # fmt: skip
 
 
 class TestOwnedFolders(TemporaryFolder):

@@ -178,6 +178,10 @@ DISK_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EROFS)
 
 
 def _DiskRefuses(error: BaseException) -> bool:
+    """Whether ``error`` (or the error a Ray task's wraps) is a write the disk refused."""
+    cause = getattr(error, "cause", None)  # (Ray's RayTaskError: its errno is lost)
+    if isinstance(cause, BaseException) and cause is not error:
+        return _DiskRefuses(cause)
     return isinstance(error, OSError) and error.errno in DISK_ERRNOS
 
 
@@ -621,8 +625,9 @@ RAY_CONNECT_SECONDS = 10.0
 def RayAddress(text: str) -> str:
     """``--ray``'s address, checked before any work (``ray.init`` waits for an address that does
     not answer for minutes, printing warnings): "auto" (Ray finds the local cluster), or
-    ``[ray://]host:port`` of a cluster that accepts a connection."""
-    if text == "auto":
+    ``[ray://]host:port`` of a cluster that accepts a connection; "" (the bare flag) for a local
+    Ray instance."""
+    if text in ("", "auto"):
         return text
     match = re.fullmatch(r"(?:ray://)?(\[[^\]]+\]|[^:/\s]+):(\d{1,5})", text)
     if match is None or not 0 < int(match[2]) < 65536:

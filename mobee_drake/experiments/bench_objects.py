@@ -11,7 +11,8 @@ each in a fresh process under a cap on its address space:
 It prints the wall time and the peak resident memory of each, and their ratios. SceneGraph's
 collision filter keeps a state per pair of geometries, so both grow with the square of N; a
 scenario of more than ``MAX_OBJECTS`` objects is refused at load (the station's cell says so and
-how long the refusal took), and a process that outgrows the cap is reported as such.
+how long the refusal took), and a process that outgrows the cap is reported by how it ended (a
+MemoryError, or a death by a signal where an allocation cannot raise).
 
 Run: ``mobee-drake bench objects [--counts 100 1000 10000] [--doc docs/benchmarks.md]``.
 """
@@ -19,6 +20,7 @@ Run: ``mobee-drake bench objects [--counts 100 1000 10000] [--doc docs/benchmark
 import multiprocessing
 import os
 import resource
+import signal
 import time
 
 import numpy as np
@@ -38,6 +40,7 @@ SCENARIO = "reach_around_ball"
 BOX = 0.02  # (m) each box's edge
 SPACING = 0.05  # (m) the grid's
 DOC_TABLE = "object count"
+TIMEOUT_SECONDS = 1800.0  # (s) a build longer than this is reported, not waited for
 
 
 def BoxPositions(count: int) -> np.ndarray:
@@ -85,18 +88,21 @@ def _Measure(kind: str, count: int, cap_bytes: int, parent: int, pipe) -> None:
         (_Floor if kind == "floor" else _Station)(count)
     except MemoryError:
         error = "over the cap"
-    except ValueError as refused:  # (the scenario's one-line error, checked)
-        if f"at most {MAX_OBJECTS}" not in str(refused):
-            raise
-        error = "refused at load"
+    except Exception as failed:  # (reported, not hidden: the scenario's refusal named)
+        refused = isinstance(failed, ValueError) and f"at most {MAX_OBJECTS}" in str(failed)
+        error = "refused at load" if refused else f"failed: {type(failed).__name__}"
     seconds = time.perf_counter() - start
     pipe.send((seconds, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024, error))
 
 
-def Measure(kind: str, count: int, cap_bytes: int) -> tuple[float, float, str]:
+def Measure(
+    kind: str, count: int, cap_bytes: int, timeout: float = TIMEOUT_SECONDS
+) -> tuple[float, float, str]:
     """(seconds, peak bytes, error or "") of ``kind`` ("floor" or "station") with ``count``
-    boxes, in a fresh process capped at ``cap_bytes`` of address space; a process killed by the
-    cap (Drake's allocations end the process, not in a MemoryError) is "over the cap"."""
+    boxes, in a fresh process capped at ``cap_bytes`` of address space. The error says what
+    ended it otherwise: "over the cap" (a MemoryError), "refused at load", "failed: <error>", a
+    death by a signal (an allocation that fails where it cannot raise aborts the process), or
+    "timed out" after ``timeout`` seconds."""
     spawn = multiprocessing.get_context("spawn")
     receiver, sender = spawn.Pipe(duplex=False)
     process = spawn.Process(
@@ -105,12 +111,24 @@ def Measure(kind: str, count: int, cap_bytes: int) -> tuple[float, float, str]:
     start = time.perf_counter()
     process.start()
     sender.close()
+    if not receiver.poll(timeout):
+        process.kill()
     try:
         result = receiver.recv()
-    except EOFError:  # (the process died)
-        result = (time.perf_counter() - start, float("nan"), "over the cap")
+    except EOFError:  # (the process died, or was killed above)
+        process.join()
+        seconds = time.perf_counter() - start
+        code = process.exitcode
+        ended = "timed out" if seconds >= timeout else f"died ({_Ending(code)})"
+        result = (seconds, float("nan"), ended)
     process.join()
     return result
+
+
+def _Ending(code: int | None) -> str:
+    if code is not None and code < 0:
+        return signal.Signals(-code).name
+    return f"exit code {code}"
 
 
 def _Cell(seconds: float, peak: float, error: str) -> tuple[str, str]:

@@ -52,7 +52,13 @@ from mobee_drake.robots.overlay import RobotOverlay
 from mobee_drake.robots.scenario_robot import AddScenarioRobot
 from mobee_drake.station.config import Dynamic, Kinematic, Mover, Reflex, StationConfig
 from mobee_drake.station.data_log import AddDataLog, DataLogger
-from mobee_drake.station.parts import CheckClientPorts, ClientPorts, StationParts
+from mobee_drake.station.parts import (
+    CheckClientPorts,
+    ClientPorts,
+    Declared,
+    StationParts,
+    WarnOfUndeclaredHooks,
+)
 from mobee_drake.station.safety import SafetyMonitor
 from mobee_drake.station.viewer import AddViewer
 from mobee_drake.station.virtual_dynamics import VirtualDynamics
@@ -107,11 +113,12 @@ class Station:
         """Every client's systems (or ports) declared for ``hook``, a hook field of
         :class:`~mobee_drake.station.parts.ClientPorts`: the robot's client's, then the
         companions'."""
-        found = []
-        for ports in [self.client_ports, *self.companion_ports]:
-            declared = getattr(ports, hook) if ports is not None else None
-            found += declared if isinstance(declared, list) else [declared] if declared else []
-        return found
+        return [
+            system
+            for ports in [self.client_ports, *self.companion_ports]
+            if ports is not None
+            for system in Declared(ports, hook)
+        ]
 
 
 def _JointTracking(control: str) -> JointTracking:
@@ -454,8 +461,9 @@ def MakeMobeeStation(
             attractor=attractor,
             marker_forces=marker_forces,
         )
+    # (The companions' first: they were built first, and the ledger counts in this order.)
     request_ports = [
-        port for ports in [client, *companion_ports] if ports for port in ports.world_events
+        port for ports in [*companion_ports, client] if ports for port in ports.world_events
     ]
     event_ledger = builder.AddNamedSystem(
         "world_event_ledger", WorldEventLedger(num_request_ports=len(request_ports))
@@ -483,6 +491,7 @@ def MakeMobeeStation(
     ):
         builder.ExportOutput(port, name)
 
+    WarnOfUndeclaredHooks(builder.GetSystems(), [client, *companion_ports])
     diagram = builder.Build()
     diagram.set_name("mobee_station")
     return Station(

@@ -9,7 +9,8 @@ state is more than numbers (an exploring agent's learned model in abstract state
 - ``WriteCheckpoint(context, folder)``: writes it into ``folder`` (its own context), and
 - ``ReadCheckpoint(context, folder)``: restores it,
 
-and the checkpoint calls both for every such system of the diagram, knowing none of them.
+and its client declares it among its ``checkpointed`` systems (:mod:`mobee_drake.station.parts`);
+the checkpoint calls both for every declared one, knowing none of them.
 ``configuration.yaml`` records the configuration the run was started with; a checkpoint is only
 resumed under the same one. A checkpoint folder keeps *generations* of these files
 (:func:`~mobee_drake.atomic_files.WriteGeneration`), so a kill at any moment leaves a complete

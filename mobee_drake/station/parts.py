@@ -10,8 +10,8 @@ them, the forces on the markers and in configuration space) and the optional hoo
 the system that implements it. Returning None leaves MoBeE's attractor and forces as inputs of
 the station's diagram, for a script to fix.
 
-The hooks, each a Protocol here (the station reads them from ``Station.clients``, never by
-searching the diagram):
+The hooks, each a Protocol here (the station reads them through ``Station.Hooks``, never by
+searching the diagram; a system that implements one undeclared is named in a warning):
 
 - ``outcome`` (:class:`ReportsOutcome`): what the client achieved, in the run's summary;
 - ``action_counters`` (:class:`CountsActions`): actions completed, after each of which a run
@@ -30,6 +30,7 @@ client config classes implement the callable (see :mod:`mobee_drake.scenario`).
 import dataclasses as dc
 import difflib
 import inspect
+import logging
 import pathlib
 from typing import Protocol
 
@@ -119,15 +120,22 @@ HOOKS = {
 }
 
 
-def _Parameters(function) -> list[str]:
-    return [p for p in inspect.signature(function).parameters if p != "self"]
+def _Methods(protocol) -> dict:
+    """The methods a hook's Protocol asks for, by name."""
+    return {
+        name: method
+        for name, method in inspect.getmembers(protocol, inspect.isfunction)
+        if not name.startswith("_")
+    }
+
+
+def _Name(system) -> str:
+    return system.get_name() if isinstance(system, LeafSystem) else type(system).__name__
 
 
 def _CheckImplements(system, protocol, hook: str) -> None:
-    name = system.get_name() if isinstance(system, LeafSystem) else type(system).__name__
-    for method, declared in inspect.getmembers(protocol, inspect.isfunction):
-        if method.startswith("_"):
-            continue
+    name = _Name(system)
+    for method, declared in _Methods(protocol).items():
         found = getattr(system, method, None)
         if not callable(found):
             methods = [m for m in dir(system) if not m.startswith("_")]
@@ -136,12 +144,24 @@ def _CheckImplements(system, protocol, hook: str) -> None:
                 f"client system '{name}', declared as {hook}, has no method {method}"
                 + (f" (it has {near[0]})" if near else "")
             )
-        expected, given = _Parameters(declared), _Parameters(found)
-        if len(given) != len(expected):
+        expected = [p for p in inspect.signature(declared).parameters if p != "self"]
+        signature = inspect.signature(found)
+        try:  # (called as the station calls it: extra optional parameters are fine)
+            signature.bind(*expected)
+        except TypeError:
+            given = ", ".join(signature.parameters)
             raise ClientContractError(
-                f"client system '{name}': {method}({', '.join(given)}) must take "
+                f"client system '{name}': {method}({given}) must take "
                 f"({', '.join(expected)}) to be its {hook} hook"
-            )
+            ) from None
+
+
+def Declared(ports: ClientPorts, hook: str) -> list:
+    """The systems (or ports) ``ports`` declares for ``hook``, a list whatever was given."""
+    declared = getattr(ports, hook)
+    if declared is None:
+        return []
+    return list(declared) if isinstance(declared, (list, tuple)) else [declared]
 
 
 def CheckClientPorts(ports: ClientPorts) -> None:
@@ -151,21 +171,55 @@ def CheckClientPorts(ports: ClientPorts) -> None:
         ClientContractError: naming the system, the hook and the method.
     """
     for hook, protocol in HOOKS.items():
-        declared = getattr(ports, hook)
-        for system in declared if isinstance(declared, list) else [declared]:
-            if system is not None:
-                _CheckImplements(system, protocol, hook)
-    if ports.data_log is not None and not ports.data_log.HasOutputPort(DATA_LOG_PORT):
-        raise ClientContractError(
-            f"client system '{ports.data_log.get_name()}', declared as data_log, has no output "
-            f"port '{DATA_LOG_PORT}'"
-        )
-    for port in ports.world_events:
+        for system in Declared(ports, hook):
+            _CheckImplements(system, protocol, hook)
+    if ports.data_log is not None:
+        _CheckDataLogPort(ports.data_log)
+    for port in Declared(ports, "world_events"):
+        if not isinstance(port, OutputPort):
+            raise ClientContractError(f"world_events must list output ports, got {port!r}")
         if port.get_data_type() != PortDataType.kAbstractValued:
             raise ClientContractError(
                 f"world_events port '{port.get_system().get_name()}.{port.get_name()}' must be "
                 "abstract (a list of WorldEvent)"
             )
+
+
+def _CheckDataLogPort(system) -> None:
+    """A data_log system's port: a vector of one entry per column it names."""
+    name = _Name(system)
+    if not system.HasOutputPort(DATA_LOG_PORT):
+        raise ClientContractError(
+            f"client system '{name}', declared as data_log, has no output port '{DATA_LOG_PORT}'"
+        )
+    port, columns = system.GetOutputPort(DATA_LOG_PORT), system.DataLogColumns()
+    if port.get_data_type() != PortDataType.kVectorValued or port.size() != len(columns):
+        raise ClientContractError(
+            f"client system '{name}': its '{DATA_LOG_PORT}' port must be a vector of "
+            f"{len(columns)} entries, one per column of DataLogColumns()"
+        )
+
+
+def WarnOfUndeclaredHooks(systems, declared: list[ClientPorts | None]) -> None:
+    """Logs a warning for each system that implements a hook no client declares it for (it is
+    not read: see the module), so that a hook left out of a declaration is not silently lost."""
+    offered = {
+        (id(system), hook)
+        for ports in declared
+        if ports is not None
+        for hook in HOOKS
+        for system in Declared(ports, hook)
+    }
+    for system in systems:
+        for hook, protocol in HOOKS.items():
+            implements = all(callable(getattr(system, m, None)) for m in _Methods(protocol))
+            if implements and (id(system), hook) not in offered:
+                logging.getLogger(__name__).warning(
+                    "system '%s' implements the %s hook, but no client declares it in its "
+                    "ClientPorts: the station does not read it",
+                    _Name(system),
+                    hook,
+                )
 
 
 class ClientConfig(Protocol):
