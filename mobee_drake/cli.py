@@ -218,7 +218,7 @@ def _Experiment(args: list[str]) -> None:
             "ch7": "mobee_drake.experiments.ch7_model_learning",
             "ch8": "mobee_drake.experiments.ch8_command",
             "ch8-discounting": "mobee_drake.experiments.ch8_discounting",
-            "saggriac": "mobee_drake.experiments.saggriac",
+            "saggriac": "mobee_drake.experiments.saggriac_command",
             "roadmaps": "mobee_drake.experiments.ch4_roadmaps",
             "trm": "mobee_drake.experiments.trm_roadmaps",
         },

@@ -27,7 +27,7 @@ from mobee_drake.atomic_files import (
     WriteGeneration,
     WriteJsonAtomically,
 )
-from mobee_drake.experiments import ch7_model_learning, saggriac
+from mobee_drake.experiments import ch7_model_learning, saggriac_command
 from mobee_drake.experiments.battery import InProcess, Job, RunBattery
 from mobee_drake.experiments.ch7_model_learning import Stop
 from mobee_drake.experiments.exploration import ExplorationScenario, Explore
@@ -384,7 +384,7 @@ class TestStrictJson(TemporaryFolder):
             LoadScenario("explore_hypercube", "{duration: 3}"), checkpoint=str(self.folder / "run")
         )
         with contextlib.redirect_stdout(io.StringIO()):
-            saggriac.main(
+            saggriac_command.main(
                 [
                     "--smoke",
                     "--experiments",

@@ -14,7 +14,7 @@ from mobee_drake.experiments import (
     bench_forces,
     ch7_model_learning,
     ch8_figures,
-    saggriac,
+    saggriac_figures,
     trm_roadmaps,
 )
 from mobee_drake.experiments.plots import SaveFigure
@@ -233,7 +233,7 @@ class TestOtherFigures(FigureTest):
             for method in ("SAGG-RIAC", "ACTUATOR-Random")
             for seed in range(2)
         ]
-        figure = saggriac.CurvesFigure(runs, ["SAGG-RIAC", "ACTUATOR-Random"], 1)
+        figure = saggriac_figures.CurvesFigure(runs, ["SAGG-RIAC", "ACTUATOR-Random"], 1)
         self.assertPlots(figure, [10 / 101, 10 / 201, 5 / 201], "saggriac curves")
         self.assertReadable(figure, "saggriac curves")
         goals = np.zeros((40, 7))
@@ -250,7 +250,7 @@ class TestOtherFigures(FigureTest):
             ],
             spec=dict(experiment=2, seed=0, budget=1000),
         )
-        figure = saggriac.GoalsFigure(run)
+        figure = saggriac_figures.GoalsFigure(run)
         # The last panel: every goal's bin, counted.
         counts, *_ = np.histogram2d(goals[:, 1], goals[:, 2], 30, [[0, 100], [-100, 100]])
         drawn = [a for a in figure.axes if not _IsColorbar(a)][-1].collections[0].get_array()

@@ -11,7 +11,7 @@ import unittest
 
 import numpy as np
 
-from mobee_drake.experiments import saggriac as experiments
+from mobee_drake.experiments import saggriac_command as command
 from mobee_drake.goal_babbling.baselines import ActuatorRandom, ActuatorRiac, SaggRandom
 from mobee_drake.goal_babbling.config import Experiment1Config, Experiment2Config, InterestConfig
 from mobee_drake.goal_babbling.evaluation import MakeEvaluator, MakeTestSet
@@ -148,7 +148,7 @@ class TestExperimentScript(unittest.TestCase):
                 "1",
             ]
             with contextlib.redirect_stdout(io.StringIO()):
-                experiments.main(argv)
+                command.main(argv)
             results = sorted((output / "runs").glob("*/result.json"))
             self.assertEqual(len(results), 8)
             self.assertFalse(list((output / "runs").rglob("*.tmp")))
@@ -169,7 +169,7 @@ class TestExperimentScript(unittest.TestCase):
             self.assertIn("SAGG-RIAC vs SAGG-Random", (output / "report.md").read_text())
             before = [path.stat().st_mtime_ns for path in results]
             with contextlib.redirect_stdout(io.StringIO()):
-                experiments.main(argv)  # Every run has its result: none runs again.
+                command.main(argv)  # Every run has its result: none runs again.
             self.assertEqual([path.stat().st_mtime_ns for path in results], before)
 
 

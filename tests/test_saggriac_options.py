@@ -15,6 +15,9 @@ from scipy import stats
 from test_figures import FigureTest
 
 from mobee_drake.experiments import saggriac as experiments
+from mobee_drake.experiments import saggriac_command as command
+from mobee_drake.experiments import saggriac_figures as figures
+from mobee_drake.experiments import saggriac_report as report
 from mobee_drake.goal_babbling.baselines import ActuatorRandom, ActuatorRiac, SaggRandom
 from mobee_drake.goal_babbling.competence import Interest
 from mobee_drake.goal_babbling.config import (
@@ -326,7 +329,7 @@ class TestVariants(unittest.TestCase):
         self.assertEqual(specs[0].Name(), "exp2_SAGG-RIAC_seed03_budget100")  # as before
         spec = experiments.RunSpec(2, "SAGG-RIAC", 3, 100, 1, "stall+model-error")
         self.assertEqual(spec.Label(), "SAGG-RIAC [stall+model-error]")
-        pairs = experiments.Pairs(
+        pairs = report.Pairs(
             ["SAGG-RIAC", "SAGG-RIAC [stall]", "ACTUATOR-RIAC [set]", "ACTUATOR-Random [set]"]
         )
         self.assertEqual(
@@ -347,7 +350,7 @@ class TestVariants(unittest.TestCase):
             ):
                 stderr = io.StringIO()
                 with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit):
-                    experiments.main([*argv, "--output", str(pathlib.Path(folder) / "x")])
+                    command.main([*argv, "--output", str(pathlib.Path(folder) / "x")])
                 self.assertIn(message, stderr.getvalue())
                 self.assertEqual(len(stderr.getvalue().strip().splitlines()), 1, stderr.getvalue())
 
@@ -358,9 +361,9 @@ class TestVariants(unittest.TestCase):
             pass
 
         def Specs(argv: list[str]) -> list:
-            with mock.patch.object(experiments, "RunAll", side_effect=Ran) as run_all:
+            with mock.patch.object(command, "RunAll", side_effect=Ran) as run_all:
                 with self.assertRaises(Ran):
-                    experiments.main([*argv, "--experiments", "1", "--methods", "SAGG-RIAC"])
+                    command.main([*argv, "--experiments", "1", "--methods", "SAGG-RIAC"])
             return run_all.call_args.args[0]
 
         smoke = Specs(["--smoke"])
@@ -380,7 +383,7 @@ class TestVariants(unittest.TestCase):
                 contextlib.redirect_stdout(io.StringIO()),
                 contextlib.redirect_stderr(io.StringIO()),
             ):
-                experiments.main(argv)
+                command.main(argv)
             output = pathlib.Path(folder)
             self.assertEqual(len(list(output.glob("runs/*/result.json"))), 2 * 4)
             report = (output / "report.md").read_text()
@@ -405,7 +408,7 @@ class TestCheckpointTable(unittest.TestCase):
             for method, values in (("SAGG-RIAC", first), ("SAGG-Random", second))
             for seed, value in enumerate(values)
         ]
-        lines = experiments.CheckpointTable(runs, "SAGG-RIAC", "SAGG-Random", ("a", "b"))
+        lines = report.CheckpointTable(runs, "SAGG-RIAC", "SAGG-Random", ("a", "b"))
         self.assertEqual(len(lines), 2 + 2)  # header, rule, checkpoints 100 and 200
         self.assertIn("a: SAGG-RIAC - SAGG-Random (Welch p)", lines[0])
         p_value = stats.ttest_ind(first, second, equal_var=False).pvalue
@@ -418,7 +421,7 @@ class TestCheckpointTable(unittest.TestCase):
     def test_no_rows_with_fewer_than_two_runs_per_group(self):
         runs = [{"spec": {"method": "SAGG-RIAC"}, "curve": [{"time_step": 0, "a": 1.0}]}]
         runs += [{"spec": {"method": "SAGG-Random"}, "curve": [{"time_step": 0, "a": 2.0}]}] * 2
-        self.assertEqual(experiments.CheckpointTable(runs, "SAGG-RIAC", "SAGG-Random", ("a",)), [])
+        self.assertEqual(report.CheckpointTable(runs, "SAGG-RIAC", "SAGG-Random", ("a",)), [])
 
 
 class TestFigures(FigureTest):
@@ -442,11 +445,11 @@ class TestFigures(FigureTest):
                     "diagnostics": {"tip_spread": 9.0, "tip_coverage": 0.3, "drift_ratio": 1.1},
                 }
             )  # fmt: skip
-        self.assertReadable(experiments.CurvesFigure(runs, groups, 2), "curves, 5 measures")
-        self.assertReadable(experiments.TipsFigure(runs, groups), "tips")
-        statistics = experiments.Statistics(runs, groups)
-        figure = experiments.EffectsFigure(
-            experiments._NoNan(statistics), 2, ["reaching_error", "prediction_error"]
+        self.assertReadable(figures.CurvesFigure(runs, groups, 2), "curves, 5 measures")
+        self.assertReadable(figures.TipsFigure(runs, groups), "tips")
+        statistics = report.Statistics(runs, groups)
+        figure = figures.EffectsFigure(
+            report._NoNan(statistics), 2, ["reaching_error", "prediction_error"]
         )
         self.assertReadable(figure, "effects")
 
