@@ -215,7 +215,7 @@ def _Experiment(args: list[str]) -> None:
         "mobee-drake experiment",
         args,
         {
-            "ch7": "mobee_drake.experiments.ch7_model_learning",
+            "ch7": "mobee_drake.experiments.ch7_command",
             "ch8": "mobee_drake.experiments.ch8_command",
             "ch8-discounting": "mobee_drake.experiments.ch8_discounting",
             "saggriac": "mobee_drake.experiments.saggriac_command",

@@ -27,7 +27,7 @@ from mobee_drake.atomic_files import (
     WriteGeneration,
     WriteJsonAtomically,
 )
-from mobee_drake.experiments import ch7_model_learning, saggriac_command
+from mobee_drake.experiments import ch7_command, saggriac_command
 from mobee_drake.experiments.battery import InProcess, Job, RunBattery
 from mobee_drake.experiments.ch7_model_learning import Stop
 from mobee_drake.experiments.exploration import ExplorationScenario, Explore
@@ -395,7 +395,7 @@ class TestStrictJson(TemporaryFolder):
                     str(self.folder / "s"),
                 ]
             )
-            ch7_model_learning.main(
+            ch7_command.main(
                 ["--experiment", "7.4.1", "--transitions", "3", "--runs", "1", "--output",
                  str(self.folder / "c7")]
             )  # fmt: skip

@@ -12,7 +12,7 @@ import numpy as np
 
 from mobee_drake.experiments import (
     bench_forces,
-    ch7_model_learning,
+    ch7_figures,
     ch8_figures,
     saggriac_figures,
     trm_roadmaps,
@@ -117,8 +117,8 @@ class TestCh7Figures(FigureTest):
             for gamma in (0.5, 0.9)
             for run in range(3)
         ]
-        self.assertReadable(ch7_model_learning.HypercubeFigure(runs), "7.1")
-        self.assertReadable(ch7_model_learning.InitializationFigure(runs, "60-40"), "7.2i")
+        self.assertReadable(ch7_figures.HypercubeFigure(runs), "7.1")
+        self.assertReadable(ch7_figures.InitializationFigure(runs, "60-40"), "7.2i")
 
     def test_coverage(self):
         runs = [
@@ -126,7 +126,7 @@ class TestCh7Figures(FigureTest):
             for k, strategy in enumerate(("curious", "random", "least_tried"))
             for run in range(2)
         ]
-        figure = ch7_model_learning.CoverageFigure(runs)
+        figure = ch7_figures.CoverageFigure(runs)
         for run in runs:  # each run's own line
             coverage = np.array(run["coverage"])
             self.assertDrawsLine(figure, coverage[:, 0], coverage[:, 1], f"7.2 {run}")
@@ -144,7 +144,7 @@ class TestCh7Figures(FigureTest):
             misses=[misses],
             values=[RNG.random(n)],
         )
-        figure = ch7_model_learning.Rank4Figure(run, space, np.array([5, 6]))
+        figure = ch7_figures.Rank4Figure(run, space, np.array([5, 6]))
         self.assertPlots(figure, run["values"][0], "7.3")
         self.assertReadable(figure, "7.3")
 
@@ -154,7 +154,7 @@ class TestCh7Figures(FigureTest):
             no_box=dict(reliability=np.ones(64)),
             unreliable=[3, 9],
         )
-        figure = ch7_model_learning.MovingBoxFigure(moving)
+        figure = ch7_figures.MovingBoxFigure(moving)
         self.assertPlots(figure, moving["moving_box"]["reliability"], "7.4.1")
         self.assertReadable(figure, "7.4.1")
         agents = dict(
@@ -162,7 +162,7 @@ class TestCh7Figures(FigureTest):
             tries=[RNG.integers(0, 9, 30) for _ in range(3)],
             actions=[10, 11, 12],
         )
-        figure = ch7_model_learning.ThreeAgentsFigure(agents)
+        figure = ch7_figures.ThreeAgentsFigure(agents)
         for axis, tries in zip(figure.axes, agents["tries"], strict=True):  # each agent's own
             np.testing.assert_array_equal([bar.get_height() for bar in axis.patches], tries)
         self.assertReadable(figure, "7.4")

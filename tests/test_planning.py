@@ -351,7 +351,7 @@ class TestExperimentsSmoke(unittest.TestCase):
         import pathlib
         import tempfile
 
-        from mobee_drake.experiments import ch7_model_learning as experiments
+        from mobee_drake.experiments import ch7_command as experiments
 
         output = pathlib.Path(tempfile.mkdtemp())
         experiments.main(

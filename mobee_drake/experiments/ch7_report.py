@@ -1,0 +1,234 @@
+"""The reports of the model-learning experiments of dissertation ch. 7: per experiment, its
+figures and its report's lines (:data:`REPORTS`)."""
+
+import pathlib
+
+import numpy as np
+from pydrake.geometry import SceneGraph
+from pydrake.multibody.plant import MultibodyPlant
+from scipy.stats import spearmanr
+
+from mobee_drake.experiments.ch7_figures import (
+    COVERAGE_STATE_ACTIONS,
+    CoverageFigure,
+    HypercubeFigure,
+    InitializationFigure,
+    MovingBoxFigure,
+    Rank4Figure,
+    ThreeAgentsFigure,
+)
+from mobee_drake.experiments.ch7_model_learning import RIGHT_ARM, UNRELIABLE
+from mobee_drake.experiments.plots import SaveFigure
+from mobee_drake.mobee.constraints import ClauseSet
+from mobee_drake.planning.state_space import Lattice
+from mobee_drake.robots.icub import (
+    AddIcub,
+    IcubConfig,
+)
+
+
+def _ConstraintClearances(centres: np.ndarray) -> np.ndarray:
+    """The smallest clearance (deg) of the right arm's constraint clauses at each state centre
+    (fractions of the shoulder-elbow joints' ranges), from the iCub model and its overlay."""
+    plant, scene_graph = MultibodyPlant(0.0), SceneGraph()
+    plant.RegisterAsSourceForSceneGraph(scene_graph)
+    robot = AddIcub(plant, scene_graph, IcubConfig(controlled_joints=RIGHT_ARM))
+    plant.Finalize()
+    lower = np.array([plant.GetJointByName(j).position_lower_limits()[0] for j in RIGHT_ARM])
+    upper = np.array([plant.GetJointByName(j).position_upper_limits()[0] for j in RIGHT_ARM])
+    clauses = ClauseSet(robot.overlay.clauses, RIGHT_ARM, robot.frozen_joints)
+    return np.array(
+        [np.degrees(clauses.Clearances(lower + c * (upper - lower)).min()) for c in centres]
+    )
+
+
+def _HypercubeReport(output: pathlib.Path, results) -> list[str]:
+    """The hypercube of ch. 7.1: tries and values after 320 actions, per gamma."""
+    lines = []
+    SaveFigure(HypercubeFigure(results), output / "7.1_hypercube.png")
+    for gamma in sorted({r["gamma"] for r in results}):
+        mine = [r for r in results if r["gamma"] == gamma]
+        tries = np.array([r["snapshots"]["320"]["tries"] for r in mine])
+        values = np.array([r["snapshots"]["320"]["values"] for r in mine])
+        lines.append(
+            f"| {gamma} | {len(mine)} | {tries.mean():.2f} | "
+            f"{tries.std(axis=1).mean():.2f} | {values.mean():.4f} | "
+            f"{np.mean([r['wall_seconds'] for r in mine]):.1f} |"
+        )
+    header = [
+        "| gamma | runs | mean tries per state-action after 320 actions | "
+        "spread of tries (std over state-actions, mean over runs) | mean V(s, a) | "
+        "wall s per run |",
+        "|---:|---:|---:|---:|---:|---:|",
+    ]
+    return header + lines
+
+
+def _CoverageReport(output: pathlib.Path, results) -> list[str]:
+    """Coverage (ch. 7.2): transitions until every state-action was tried."""
+    lines = []
+    SaveFigure(CoverageFigure(results), output / "7.2_coverage.png")
+    for strategy in ("curious", "random", "least_tried"):
+        for r in [r for r in results if r["strategy"] == strategy]:
+            coverage = np.array(r["coverage"])
+            full = coverage[coverage[:, 1] >= COVERAGE_STATE_ACTIONS, 0]
+            lines.append(
+                f"| {strategy} | {r['run']} | {coverage[-1, 0]} | "
+                f"{coverage[-1, 1]} | {full[0] if len(full) else '-'} |"
+            )
+    return [
+        "| strategy | run | transitions | state-actions tried | transitions to try all |",
+        "|---|---:|---:|---:|---:|",
+    ] + lines
+
+
+def _Rank4Report(output: pathlib.Path, results) -> list[str]:
+    """The rank-4 lattices (ch. 7.3): states never entered, several outcomes."""
+    lines = []
+    header = [
+        "| lattice | actions | states never entered (clearance of the tightest "
+        "constraint clause at their centres, deg of joint space) | state-actions with "
+        "several outcomes (tried >= 3 times) | most-tried state-action: tries, share "
+        "ending in its goal |",
+        "|---|---:|---|---:|---|",
+    ]
+    for r in results:
+        space = Lattice(r["levels"], 4)
+        tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
+        entered = np.zeros(space.num_states, dtype=bool)
+        entered[space.action_state[tries > 0]] = True  # an action was tried from it
+        never = np.flatnonzero(~entered)
+        clearance = _ConstraintClearances(space.centres[never])
+        clearances = [f"{s_}: {c:.0f}" for s_, c in zip(never, clearance)]
+        several = int(np.sum((misses > 0) & (misses < 1) & (tries >= 3)))
+        top = int(np.argmax(tries))
+        lines.append(
+            f"| {r['lattice']} | {r['actions'][0]} | {len(never)}: "
+            f"{', '.join(clearances) or '-'} | {several} | "
+            f"{space.action_state[top]}->{space.action_goal[top]}: {tries[top]}, "
+            f"{100 * (1 - misses[top]):.0f} % |"
+        )
+        SaveFigure(Rank4Figure(r, space, never), output / f"7.3_{r['lattice']}.png")
+    return header + lines
+
+
+def _InitializationReport(output: pathlib.Path, results) -> list[str]:
+    """The initialisations (ch. 7.2): state-actions that miss their goal."""
+    lines = []
+    space = Lattice([0.25, 0.5, 0.75], 4)
+    header = [
+        "| initialisation | gamma | run | actions | state-actions missing their goal "
+        "in more than 10 % of >= 3 tries (state -> goal: misses/tries) |",
+        "|---|---:|---:|---:|---|",
+    ]
+    for initialization in ("50-50", "60-40"):
+        SaveFigure(
+            InitializationFigure(results, initialization),
+            output / f"7.2i_{initialization}.png",
+        )
+        for gamma in sorted({r["gamma"] for r in results}):
+            for r in results:
+                if r["initialization"] != initialization or r["gamma"] != gamma:
+                    continue
+                tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
+                unreliable = np.flatnonzero((misses > 0.1) & (tries >= 3))
+                listed = ", ".join(
+                    f"{space.action_state[i]}->{space.action_goal[i]}: "
+                    f"{round(misses[i] * tries[i])}/{tries[i]}"
+                    for i in unreliable
+                )
+                lines.append(
+                    f"| {initialization} | {gamma} | {r['run']} | "
+                    f"{r['actions'][0]} | {listed or '-'} |"
+                )
+    return header + lines
+
+
+def _MovingBoxReport(output: pathlib.Path, results) -> list[str]:
+    """The moving box (ch. 7.4.1): plans and executions over risky steps."""
+    lines = []
+    SaveFigure(MovingBoxFigure(results), output / "7.4.1_moving_box.png")
+    unreliable = np.array(results["unreliable"], dtype=int)
+    risky = {(results["action_state"][sa], results["action_goal"][sa]) for sa in unreliable}
+    header = [
+        f"- unreliable state-actions learned among the moving box (reached their goal "
+        f"in < {UNRELIABLE:.0%} of >= 5 tries), state -> goal: "
+        + (", ".join(f"{s_}->{g}" for s_, g in sorted(risky)) or "none"),
+        f"- problems with one risky and one safe shortest route: {len(results['problems'])}",
+        "",
+        "| trained | greedy plans over a risky step | executed problems | actions per "
+        "problem | failed transitions per problem | problems that tried a risky "
+        "state-action | penetrating control periods |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for trained in ("moving_box", "no_box"):
+        r = results[trained]
+        crossing = sum(any(step in risky for step in zip(path, path[1:])) for path in r["plans"])
+        episodes = r["episodes"] or [dict(actions=0, failed=0, tried=[])]
+        lines.append(
+            f"| {trained} | {crossing} of {len(r['plans'])} | {len(r['episodes'])} | "
+            f"{np.mean([e['actions'] for e in episodes]):.2f} | "
+            f"{np.mean([e['failed'] for e in episodes]):.2f} | "
+            f"{np.mean([bool(set(e['tried']) & set(unreliable)) for e in episodes]):.0%} | "
+            f"{r.get('penetrating_steps', 0)} |"
+        )
+    return header + lines
+
+
+def _ThreeAgentsReport(output: pathlib.Path, results) -> list[str]:
+    """Three agents (ch. 7.4): tries, contacts and surprises per agent."""
+    SaveFigure(ThreeAgentsFigure(results), output / "7.4_three_agents.png")
+    right, left = (np.array(t, dtype=float) for t in results["tries"][:2])
+    correlation = float(np.corrcoef(right, left)[0, 1])
+    lines = [
+        f"- transitions: {sum(results['actions'])} ({results['actions']} per agent), "
+        f"{results['simulated_seconds']:.0f} s simulated in {results['wall_seconds']:.0f} s "
+        f"wall",
+        f"- correlation of the right and the left arm's tries per state-action: {correlation:.3f}",
+        f"- penetrating control periods: {results['penetrating_steps']}",
+    ]
+    for name, tries, contacts in zip(
+        results["agents"], results["tries"], results.get("table_contacts", [])
+    ):
+        tries, contacts = np.array(tries), np.array(contacts)
+        top = np.argsort(tries)[::-1][:20]
+        # Undefined when either is constant (e.g. no contact at all in a short run).
+        constant = np.ptp(tries) == 0 or np.ptp(contacts) == 0
+        correlation = "n/a" if constant else f"{spearmanr(tries, contacts).statistic:.2f}"
+        lines.append(
+            f"- {name}: hand-table contact (samples every 0.1 s with a hand inside a field with "
+            f"the table) during {contacts.sum()} samples; the 20 most-tried state-actions "
+            f"({100 * tries[top].sum() / tries.sum():.0f} % of the tries) hold "
+            f"{100 * contacts[top].sum() / max(contacts.sum(), 1):.0f} % of them; rank "
+            f"correlation of tries and contact samples per state-action: "
+            f"{correlation}; state-actions with contact: "
+            f"{int((contacts > 0).sum())} of {len(tries)}"
+        )
+    for name, tries, misses, goals in zip(
+        results["agents"], results["tries"], results["misses"], results["goals"]
+    ):
+        tries, misses, goals = np.array(tries), np.array(misses), np.array(goals)
+        top = np.argsort(tries)[::-1][:20]
+        surprising = misses > 0.1
+        tried_surprising = tries[surprising].mean() if surprising.any() else 0.0
+        lines.append(
+            f"- {name}: the 20 most-tried state-actions (mean {tries[top].mean():.0f} tries, "
+            f"median of all {np.median(tries):.0f}) miss their goal in "
+            f"{100 * misses[top].mean():.0f} % of their tries (all: "
+            f"{100 * misses.mean():.0f} %); state-actions missing their goal more than 10 % of "
+            f"the time: {surprising.sum()}, tried {tried_surprising:.0f} times on average "
+            f"against {tries[~surprising].mean():.0f}; mean goal of the 20 "
+            f"most-tried, in fractions of range: {np.round(goals[top].mean(axis=0), 2).tolist()}"
+        )
+    return lines
+
+
+# Each experiment's figures, written into the output folder; each returns its report's lines.
+REPORTS = {
+    "7.1": _HypercubeReport,
+    "7.2": _CoverageReport,
+    "7.3": _Rank4Report,
+    "7.2i": _InitializationReport,
+    "7.4.1": _MovingBoxReport,
+    "7.4": _ThreeAgentsReport,
+}
