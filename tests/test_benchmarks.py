@@ -42,9 +42,10 @@ class TestBenchmarks(unittest.TestCase):
 
 class TestObjectCount(unittest.TestCase):
     def test_builds_measured_in_their_own_processes_and_the_limit_refused(self):
-        """Issue 31, item 5: ``bench objects`` on 20 boxes and one more than the limit."""
-        table = bench_objects.Table([20, MAX_OBJECTS + 1], cap_bytes=8 * 2**30)
-        header, _, small, large = (line.strip("|").split("|") for line in table.splitlines())
+        """Issue 31, item 5: ``bench objects`` on 20 boxes, and the station of one more than the
+        limit refused at load (Drake's floor for it, seconds of work, is left to the bench)."""
+        table = bench_objects.Table([20], cap_bytes=8 * 2**30)
+        header, _, small = (line.strip("|").split("|") for line in table.splitlines())
         self.assertEqual(len(header), 7)
         floor_seconds, floor_peak, seconds, peak, time_ratio, memory_ratio = map(float, small[1:])
         # A build's peak is at least an imported pydrake's, and each ratio is its columns' (but
@@ -54,9 +55,8 @@ class TestObjectCount(unittest.TestCase):
         self.assertAlmostEqual(time_ratio, seconds / floor_seconds, delta=time_ratio * rounding)
         peaks_rounding = 0.005 / floor_peak + 0.005 / peak  # (GiB shown to 0.01)
         self.assertAlmostEqual(memory_ratio, peak / floor_peak, delta=memory_ratio * peaks_rounding)
-        self.assertEqual(large[0].strip(), f"{MAX_OBJECTS + 1:,}")
-        self.assertNotIn("over the cap", large[1])
-        self.assertRegex(large[3], r"refused at load \(\d+\.\d s\)")
+        *_, error = bench_objects.Measure("station", MAX_OBJECTS + 1, cap_bytes=8 * 2**30)
+        self.assertEqual(error, "refused at load")
 
     def test_a_process_over_its_cap_is_reported_by_how_it_ended(self):
         seconds, peak, error = bench_objects.Measure("floor", 100, cap_bytes=2**28)
