@@ -10,6 +10,7 @@ import numpy as np
 from pydrake.multibody.plant import AddMultibodyPlantSceneGraph
 from pydrake.systems.framework import DiagramBuilder
 
+from mobee_drake.mobee.barrier import BarrierParams
 from mobee_drake.mobee.params import MobeeParams, SquashParams
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.assembly import AddRobotWithOverlay
@@ -78,6 +79,13 @@ class TestBadCommands(unittest.TestCase):
     def test_bad_parameters(self):
         with self.assertRaisesRegex(ValueError, r"collision_squash\.m must be > 0, got -1"):
             ArmDiagram(params=MobeeParams(collision_squash=SquashParams(m=-1.0, k=1.0)))
+        # A gain of zero is refused (a mutation of "> 0" into ">= 0" survived every test), and
+        # a damping of zero only with the barrier on.
+        with self.assertRaisesRegex(ValueError, r"collision_gain must be > 0, got 0"):
+            MobeeParams(collision_gain=0.0).Validate(["a"])
+        with self.assertRaisesRegex(ValueError, r"damping must be > 0 while the safety barrier"):
+            MobeeParams(damping=0.0).Validate(["a"])
+        MobeeParams(damping=0.0, barrier=BarrierParams(enabled=False)).Validate(["a"])
 
 
 class TestBadRobots(unittest.TestCase):
