@@ -38,6 +38,9 @@ FORCE_TERMS = (
 )
 # The rows of MoBeE's "forces" output, named: each term of FORCE_TERMS, then their total.
 ForceRows = namedview("ForceRows", FORCE_TERMS + ("total",))
+# The rows from f_lim on (zero unless something pushes), and the barrier's row.
+_PUSHED_ROWS = slice(FORCE_TERMS.index("f_lim"), None)
+_BARRIER_ROW = FORCE_TERMS.index("f_barrier")
 
 
 class Mobee(LeafSystem):
@@ -479,7 +482,7 @@ class Mobee(LeafSystem):
         # -L(K(q - q*)) as L(K(q* - q)): L is odd (the same numbers, one operation fewer).
         f.spring = Squash(self._stiffness * (q_star - q), *self._squash["spring"])
         np.multiply(self._negative_damping, v, out=f.damping)
-        f[FORCE_TERMS.index("f_lim") :] = 0.0
+        f[_PUSHED_ROWS] = 0.0
         depths = self._band_rows @ q + self._band_offsets
         if depths.max() > 0.0:
             n = len(q)
@@ -524,7 +527,7 @@ class Mobee(LeafSystem):
             )
 
         if self._barrier:
-            others = f[: FORCE_TERMS.index("f_barrier")].sum(axis=0)
+            others = f[:_BARRIER_ROW].sum(axis=0)
             f.f_barrier = self._Barrier(context, q, v, others, pairs, normals)
         np.sum(f[: len(FORCE_TERMS)], axis=0, out=f.total)
 

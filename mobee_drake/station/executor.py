@@ -52,6 +52,8 @@ SLOTS += tuple(f"target_{c}" for c in "xyz") + tuple(f"reached_{c}" for c in "xy
 TARGET = slice(SLOTS.index("target_x"), SLOTS.index("target_z") + 1)
 REACHED = slice(SLOTS.index("reached_x"), SLOTS.index("reached_z") + 1)
 Q_STAR = len(SLOTS)
+# What the data log keeps of the state (see DataLogColumns).
+LOGGED = [SLOTS.index("phase"), SLOTS.index("finished_actions")]
 
 
 @dc.dataclass
@@ -146,9 +148,7 @@ class StateActionExecutor(LeafSystem):
         self.DeclareVectorOutputPort(
             "data_log",
             2,
-            lambda context, output: output.SetFromVector(
-                self._Vector(context)[[SLOTS.index("phase"), SLOTS.index("finished_actions")]]
-            ),
+            lambda context, output: output.SetFromVector(self._Vector(context)[LOGGED]),
             prerequisites_of_calc={self.discrete_state_ticket(self._state)},
         )
 
