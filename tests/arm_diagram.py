@@ -20,7 +20,7 @@ JOINTS = ["joint1", "joint2", "joint3"]
 class ArmDiagram:
     """The arm, optional fixed boxes and MoBeE, with the plant's positions set by the test."""
 
-    def __init__(self, boxes=(), params=None, joints=JOINTS, couplings=()):
+    def __init__(self, boxes=(), params=None, joints=JOINTS, couplings=(), step=None):
         builder = DiagramBuilder()
         self.plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
         self.robot = AddRobotWithOverlay(
@@ -45,6 +45,7 @@ class ArmDiagram:
             robot=self.robot,
             joints=list(joints),
             params=self.params,
+            step=step,
         )
         self.diagram = builder.Build()
         self.root_context = self.diagram.CreateDefaultContext()

@@ -14,6 +14,7 @@ from mobee_drake.experiments import (
     bench_forces,
     ch7_figures,
     ch8_figures,
+    saggriac,
     saggriac_figures,
     trm_roadmaps,
 )
@@ -30,6 +31,15 @@ def _IsColorbar(axis) -> bool:
 
 def _HasColorbar(axis) -> bool:
     return any(m.colorbar is not None for m in [*axis.images, *axis.collections])
+
+
+def _BabblingRun(spec, **fields) -> saggriac.BabblingRun:
+    """A constructed SAGG-RIAC run: empty but for ``fields``."""
+    defaults = dict(
+        config={}, wall_time_s=1.0, time_steps=0, curve=[], final_reaching_errors=[],
+        diagnostics={}, tip_sample=[],
+    )  # fmt: skip
+    return saggriac.BabblingRun(spec=spec, **(defaults | fields))
 
 
 def _LegendColours(legend) -> set:
@@ -229,7 +239,7 @@ class TestOtherFigures(FigureTest):
             for t in (0, 100, 200)
         ]
         runs = [
-            dict(spec=dict(method=method, seed=seed), curve=curve)
+            _BabblingRun(saggriac.RunSpec(1, method, seed, 200, 2), curve=curve)
             for method in ("SAGG-RIAC", "ACTUATOR-Random")
             for seed in range(2)
         ]
@@ -239,7 +249,8 @@ class TestOtherFigures(FigureTest):
         goals = np.zeros((40, 7))
         goals[:, 1:3] = RNG.uniform([0, -100], [100, 100], (40, 2))
         goals[:, 4] = 1  # a goal, not a subgoal
-        run = dict(
+        run = _BabblingRun(
+            saggriac.RunSpec(2, "SAGG-RIAC", 0, 1000, 2),
             config=dict(
                 goal_space_low=[0, -100], goal_space_high=[100, 100], arm=dict(total_length=50)
             ),
@@ -248,7 +259,6 @@ class TestOtherFigures(FigureTest):
                 dict(first_goal=10 * i, end_goal=10 * i + 10, regions=[[0, -100, 50, 100]])
                 for i in range(4)
             ],
-            spec=dict(experiment=2, seed=0, budget=1000),
         )
         figure = saggriac_figures.GoalsFigure(run)
         # The last panel: every goal's bin, counted.

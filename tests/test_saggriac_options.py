@@ -393,21 +393,31 @@ class TestVariants(unittest.TestCase):
                 self.assertGreater((output / name).stat().st_size, 1000, name)
 
 
+def _Run(method: str, seed: int, curve: list[dict], variant: str = "paper", **fields):
+    """A constructed run of experiment 1 (a 50-unit arm) with the given evaluations."""
+    spec = experiments.RunSpec(1, method, seed, budget=200, num_checkpoints=2, variant=variant)
+    defaults = dict(
+        config={"arm": {"total_length": 50.0}},
+        wall_time_s=1.0,
+        time_steps=200,
+        final_reaching_errors=[],
+        diagnostics={},
+        tip_sample=[],
+    )
+    return experiments.BabblingRun(spec=spec, curve=curve, **(defaults | fields))
+
+
 class TestCheckpointTable(unittest.TestCase):
     def test_rows_give_each_checkpoint_difference_and_welch_p(self):
         # Two groups of three runs whose values at checkpoint k are k * (1, 2, 4) and k * (2, 3, 7):
         # the difference of the means is -k * 5 / 3, and Welch's t on the same values gives p.
         first, second = (1.0, 2.0, 4.0), (2.0, 3.0, 7.0)
         runs = [
-            {
-                "spec": {"method": method, "seed": seed},
-                "curve": [
-                    {"time_step": 100 * k, "a": k * value, "b": -k * value} for k in range(3)
-                ],
-            }
+            _Run(method, seed, [{"time_step": 100 * k, "a": k * value, "b": -k * value}
+                                for k in range(3)])
             for method, values in (("SAGG-RIAC", first), ("SAGG-Random", second))
             for seed, value in enumerate(values)
-        ]
+        ]  # fmt: skip
         lines = report.CheckpointTable(runs, "SAGG-RIAC", "SAGG-Random", ("a", "b"))
         self.assertEqual(len(lines), 2 + 2)  # header, rule, checkpoints 100 and 200
         self.assertIn("a: SAGG-RIAC - SAGG-Random (Welch p)", lines[0])
@@ -419,8 +429,8 @@ class TestCheckpointTable(unittest.TestCase):
             self.assertEqual(cells[2], f"{k * 5 / 3:+.2f} ({p_value:.2g})")
 
     def test_no_rows_with_fewer_than_two_runs_per_group(self):
-        runs = [{"spec": {"method": "SAGG-RIAC"}, "curve": [{"time_step": 0, "a": 1.0}]}]
-        runs += [{"spec": {"method": "SAGG-Random"}, "curve": [{"time_step": 0, "a": 2.0}]}] * 2
+        runs = [_Run("SAGG-RIAC", 0, [{"time_step": 0, "a": 1.0}])]
+        runs += [_Run("SAGG-Random", seed, [{"time_step": 0, "a": 2.0}]) for seed in range(2)]
         self.assertEqual(report.CheckpointTable(runs, "SAGG-RIAC", "SAGG-Random", ("a",)), [])
 
 
@@ -436,15 +446,15 @@ class TestFigures(FigureTest):
                 for t in (0, 100, 200)
             ]
             runs.append(
-                {
-                    "spec": {"method": method, "variant": variant.rstrip("]") or "paper",
-                             "seed": seed},
-                    "curve": curve,
-                    "config": {"arm": {"total_length": 50.0}},
-                    "tip_sample": rng.uniform(-50, 50, (100, 2)).tolist(),
-                    "diagnostics": {"tip_spread": 9.0, "tip_coverage": 0.3, "drift_ratio": 1.1},
-                }
-            )  # fmt: skip
+                _Run(
+                    method,
+                    seed,
+                    curve,
+                    variant=variant.rstrip("]") or "paper",
+                    tip_sample=rng.uniform(-50, 50, (100, 2)).tolist(),
+                    diagnostics={"tip_spread": 9.0, "tip_coverage": 0.3, "drift_ratio": 1.1},
+                )
+            )
         self.assertReadable(figures.CurvesFigure(runs, groups, 2), "curves, 5 measures")
         self.assertReadable(figures.TipsFigure(runs, groups), "tips")
         statistics = report.Statistics(runs, groups)

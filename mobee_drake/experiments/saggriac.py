@@ -156,14 +156,66 @@ class RunSpec:
         return f"exp{self.experiment}_{self.method}{suffix}_seed{self.seed:02d}_budget{self.budget}"
 
     def Label(self) -> str:
-        """The group of the run in tables and plots: the method, and the variant unless paper."""
-        return Label(dataclasses.asdict(self))
+        """The group of the run in tables and plots: 'METHOD', or 'METHOD [variant]' unless the
+        variant is paper."""
+        return self.method if self.variant == "paper" else f"{self.method} [{self.variant}]"
 
 
-def Label(spec: dict) -> str:
-    """The group of a run (its spec as a dict): 'METHOD' or 'METHOD [variant]'."""
-    variant = spec.get("variant", "paper")
-    return spec["method"] if variant == "paper" else f"{spec['method']} [{variant}]"
+# The columns of BabblingRun.goal_log's rows.
+GOAL_LOG_COLUMNS = ("time_step", "x", "y", "competence", "mode", "attempt", "tree_points")
+
+
+@dataclasses.dataclass
+class BabblingRun:
+    """What one learner's run produced (a battery job's result, :func:`RunOne`).
+
+    Attributes:
+        spec: The run.
+        config: Its configuration (``ConfigToDict``).
+        wall_time_s: Wall time of the run.
+        time_steps: Micro-actions taken.
+        curve: One evaluation per checkpoint: ``time_step`` and every measure of
+            ``goal_babbling.evaluation.MEASURES``.
+        final_reaching_errors: The last evaluation's error per test goal (units).
+        diagnostics: :func:`Diagnostics` of the run.
+        tip_sample: Every k-th stored hand tip (TIP_SAMPLES of them at most).
+        goal_log: Goal-space methods: one row per goal or subgoal (GOAL_LOG_COLUMNS).
+        region_snapshots: SAGG-RIAC: the regions at the end of each goal window (Fig. 3).
+        num_regions: RIAC methods: the leaves of the region tree at the end.
+    """
+
+    spec: RunSpec
+    config: dict
+    wall_time_s: float
+    time_steps: int
+    curve: list[dict[str, float]]
+    final_reaching_errors: list[float]
+    diagnostics: dict[str, float]
+    tip_sample: list[list[float]]
+    goal_log: list[list[float]] | None = None
+    region_snapshots: list[dict] | None = None
+    num_regions: int | None = None
+
+    @property
+    def label(self) -> str:
+        """The run's group in tables and plots (RunSpec.Label)."""
+        return self.spec.Label()
+
+    def ToJson(self) -> dict:
+        """The result as written to the run's folder."""
+        return dataclasses.asdict(self)
+
+    def Goals(self) -> np.ndarray:
+        """The goal log's rows of goals (subgoals excluded), columns GOAL_LOG_COLUMNS."""
+        log = np.array(self.goal_log, dtype=float).reshape(-1, len(GOAL_LOG_COLUMNS))
+        return log[log[:, GOAL_LOG_COLUMNS.index("mode")] > 0]
+
+    @classmethod
+    def FromJson(cls, data: dict) -> "BabblingRun":
+        """A result as read back from a run's folder."""
+        # Results written before 0.3.1 also hold the goal log's column names.
+        data = {key: value for key, value in data.items() if key != "goal_log_columns"}
+        return cls(**dict(data, spec=RunSpec(**data["spec"])))
 
 
 def MakeConfig(spec: RunSpec) -> GoalBabblingConfig:
@@ -247,50 +299,40 @@ def Diagnostics(learner, evaluator: Evaluator) -> dict:
 
 def RunOne(run: RunFolder, spec: dict) -> dict:
     """Runs one learner (a battery job; ``spec`` a :class:`RunSpec` as a dict) and returns its
-    result.
-    """
+    :class:`BabblingRun` as written."""
     spec = RunSpec(**spec)
     config = MakeConfig(spec)
     evaluator = Evaluator(config)
     started = time.perf_counter()
     learner = METHODS[spec.method](config, evaluator).Run()
     stride = max(1, learner.memory.size // TIP_SAMPLES)
-    result = {
-        "spec": dataclasses.asdict(spec),
-        "config": ConfigToDict(config),
-        "wall_time_s": time.perf_counter() - started,
-        "time_steps": learner.time_steps,
-        "curve": learner.curve,
-        "final_reaching_errors": [float(error) for error in evaluator.reaching_errors],
-        "diagnostics": Diagnostics(learner, evaluator),
-        "tip_sample": learner.memory.positions[: learner.memory.size : stride].round(3).tolist(),
-    }
+    result = BabblingRun(
+        spec=spec,
+        config=ConfigToDict(config),
+        wall_time_s=time.perf_counter() - started,
+        time_steps=learner.time_steps,
+        curve=learner.curve,
+        final_reaching_errors=[float(error) for error in evaluator.reaching_errors],
+        diagnostics=Diagnostics(learner, evaluator),
+        tip_sample=learner.memory.positions[: learner.memory.size : stride].round(3).tolist(),
+    )
     if isinstance(learner, SaggRiac):
-        result["goal_log"] = [list(map(float, row)) for row in learner.goal_log]
-        result["goal_log_columns"] = [
-            "time_step",
-            "x",
-            "y",
-            "competence",
-            "mode",
-            "attempt",
-            "tree_points",
-        ]
-        result["num_regions"] = len(learner.tree.leaves)
-        result["region_snapshots"] = _RegionSnapshots(learner)
-    if isinstance(learner, ActuatorRiac):
-        result["num_regions"] = len(learner.tree.leaves)
-    return result
+        result.goal_log = [list(map(float, row)) for row in learner.goal_log]
+        result.region_snapshots = _RegionSnapshots(learner)
+    if isinstance(learner, (SaggRiac, ActuatorRiac)):
+        result.num_regions = len(learner.tree.leaves)
+    return result.ToJson()
 
 
-def RunAll(specs: list[RunSpec], output: pathlib.Path, backend: Backend) -> list[dict]:
+def RunAll(specs: list[RunSpec], output: pathlib.Path, backend: Backend) -> list[BabblingRun]:
     """Runs the missing runs on ``backend`` (see :mod:`mobee_drake.experiments.battery`) and
     returns every run's result."""
     jobs = [Job(spec.Name(), RunOne, {"spec": dataclasses.asdict(spec)}) for spec in specs]
-    return list(RunBattery(jobs, output, backend=backend, description="SAGG-RIAC").values())
+    results = RunBattery(jobs, output, backend=backend, description="SAGG-RIAC")
+    return [BabblingRun.FromJson(result) for result in results.values()]
 
 
-def LoadRuns(specs: list[RunSpec], output: pathlib.Path) -> list[dict]:
+def LoadRuns(specs: list[RunSpec], output: pathlib.Path) -> list[BabblingRun]:
     """Results of the given runs that exist on disk."""
     paths = [output / "runs" / spec.Name() / RESULT for spec in specs]
-    return [json.loads(path.read_text()) for path in paths if path.exists()]
+    return [BabblingRun.FromJson(json.loads(path.read_text())) for path in paths if path.exists()]

@@ -6,11 +6,11 @@ import math
 import numpy as np
 
 from mobee_drake.experiments.plots import Figure, plt
-from mobee_drake.experiments.saggriac import MEASURE_TITLES, NUM_HISTOGRAM_WINDOWS, Label
+from mobee_drake.experiments.saggriac import MEASURE_TITLES, NUM_HISTOGRAM_WINDOWS, BabblingRun
 
 
 def CurvesFigure(
-    runs: list[dict], groups: list[str], experiment: int, measures: list[str] | None = None
+    runs: list[BabblingRun], groups: list[str], experiment: int, measures: list[str] | None = None
 ) -> Figure:
     """Mean and standard deviation over seeds of each measure against time steps (Fig. 4-5).
 
@@ -21,7 +21,7 @@ def CurvesFigure(
         measures: Measures drawn, one panel each (default: those of MEASURE_TITLES in the runs).
     """
     if measures is None:
-        present = runs[0]["curve"][0]
+        present = runs[0].curve[0]
         measures = [measure for measure in MEASURE_TITLES if measure in present]
         measures += [m for m in present if m != "time_step" and m not in measures]
     columns = min(len(measures), 3)
@@ -30,12 +30,12 @@ def CurvesFigure(
     for axis in axes.flat[len(measures) :]:
         axis.remove()
     for offset, group in enumerate(groups):
-        group_runs = [run for run in runs if Label(run["spec"]) == group]
+        group_runs = [run for run in runs if run.label == group]
         if not group_runs:
             continue
-        steps = np.array([point["time_step"] for point in group_runs[0]["curve"]]) / 1000
+        steps = np.array([point["time_step"] for point in group_runs[0].curve]) / 1000
         for axis, measure in zip(axes.flat, measures, strict=False):
-            values = np.array([[point[measure] for point in run["curve"]] for run in group_runs])
+            values = np.array([[point[measure] for point in run.curve] for run in group_runs])
             mean, spread = values.mean(axis=0), values.std(axis=0)
             (line,) = axis.plot(steps, mean, label=f"{group} ({len(group_runs)} seeds)")
             # Error bars shifted per group for readability, as in the paper's figures.
@@ -123,7 +123,7 @@ def EffectsFigure(statistics: list[dict], experiment: int, measures: list[str]) 
     return figure
 
 
-def TipsFigure(runs: list[dict], groups: list[str]) -> Figure:
+def TipsFigure(runs: list[BabblingRun], groups: list[str]) -> Figure:
     """Where each group's memory lies: the stored tips of its lowest seed (every k-th), with the
     reachable half-disc, and its drift and coverage diagnostics over all its seeds.
 
@@ -131,16 +131,14 @@ def TipsFigure(runs: list[dict], groups: list[str]) -> Figure:
         runs: Results (with tip_sample).
         groups: Labels drawn, one panel each.
     """
-    groups = [g for g in groups if any(Label(run["spec"]) == g for run in runs)]
+    groups = [g for g in groups if any(run.label == g for run in runs)]
     figure, axes = plt.subplots(1, len(groups), figsize=(4.2 * len(groups), 4.6), squeeze=False)
     angles = np.linspace(-np.pi, np.pi, 200)
     for axis, group in zip(axes[0], groups, strict=True):
-        group_runs = sorted(
-            (run for run in runs if Label(run["spec"]) == group), key=lambda r: r["spec"]["seed"]
-        )
-        tips = np.array(group_runs[0]["tip_sample"])
-        length = group_runs[0]["config"]["arm"]["total_length"]
-        diagnostics = [run["diagnostics"] for run in group_runs]
+        group_runs = sorted((run for run in runs if run.label == group), key=lambda r: r.spec.seed)
+        tips = np.array(group_runs[0].tip_sample)
+        length = group_runs[0].config["arm"]["total_length"]
+        diagnostics = [run.diagnostics for run in group_runs]
         spread = np.mean([d["tip_spread"] for d in diagnostics])
         coverage = 100 * np.mean([d["tip_coverage"] for d in diagnostics])
         axis.scatter(tips[:, 0], tips[:, 1], s=1, alpha=0.3, color="C0", label="stored tips")
@@ -156,7 +154,7 @@ def TipsFigure(runs: list[dict], groups: list[str]) -> Figure:
         axis.set(
             xlabel="tip x [units]",
             ylabel="tip y [units]",
-            title=f"{group}, seed {group_runs[0]['spec']['seed']}\n"
+            title=f"{group}, seed {group_runs[0].spec.seed}\n"
             f"spread {spread:.1f}, coverage {coverage:.0f} %{drift}",
             xlim=(-length * 1.05, length * 1.05),
             ylim=(-length * 1.05, length * 1.05),
@@ -172,23 +170,22 @@ def TipsFigure(runs: list[dict], groups: list[str]) -> Figure:
     return figure
 
 
-def GoalsFigure(run: dict) -> Figure:
+def GoalsFigure(run: BabblingRun) -> Figure:
     """Histograms of the self-generated goals (subgoals excluded) in four windows, with regions
     (Fig. 3).
     """
-    config = run["config"]
+    config = run.config
     low, high = config["goal_space_low"], config["goal_space_high"]
     length = config["arm"]["total_length"]
-    log = np.array(run["goal_log"]).reshape(-1, 7)
-    goals = log[log[:, 4] > 0]
+    goals = run.Goals()
     figure, axes = plt.subplots(
         1, NUM_HISTOGRAM_WINDOWS + 1, figsize=(4.2 * (NUM_HISTOGRAM_WINDOWS + 1), 5.5)
     )
     panels = [
         (snapshot["first_goal"], snapshot["end_goal"], snapshot["regions"])
-        for snapshot in run["region_snapshots"]
+        for snapshot in run.region_snapshots
     ]
-    panels.append((0, len(goals), run["region_snapshots"][-1]["regions"]))
+    panels.append((0, len(goals), run.region_snapshots[-1]["regions"]))
     angles = np.linspace(-np.pi / 2, np.pi / 2, 100)
     for axis, (begin, end, regions) in zip(axes, panels, strict=True):
         *_, shown = axis.hist2d(
@@ -223,9 +220,9 @@ def GoalsFigure(run: dict) -> Figure:
             aspect="equal",
         )
     axes[-1].legend(loc="lower right", fontsize=7, facecolor="0.85")
-    spec = run["spec"]
+    spec = run.spec
     figure.suptitle(
-        f"SAGG-RIAC's goals (30 x 30 bins) and regions, experiment {spec['experiment']}, "
-        f"seed {spec['seed']}, {spec['budget']} time steps (cf. the paper's Fig. 3)"
+        f"SAGG-RIAC's goals (30 x 30 bins) and regions, experiment {spec.experiment}, "
+        f"seed {spec.seed}, {spec.budget} time steps (cf. the paper's Fig. 3)"
     )
     return figure

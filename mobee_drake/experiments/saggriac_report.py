@@ -19,7 +19,7 @@ from mobee_drake.experiments.saggriac import (
     METHODS,
     SAGG_METHODS,
     VARIANTS,
-    Label,
+    BabblingRun,
     LoadRuns,
     RunSpec,
 )
@@ -37,8 +37,8 @@ from mobee_drake.goal_babbling.evaluation import MEASURES, MakeTestSet
 from mobee_drake.goal_babbling.sagg_riac import SaggRiac
 
 
-def _Final(runs: list[dict], group: str, measure: str) -> np.ndarray:
-    return np.array([run["curve"][-1][measure] for run in runs if Label(run["spec"]) == group])
+def _Final(runs: list[BabblingRun], group: str, measure: str) -> np.ndarray:
+    return np.array([run.curve[-1][measure] for run in runs if run.label == group])
 
 
 # The comparisons behind the paper's claims (Sec. IV-B): (first group, second group, claim).
@@ -64,7 +64,7 @@ def Pairs(groups: list[str]) -> list[tuple[str, str, str]]:
     return pairs
 
 
-def Statistics(runs: list[dict], groups: list[str]) -> list[dict]:
+def Statistics(runs: list[BabblingRun], groups: list[str]) -> list[dict]:
     """Run-level tests at the end of the runs, per measure: a one-way ANOVA over the paper's four
     methods, and each pair of Pairs() with effect sizes, intervals and power (see
     :func:`mobee_drake.experiments.statistics.CompareRuns`).
@@ -111,20 +111,20 @@ def Statistics(runs: list[dict], groups: list[str]) -> list[dict]:
     return rows
 
 
-def WriteCurves(runs: list[dict], path: pathlib.Path) -> None:
+def WriteCurves(runs: list[BabblingRun], path: pathlib.Path) -> None:
     """CSV with one row per (method, variant, seed, checkpoint)."""
     with open(path, "w", newline="") as stream:
         writer = csv.writer(stream)
         writer.writerow(["experiment", "method", "variant", "seed", "time_step", *MEASURES])
         for run in runs:
-            spec = run["spec"]
-            for point in run["curve"]:
+            spec = run.spec
+            for point in run.curve:
                 writer.writerow(
                     [
-                        spec["experiment"],
-                        spec["method"],
-                        spec.get("variant", "paper"),
-                        spec["seed"],
+                        spec.experiment,
+                        spec.method,
+                        spec.variant,
+                        spec.seed,
                         point["time_step"],
                         *(f"{point[measure]:.6g}" for measure in MEASURES),
                     ]
@@ -138,15 +138,14 @@ def _Format(values: np.ndarray, digits: int = 2, scale: float = 1.0) -> str:
     return f"{values.mean():.{digits}f} ± {spread:.{digits}f} ({np.median(values):.{digits}f})"
 
 
-def _GoalStatistics(runs: list[dict]) -> str:
+def _GoalStatistics(runs: list[BabblingRun]) -> str:
     """'goals per run | % of goals within reach' of goal-space runs, '- | -' otherwise."""
-    if "goal_log" not in runs[0]:
+    if runs[0].goal_log is None:
         return "- | -"
     counts, inside = [], []
     for run in runs:
-        log = np.array(run["goal_log"]).reshape(-1, 7)
-        goals = log[log[:, 4] > 0]
-        length = run["config"]["arm"]["total_length"]
+        goals = run.Goals()
+        length = run.config["arm"]["total_length"]
         counts.append(len(goals))
         inside.append(np.mean(np.hypot(goals[:, 1], goals[:, 2]) <= length) if len(goals) else 0.0)
     return f"{np.mean(counts):.0f} | {100 * np.mean(inside):.1f}"
@@ -164,25 +163,25 @@ def _P(value) -> str:
     return f"{value:.2g}" if value >= 1e-3 else f"{value:.1e}"
 
 
-def _Diagnostic(runs: list[dict], name: str, scale: float = 1.0, digits: int = 1) -> str:
-    values = [run.get("diagnostics", {}).get(name) for run in runs]
+def _Diagnostic(runs: list[BabblingRun], name: str, scale: float = 1.0, digits: int = 1) -> str:
+    values = [run.diagnostics.get(name) for run in runs]
     values = [value for value in values if value is not None]
     return f"{scale * np.mean(values):.{digits}f}" if values else "-"
 
 
 def _GroupTable(
-    runs: list[dict], groups: list[str], columns: list[str], Cells: Callable[..., list]
+    runs: list[BabblingRun], groups: list[str], columns: list[str], Cells: Callable[..., list]
 ) -> list[str]:
     """Markdown rows: one per group with runs, its cells Cells(group, its runs)."""
     lines = ["| group | " + " | ".join(columns) + " |", "|---" * (len(columns) + 1) + "|"]
     for group in groups:
-        group_runs = [run for run in runs if Label(run["spec"]) == group]
+        group_runs = [run for run in runs if run.label == group]
         if group_runs:
             lines.append(f"| {group} | " + " | ".join(map(str, Cells(group, group_runs))) + " |")
     return lines
 
 
-def ResultsTable(runs: list[dict], groups: list[str]) -> list[str]:
+def ResultsTable(runs: list[BabblingRun], groups: list[str]) -> list[str]:
     """Markdown rows: per group, the final measures as mean ± sd (median) over its runs."""
     columns = [
         "runs",
@@ -204,12 +203,12 @@ def ResultsTable(runs: list[dict], groups: list[str]) -> list[str]:
             _Format(_Final(runs, group, "reached_share"), digits=1, scale=100.0),
             _Format(_Final(runs, group, "prediction_error")),
             _Format(_Final(runs, group, "prediction_error_near_rest")),
-            f"{np.mean([run['wall_time_s'] for run in group_runs]):.0f}",
+            f"{np.mean([run.wall_time_s for run in group_runs]):.0f}",
         ],
     )
 
 
-def DiagnosticsTable(runs: list[dict], groups: list[str]) -> list[str]:
+def DiagnosticsTable(runs: list[BabblingRun], groups: list[str]) -> list[str]:
     """Markdown rows: per group, the means over its runs of the diagnostics (see Diagnostics)."""
     columns = [
         "tip coverage (%)",
@@ -223,8 +222,8 @@ def DiagnosticsTable(runs: list[dict], groups: list[str]) -> list[str]:
         "goals in reach (%)",
     ]
 
-    def Cells(group: str, group_runs: list[dict]) -> list[str]:
-        regions = [run["num_regions"] for run in group_runs if "num_regions" in run]
+    def Cells(group: str, group_runs: list[BabblingRun]) -> list[str]:
+        regions = [run.num_regions for run in group_runs if run.num_regions is not None]
         return [
             _Diagnostic(group_runs, "tip_coverage", 100.0),
             _Diagnostic(group_runs, "tip_spread"),
@@ -240,21 +239,20 @@ def DiagnosticsTable(runs: list[dict], groups: list[str]) -> list[str]:
 
 
 def CheckpointTable(
-    runs: list[dict], first: str, second: str, measures: tuple[str, ...]
+    runs: list[BabblingRun], first: str, second: str, measures: tuple[str, ...]
 ) -> list[str]:
     """Markdown rows: at every checkpoint, the difference of the groups' means of each measure
     and its Welch p (one value per run and checkpoint; checkpoints are not pooled)."""
     curves = {
         group: np.array(
-            [[[p[m] for m in measures] for p in run["curve"]] for run in runs
-             if Label(run["spec"]) == group]
+            [[[p[m] for m in measures] for p in run.curve] for run in runs
+             if run.label == group]
         )
         for group in (first, second)
     }  # fmt: skip
     if min(len(curve) for curve in curves.values()) < 2:
         return []
-    steps = [point["time_step"] for point in next(r for r in runs if Label(r["spec"]) == first)[
-        "curve"]]  # fmt: skip
+    steps = [point["time_step"] for point in next(r for r in runs if r.label == first).curve]
     lines = [
         "| time step | "
         + " | ".join(f"{m}: {first} - {second} (Welch p)" for m in measures)
@@ -275,11 +273,11 @@ def CheckpointTable(
 RADIUS_BANDS = (0.0, 15.0, 30.0, 40.0, 50.0)
 
 
-def RadiusTable(runs: list[dict], groups: list[str]) -> list[str]:
+def RadiusTable(runs: list[BabblingRun], groups: list[str]) -> list[str]:
     """Markdown rows: per group, the share of test goals reached within 1 unit by distance of the
     goal from the base (mean over runs of each run's share in the band), and the band's mean
     error: where the heavy tail of missed goals lies."""
-    config = ConfigFromDict(runs[0]["config"])
+    config = ConfigFromDict(runs[0].config)
     radii = np.linalg.norm(MakeTestSet(config).goals, axis=1)
     bands = list(zip(RADIUS_BANDS[:-1], RADIUS_BANDS[1:], strict=True))
     reached = config.evaluation.reached_distance
@@ -291,9 +289,7 @@ def RadiusTable(runs: list[dict], groups: list[str]) -> list[str]:
         "|---|" + "---|" * len(bands),
     ]  # fmt: skip
     for group in groups:
-        errors = np.array(
-            [run["final_reaching_errors"] for run in runs if Label(run["spec"]) == group]
-        )
+        errors = np.array([run.final_reaching_errors for run in runs if run.label == group])
         if errors.size == 0:
             continue
         cells = []
@@ -332,7 +328,7 @@ def TestsTable(statistics: list[dict], measures: tuple[str, ...] = MEASURES) -> 
 
 
 def WriteReport(
-    all_runs: dict[int, list[dict]],
+    all_runs: dict[int, list[BabblingRun]],
     statistics: dict[int, list[dict]],
     groups: list[str],
     command: str,
@@ -351,7 +347,7 @@ def WriteReport(
     for experiment, runs in all_runs.items():
         if not runs:
             continue
-        budget = runs[0]["spec"]["budget"]
+        budget = runs[0].spec.budget
         lines += [
             f"## Experiment {experiment} ({budget} time steps per run)",
             "",
@@ -391,7 +387,11 @@ def WriteReport(
             "",
             f"Plots: `exp{experiment}_curves.png`, `exp{experiment}_effects.png`, "
             f"`exp{experiment}_tips.png`"
-            + (f", `exp{experiment}_goals.png`" if any("goal_log" in run for run in runs) else ""),
+            + (
+                f", `exp{experiment}_goals.png`"
+                if any(run.goal_log is not None for run in runs)
+                else ""
+            ),
             "",
         ]
     WriteTextAtomically(path, "\n".join(lines) + "\n")
@@ -436,7 +436,7 @@ def Analyse(specs: list[RunSpec], output: pathlib.Path, command: str) -> None:
                 dpi=110,
             )
         SaveFigure(TipsFigure(runs, groups), output / f"exp{experiment}_tips.png", dpi=100)
-        sagg_riac_runs = [run for run in runs if Label(run["spec"]) == SaggRiac.name]
+        sagg_riac_runs = [run for run in runs if run.label == SaggRiac.name]
         if sagg_riac_runs:
             SaveFigure(
                 GoalsFigure(sagg_riac_runs[0]), output / f"exp{experiment}_goals.png", dpi=100
