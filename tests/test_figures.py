@@ -18,6 +18,8 @@ from mobee_drake.experiments import (
     saggriac_figures,
     trm_roadmaps,
 )
+from mobee_drake.experiments.ch7_model_learning import MovingBoxResult, PlanningRun
+from mobee_drake.experiments.exploration import ExplorationRun
 from mobee_drake.experiments.plots import SaveFigure
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.reaching.learner import LOG_COLUMNS
@@ -31,6 +33,15 @@ def _IsColorbar(axis) -> bool:
 
 def _HasColorbar(axis) -> bool:
     return any(m.colorbar is not None for m in [*axis.images, *axis.collections])
+
+
+def _ExplorationRun(**fields) -> ExplorationRun:
+    """A constructed exploration run: empty but for ``fields``."""
+    defaults = dict(
+        agents=[], tries=[], values=[], misses=[], goals=[], actions=[], snapshots={},
+        coverage=[], simulated_seconds=0.0, wall_seconds=0.0, penetrating_steps=0,
+    )  # fmt: skip
+    return ExplorationRun(**(defaults | fields))
 
 
 def _BabblingRun(spec, **fields) -> saggriac.BabblingRun:
@@ -115,11 +126,9 @@ class FigureTest(unittest.TestCase):
 class TestCh7Figures(FigureTest):
     def test_hypercube_and_initializations(self):
         runs = [
-            dict(
-                gamma=gamma,
-                run=run,
-                initialization=initialization,
-                snapshots={"320": dict(tries=RNG.integers(4, 7, 16), values=RNG.random(16))},
+            _ExplorationRun(
+                labels=dict(gamma=gamma, run=run, initialization=initialization),
+                snapshots={320: dict(tries=RNG.integers(4, 7, 16), values=RNG.random(16))},
                 tries=[RNG.integers(4, 9, 40)],
                 values=[RNG.random(40)],
             )
@@ -132,13 +141,16 @@ class TestCh7Figures(FigureTest):
 
     def test_coverage(self):
         runs = [
-            dict(strategy=strategy, run=run, coverage=[[0, 0], [50, 40 + 3 * k + run], [100, 70]])
+            _ExplorationRun(
+                labels=dict(strategy=strategy, run=run),
+                coverage=[[0, 0], [50, 40 + 3 * k + run], [100, 70]],
+            )
             for k, strategy in enumerate(("curious", "random", "least_tried"))
             for run in range(2)
         ]
         figure = ch7_figures.CoverageFigure(runs)
         for run in runs:  # each run's own line
-            coverage = np.array(run["coverage"])
+            coverage = np.array(run.coverage)
             self.assertDrawsLine(figure, coverage[:, 0], coverage[:, 1], f"7.2 {run}")
         self.assertReadable(figure, "7.2")
 
@@ -147,33 +159,38 @@ class TestCh7Figures(FigureTest):
         n = space.num_state_actions
         misses = np.zeros(n)
         misses[[1, 2]], misses[[3, 4]] = 0.5, 1.0  # several outcomes; never the goal
-        run = dict(
-            lattice="20-80",
+        run = _ExplorationRun(
+            labels=dict(lattice="20-80"),
             actions=[200],
             tries=[RNG.integers(3, 9, n)],
             misses=[misses],
             values=[RNG.random(n)],
         )
         figure = ch7_figures.Rank4Figure(run, space, np.array([5, 6]))
-        self.assertPlots(figure, run["values"][0], "7.3")
+        self.assertPlots(figure, run.values[0], "7.3")
         self.assertReadable(figure, "7.3")
 
     def test_moving_box_and_three_agents(self):
-        moving = dict(
-            moving_box=dict(reliability=RNG.random(64)),
-            no_box=dict(reliability=np.ones(64)),
+        moving = MovingBoxResult(
             unreliable=[3, 9],
+            problems=[],
+            action_state=[],
+            action_goal=[],
+            planners=dict(
+                moving_box=PlanningRun(reliability=RNG.random(64), plans=[]),
+                no_box=PlanningRun(reliability=np.ones(64), plans=[]),
+            ),
         )
         figure = ch7_figures.MovingBoxFigure(moving)
-        self.assertPlots(figure, moving["moving_box"]["reliability"], "7.4.1")
+        self.assertPlots(figure, moving.planners["moving_box"].reliability, "7.4.1")
         self.assertReadable(figure, "7.4.1")
-        agents = dict(
+        agents = _ExplorationRun(
             agents=["right_arm", "left_arm", "torso"],
             tries=[RNG.integers(0, 9, 30) for _ in range(3)],
             actions=[10, 11, 12],
         )
         figure = ch7_figures.ThreeAgentsFigure(agents)
-        for axis, tries in zip(figure.axes, agents["tries"], strict=True):  # each agent's own
+        for axis, tries in zip(figure.axes, agents.tries, strict=True):  # each agent's own
             np.testing.assert_array_equal([bar.get_height() for bar in axis.patches], tries)
         self.assertReadable(figure, "7.4")
 

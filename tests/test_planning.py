@@ -361,7 +361,7 @@ class TestExperimentsSmoke(unittest.TestCase):
             result = json.loads(
                 (output / "runs" / f"7.2_{strategy}_run0" / "result.json").read_text()
             )
-            self.assertEqual(result["strategy"], strategy)
+            self.assertEqual(result["labels"]["strategy"], strategy)
             self.assertGreaterEqual(result["actions"][0], 3)  # the run's stop condition
             # The report's row holds the run's own numbers (issue 32: wrong numbers passed).
             transitions, tried = result["coverage"][-1]

@@ -3,7 +3,8 @@ the runs' results (:mod:`mobee_drake.experiments.ch7_model_learning`)."""
 
 import numpy as np
 
-from mobee_drake.experiments.ch7_model_learning import UNRELIABLE
+from mobee_drake.experiments.ch7_model_learning import UNRELIABLE, MovingBoxResult
+from mobee_drake.experiments.exploration import ExplorationRun
 from mobee_drake.experiments.plots import Figure, Legend, StackedBars, plt
 from mobee_drake.planning.state_space import Lattice
 
@@ -13,19 +14,19 @@ VALUE = "value V(s, a) [nats]"  # expected discounted KL reward (Alg. 6)
 STATE_ACTION = "state-action [index]"
 
 
-def HypercubeFigure(results: list[dict]) -> Figure:
+def HypercubeFigure(results: list[ExplorationRun]) -> Figure:
     """Fig. 7.2-7.3 on the hypercube: tries and values per state-action after 320 actions, one
     column per gamma, the runs stacked."""
-    gammas = sorted({r["gamma"] for r in results})
+    gammas = sorted({r.labels["gamma"] for r in results})
     figure, axes = plt.subplots(2, len(gammas), figsize=(6 * len(gammas), 6.5), squeeze=False)
     for column, gamma in enumerate(gammas):
-        mine = [r for r in results if r["gamma"] == gamma]
+        mine = [r for r in results if r.labels["gamma"] == gamma]
         for row, (key, unit) in enumerate((("tries", TRIES), ("values", VALUE))):
             axis = axes[row, column]
             StackedBars(
                 axis,
-                np.array([r["snapshots"]["320"][key] for r in mine]),
-                [f"run {r['run']}" for r in mine],
+                np.array([r.snapshots[320][key] for r in mine]),
+                [f"run {r.labels['run']}" for r in mine],
             )
             axis.set(
                 xlabel=STATE_ACTION,
@@ -36,22 +37,22 @@ def HypercubeFigure(results: list[dict]) -> Figure:
     return figure
 
 
-def CoverageFigure(results: list[dict]) -> Figure:
+def CoverageFigure(results: list[ExplorationRun]) -> Figure:
     """Fig. 7.5: state-actions tried against transitions, one line per run."""
     figure, axis = plt.subplots(figsize=(8, 4))
     for strategy, colour in zip(
         ("curious", "random", "least_tried"), ("tab:green", "tab:red", "tab:blue")
     ):
-        for r in [r for r in results if r["strategy"] == strategy]:
-            coverage = np.array(r["coverage"])
+        for r in [r for r in results if r.labels["strategy"] == strategy]:
+            coverage = np.array(r.coverage)
             axis.plot(
                 coverage[:, 0],
                 coverage[:, 1],
                 color=colour,
-                label=strategy if r["run"] == 0 else None,
+                label=strategy if r.labels["run"] == 0 else None,
             )
     axis.axhline(COVERAGE_STATE_ACTIONS, color="0.5", linestyle=":", label="all state-actions")
-    runs = len({r["run"] for r in results})
+    runs = len({r.labels["run"] for r in results})
     axis.set(
         xlabel="transitions [count]",
         ylabel=f"state-actions tried [count, of {COVERAGE_STATE_ACTIONS}]",
@@ -62,10 +63,10 @@ def CoverageFigure(results: list[dict]) -> Figure:
     return figure
 
 
-def Rank4Figure(r: dict, space: Lattice, never: np.ndarray) -> Figure:
+def Rank4Figure(r: ExplorationRun, space: Lattice, never: np.ndarray) -> Figure:
     """Fig. 7.8-7.9 on a rank-4 lattice: tries and values per state-action, coloured by their
     outcomes, and the actions taken from each state, the states never entered shaded."""
-    tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
+    tries, misses = np.array(r.tries[0]), np.array(r.misses[0])
     outcomes = {
         "several outcomes (>= 3 tries)": ("tab:red", (misses > 0) & (misses < 1) & (tries >= 3)),
         "never reaches its goal (>= 3 tries)": ("tab:orange", (misses == 1) & (tries >= 3)),
@@ -76,10 +77,10 @@ def Rank4Figure(r: dict, space: Lattice, never: np.ndarray) -> Figure:
     legend = {label: colour for label, (colour, _) in outcomes.items()}
     legend["reaches its goal, or tried < 3 times"] = "tab:blue"
     figure, axes = plt.subplots(3, 1, figsize=(13, 9))
-    caption = f"{r['lattice']} % lattice after {r['actions'][0]} actions"
+    caption = f"{r.labels['lattice']} % lattice after {r.actions[0]} actions"
     for axis, heights, unit, what in (
         (axes[0], tries, TRIES, "tries"),
-        (axes[1], r["values"][0], VALUE, "value"),
+        (axes[1], r.values[0], VALUE, "value"),
     ):
         axis.bar(np.arange(len(tries)), heights, width=1.0, color=colours)
         axis.set(xlabel=STATE_ACTION, ylabel=unit, title=f"{caption}: {what} per state-action")
@@ -97,18 +98,20 @@ def Rank4Figure(r: dict, space: Lattice, never: np.ndarray) -> Figure:
     return figure
 
 
-def InitializationFigure(results: list[dict], initialization: str) -> Figure:
+def InitializationFigure(results: list[ExplorationRun], initialization: str) -> Figure:
     """Fig. 7.6-7.7: tries and values per state-action after every state-action was tried 5
     times, one pair of rows per gamma, the runs stacked."""
-    mine = [r for r in results if r["initialization"] == initialization]
-    gammas = sorted({r["gamma"] for r in mine})
+    mine = [r for r in results if r.labels["initialization"] == initialization]
+    gammas = sorted({r.labels["gamma"] for r in mine})
     figure, axes = plt.subplots(2 * len(gammas), 1, figsize=(13, 5.2 * len(gammas)), squeeze=False)
     for row, gamma in enumerate(gammas):
-        runs = [r for r in mine if r["gamma"] == gamma]
+        runs = [r for r in mine if r.labels["gamma"] == gamma]
         for offset, (key, unit) in enumerate((("tries", TRIES), ("values", VALUE))):
             axis = axes[2 * row + offset, 0]
             StackedBars(
-                axis, np.array([r[key][0] for r in runs]), [f"run {r['run']}" for r in runs]
+                axis,
+                np.array([getattr(r, key)[0] for r in runs]),
+                [f"run {r.labels['run']}" for r in runs],
             )
             axis.set(
                 xlabel=STATE_ACTION,
@@ -119,16 +122,16 @@ def InitializationFigure(results: list[dict], initialization: str) -> Figure:
     return figure
 
 
-def MovingBoxFigure(results: dict) -> Figure:
+def MovingBoxFigure(results: MovingBoxResult) -> Figure:
     """Ch. 7.4.1: the share of tries reaching the goal per state-action, learned among the
     moving box and without it, the state-actions found unreliable shaded."""
     figure, axis = plt.subplots(figsize=(13, 4))
     for offset, (trained, label) in enumerate(
         (("moving_box", "learned among the moving box"), ("no_box", "learned without it"))
     ):
-        reliability = results[trained]["reliability"]
+        reliability = results.planners[trained].reliability
         axis.bar(np.arange(len(reliability)) + 0.4 * offset, reliability, width=0.4, label=label)
-    for sa in results["unreliable"]:
+    for sa in results.unreliable:
         axis.axvspan(sa - 0.3, sa + 0.7, color="red", alpha=0.15)
     axis.set(
         xlabel=STATE_ACTION,
@@ -140,17 +143,15 @@ def MovingBoxFigure(results: dict) -> Figure:
     return figure
 
 
-def ThreeAgentsFigure(results: dict) -> Figure:
+def ThreeAgentsFigure(results: ExplorationRun) -> Figure:
     """Fig. 7.10-7.12: each agent's tries per state-action, exploring together by a table."""
     figure, axes = plt.subplots(3, 1, figsize=(13, 9))
-    for axis, name, tries, actions in zip(
-        axes, results["agents"], results["tries"], results["actions"]
-    ):
+    for axis, name, tries, actions in zip(axes, results.agents, results.tries, results.actions):
         axis.bar(np.arange(len(tries)), tries, label=f"{name}, {actions} actions")
         axis.set(
             xlabel=STATE_ACTION,
             ylabel=TRIES,
-            title=f"7.4, three agents by a table ({sum(results['actions'])} transitions in "
+            title=f"7.4, three agents by a table ({sum(results.actions)} transitions in "
             f"all): {name}'s tries per state-action",
         )
         Legend(axis)

@@ -43,6 +43,7 @@ from mobee_drake.experiments.battery import (
     StopRequested,
 )
 from mobee_drake.experiments.exploration import (
+    ExplorationRun,
     ExplorationScenario,
     Explore,
     Misses,
@@ -109,7 +110,7 @@ def ExploreJob(
     learned models."""
     scenario = ExplorationScenario(agents, objects, random_seed=random_seed)
     scenario.world_events = list(world_events)
-    data = Explore(
+    explored = Explore(
         scenario,
         stop=stop,
         snapshots=snapshots,
@@ -119,20 +120,24 @@ def ExploreJob(
         progress=run.Progress,
         should_stop=StopRequested if keep_model else None,
     )
-    return dict(**labels, **data)
+    explored.labels = labels
+    return explored.ToJson()
 
 
 def _RightArm(levels, **kwargs) -> ExploringAgent:
     return ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=levels, **kwargs)
 
 
-def _Run(jobs: list[Job], output: pathlib.Path, backend: Backend, description: str) -> list:
-    return list(RunBattery(jobs, output, backend=backend, description=description).values())
+def _Run(
+    jobs: list[Job], output: pathlib.Path, backend: Backend, description: str
+) -> list[ExplorationRun]:
+    results = RunBattery(jobs, output, backend=backend, description=description)
+    return [ExplorationRun.FromJson(result) for result in results.values()]
 
 
 def RunHypercube(
     output: pathlib.Path, runs: int, backend: Backend, gammas=(0.5, 0.9, 0.99)
-) -> list[dict]:
+) -> list[ExplorationRun]:
     jobs = [
         Job(
             f"7.1_gamma{gamma}_run{run}",
@@ -152,7 +157,9 @@ def RunHypercube(
     return _Run(jobs, output, backend, "7.1")
 
 
-def RunCoverage(output: pathlib.Path, transitions: int, runs: int, backend: Backend) -> list[dict]:
+def RunCoverage(
+    output: pathlib.Path, transitions: int, runs: int, backend: Backend
+) -> list[ExplorationRun]:
     jobs = [
         Job(
             f"7.2_{strategy}_run{run}",
@@ -177,7 +184,7 @@ def RunCoverage(output: pathlib.Path, transitions: int, runs: int, backend: Back
 
 def RunInitializations(
     output: pathlib.Path, runs: int, backend: Backend, gammas=(0.5, 0.9, 0.99)
-) -> list[dict]:
+) -> list[ExplorationRun]:
     jobs = [
         Job(
             f"7.2i_{initialization}_gamma{gamma}_run{run}",
@@ -206,7 +213,9 @@ RANK_4_LATTICES = {"20-80": [0.2, 0.4, 0.6, 0.8], "12.5-87.5": [0.125, 0.375, 0.
 RANK_4_SOURCE_ACTIONS = {"20-80": 14597, "12.5-87.5": 26963}
 
 
-def RunRank4(output: pathlib.Path, transitions: int | None, backend: Backend) -> list[dict]:
+def RunRank4(
+    output: pathlib.Path, transitions: int | None, backend: Backend
+) -> list[ExplorationRun]:
     """Each rank-4 lattice for ``transitions`` actions (None: the source's number)."""
     jobs = []
     for name, levels in RANK_4_LATTICES.items():
@@ -227,7 +236,7 @@ def RunRank4(output: pathlib.Path, transitions: int | None, backend: Backend) ->
     return _Run(jobs, output, backend, "7.3")
 
 
-def RunThreeAgents(output: pathlib.Path, transitions: int, backend: Backend) -> dict:
+def RunThreeAgents(output: pathlib.Path, transitions: int, backend: Backend) -> ExplorationRun:
     rank_3 = [0.25, 0.5, 0.75]
     agents = [
         ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=rank_3, nearest=16),
@@ -277,7 +286,7 @@ def _TableContacts(simulation, period: float = 0.1):
             if touching & hands[agent]:
                 count[record.state_action] += 1
 
-    return Observe, lambda: dict(table_contacts=[c.tolist() for c in counts or []])
+    return Observe, lambda: [c.tolist() for c in counts or []]
 
 
 # Ch. 7.4.1 on the right arm's hypercube: a 20 cm box that jumps, at random times, into the arm's
@@ -338,6 +347,46 @@ def DetourProblems(space, unreliable: np.ndarray) -> list[tuple[int, int]]:
     return problems
 
 
+@dc.dataclass
+class PlanningRun:
+    """A learned model run as a planner among the moving box (ch. 7.4.1, :func:`PlanJob`).
+
+    Attributes:
+        reliability: Per state-action, the share of its tries that reached its goal (1 when
+            tried fewer than 5 times).
+        plans: Per problem, the greedy plan's states.
+        episodes: Per executed problem: ``start``, ``goal``, ``actions``, ``failed`` (failed
+            transitions) and ``tried`` (the state-actions tried).
+        simulated_seconds: Simulated time of the executions.
+        penetrating_steps: Control periods in which two solids penetrated.
+    """
+
+    reliability: list[float]
+    plans: list[list[int]]
+    episodes: list[dict] = dc.field(default_factory=list)
+    simulated_seconds: float = 0.0
+    penetrating_steps: int = 0
+
+
+@dc.dataclass
+class MovingBoxResult:
+    """Ch. 7.4.1: the problems and the planners (:func:`RunDynamicPlanning`).
+
+    Attributes:
+        unreliable: The state-actions unreliable as the moving box's agent learned them.
+        problems: (start, goal) with one risky and one safe shortest route.
+        action_state: Each state-action's state.
+        action_goal: Each state-action's goal state.
+        planners: Per training ("moving_box", "no_box"), its model's planning run.
+    """
+
+    unreliable: list[int]
+    problems: list[tuple[int, int]]
+    action_state: list[int]
+    action_goal: list[int]
+    planners: dict[str, PlanningRun]
+
+
 def _Plan(model: pathlib.Path, problems, repeats: int, seed: int) -> dict:
     """The learned model in ``model`` as a planner among the moving box: for each problem, go to
     its start, then plan to its goal and execute; counts actions and failed transitions."""
@@ -391,22 +440,20 @@ def _Plan(model: pathlib.Path, problems, repeats: int, seed: int) -> dict:
 
 
 def PlanJob(run: RunFolder, *, model: str, problems: list, repeats: int, seed: int) -> dict:
-    """The battery job of ch. 7.4.1's planning with one learned model (see :func:`_Plan`)."""
+    """The battery job of ch. 7.4.1's planning with one learned model: its
+    :class:`PlanningRun` as written (see :func:`_Plan`)."""
     explorer = LoadAgentModel(model, "right_arm", ExplorerConfig())
-    return dict(
+    planned = PlanningRun(
         reliability=_Reliability(explorer).tolist(),
         plans=[GreedyPlan(explorer, start, goal) for start, goal in problems],
-        **(
-            _Plan(pathlib.Path(model), problems, repeats, seed=seed)
-            if problems
-            else dict(episodes=[])
-        ),
+        **(_Plan(pathlib.Path(model), problems, repeats, seed=seed) if problems else {}),
     )
+    return dc.asdict(planned)
 
 
 def RunDynamicPlanning(
     output: pathlib.Path, transitions: int, repeats: int, backend: Backend
-) -> dict:
+) -> MovingBoxResult:
     """Ch. 7.4.1: a curious agent trained among the moving box and one trained without it, each
     turned into a planner (reward on a goal) and run among the moving box on the problems with a
     risky and a safe shortest route (risky as the first agent learned it)."""
@@ -450,12 +497,6 @@ def RunDynamicPlanning(
     space = learned["moving_box"].space
     unreliable = _Reliability(learned["moving_box"]) < UNRELIABLE
     problems = DetourProblems(space, unreliable)
-    results = dict(
-        unreliable=np.flatnonzero(unreliable).tolist(),
-        problems=problems,
-        action_state=space.action_state.tolist(),
-        action_goal=space.action_goal.tolist(),
-    )
     jobs = [
         Job(
             f"7.4.1_plans_{trained}_{transitions}_{repeats}",
@@ -464,5 +505,14 @@ def RunDynamicPlanning(
         )
         for trained in learned
     ]
-    plans = _Run(jobs, output, backend, "7.4.1 planning")
-    return dict(results, **dict(zip(learned, plans)))
+    plans = RunBattery(jobs, output, backend=backend, description="7.4.1 planning")
+    return MovingBoxResult(
+        unreliable=np.flatnonzero(unreliable).tolist(),
+        problems=problems,
+        action_state=space.action_state.tolist(),
+        action_goal=space.action_goal.tolist(),
+        planners={
+            trained: PlanningRun(**planned)
+            for trained, planned in zip(learned, plans.values(), strict=True)
+        },
+    )

@@ -17,7 +17,8 @@ from mobee_drake.experiments.ch7_figures import (
     Rank4Figure,
     ThreeAgentsFigure,
 )
-from mobee_drake.experiments.ch7_model_learning import RIGHT_ARM, UNRELIABLE
+from mobee_drake.experiments.ch7_model_learning import RIGHT_ARM, UNRELIABLE, MovingBoxResult
+from mobee_drake.experiments.exploration import ExplorationRun
 from mobee_drake.experiments.plots import SaveFigure
 from mobee_drake.mobee.constraints import ClauseSet
 from mobee_drake.planning.state_space import Lattice
@@ -42,18 +43,18 @@ def _ConstraintClearances(centres: np.ndarray) -> np.ndarray:
     )
 
 
-def _HypercubeReport(output: pathlib.Path, results) -> list[str]:
+def _HypercubeReport(output: pathlib.Path, results: list[ExplorationRun]) -> list[str]:
     """The hypercube of ch. 7.1: tries and values after 320 actions, per gamma."""
     lines = []
     SaveFigure(HypercubeFigure(results), output / "7.1_hypercube.png")
-    for gamma in sorted({r["gamma"] for r in results}):
-        mine = [r for r in results if r["gamma"] == gamma]
-        tries = np.array([r["snapshots"]["320"]["tries"] for r in mine])
-        values = np.array([r["snapshots"]["320"]["values"] for r in mine])
+    for gamma in sorted({r.labels["gamma"] for r in results}):
+        mine = [r for r in results if r.labels["gamma"] == gamma]
+        tries = np.array([r.snapshots[320]["tries"] for r in mine])
+        values = np.array([r.snapshots[320]["values"] for r in mine])
         lines.append(
             f"| {gamma} | {len(mine)} | {tries.mean():.2f} | "
             f"{tries.std(axis=1).mean():.2f} | {values.mean():.4f} | "
-            f"{np.mean([r['wall_seconds'] for r in mine]):.1f} |"
+            f"{np.mean([r.wall_seconds for r in mine]):.1f} |"
         )
     header = [
         "| gamma | runs | mean tries per state-action after 320 actions | "
@@ -64,16 +65,16 @@ def _HypercubeReport(output: pathlib.Path, results) -> list[str]:
     return header + lines
 
 
-def _CoverageReport(output: pathlib.Path, results) -> list[str]:
+def _CoverageReport(output: pathlib.Path, results: list[ExplorationRun]) -> list[str]:
     """Coverage (ch. 7.2): transitions until every state-action was tried."""
     lines = []
     SaveFigure(CoverageFigure(results), output / "7.2_coverage.png")
     for strategy in ("curious", "random", "least_tried"):
-        for r in [r for r in results if r["strategy"] == strategy]:
-            coverage = np.array(r["coverage"])
+        for r in [r for r in results if r.labels["strategy"] == strategy]:
+            coverage = np.array(r.coverage)
             full = coverage[coverage[:, 1] >= COVERAGE_STATE_ACTIONS, 0]
             lines.append(
-                f"| {strategy} | {r['run']} | {coverage[-1, 0]} | "
+                f"| {strategy} | {r.labels['run']} | {coverage[-1, 0]} | "
                 f"{coverage[-1, 1]} | {full[0] if len(full) else '-'} |"
             )
     return [
@@ -82,7 +83,7 @@ def _CoverageReport(output: pathlib.Path, results) -> list[str]:
     ] + lines
 
 
-def _Rank4Report(output: pathlib.Path, results) -> list[str]:
+def _Rank4Report(output: pathlib.Path, results: list[ExplorationRun]) -> list[str]:
     """The rank-4 lattices (ch. 7.3): states never entered, several outcomes."""
     lines = []
     header = [
@@ -93,8 +94,8 @@ def _Rank4Report(output: pathlib.Path, results) -> list[str]:
         "|---|---:|---|---:|---|",
     ]
     for r in results:
-        space = Lattice(r["levels"], 4)
-        tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
+        space = Lattice(r.labels["levels"], 4)
+        tries, misses = np.array(r.tries[0]), np.array(r.misses[0])
         entered = np.zeros(space.num_states, dtype=bool)
         entered[space.action_state[tries > 0]] = True  # an action was tried from it
         never = np.flatnonzero(~entered)
@@ -103,16 +104,16 @@ def _Rank4Report(output: pathlib.Path, results) -> list[str]:
         several = int(np.sum((misses > 0) & (misses < 1) & (tries >= 3)))
         top = int(np.argmax(tries))
         lines.append(
-            f"| {r['lattice']} | {r['actions'][0]} | {len(never)}: "
+            f"| {r.labels['lattice']} | {r.actions[0]} | {len(never)}: "
             f"{', '.join(clearances) or '-'} | {several} | "
             f"{space.action_state[top]}->{space.action_goal[top]}: {tries[top]}, "
             f"{100 * (1 - misses[top]):.0f} % |"
         )
-        SaveFigure(Rank4Figure(r, space, never), output / f"7.3_{r['lattice']}.png")
+        SaveFigure(Rank4Figure(r, space, never), output / f"7.3_{r.labels['lattice']}.png")
     return header + lines
 
 
-def _InitializationReport(output: pathlib.Path, results) -> list[str]:
+def _InitializationReport(output: pathlib.Path, results: list[ExplorationRun]) -> list[str]:
     """The initialisations (ch. 7.2): state-actions that miss their goal."""
     lines = []
     space = Lattice([0.25, 0.5, 0.75], 4)
@@ -126,11 +127,11 @@ def _InitializationReport(output: pathlib.Path, results) -> list[str]:
             InitializationFigure(results, initialization),
             output / f"7.2i_{initialization}.png",
         )
-        for gamma in sorted({r["gamma"] for r in results}):
+        for gamma in sorted({r.labels["gamma"] for r in results}):
             for r in results:
-                if r["initialization"] != initialization or r["gamma"] != gamma:
+                if r.labels["initialization"] != initialization or r.labels["gamma"] != gamma:
                     continue
-                tries, misses = np.array(r["tries"][0]), np.array(r["misses"][0])
+                tries, misses = np.array(r.tries[0]), np.array(r.misses[0])
                 unreliable = np.flatnonzero((misses > 0.1) & (tries >= 3))
                 listed = ", ".join(
                     f"{space.action_state[i]}->{space.action_goal[i]}: "
@@ -138,23 +139,23 @@ def _InitializationReport(output: pathlib.Path, results) -> list[str]:
                     for i in unreliable
                 )
                 lines.append(
-                    f"| {initialization} | {gamma} | {r['run']} | "
-                    f"{r['actions'][0]} | {listed or '-'} |"
+                    f"| {initialization} | {gamma} | {r.labels['run']} | "
+                    f"{r.actions[0]} | {listed or '-'} |"
                 )
     return header + lines
 
 
-def _MovingBoxReport(output: pathlib.Path, results) -> list[str]:
+def _MovingBoxReport(output: pathlib.Path, results: MovingBoxResult) -> list[str]:
     """The moving box (ch. 7.4.1): plans and executions over risky steps."""
     lines = []
     SaveFigure(MovingBoxFigure(results), output / "7.4.1_moving_box.png")
-    unreliable = np.array(results["unreliable"], dtype=int)
-    risky = {(results["action_state"][sa], results["action_goal"][sa]) for sa in unreliable}
+    unreliable = np.array(results.unreliable, dtype=int)
+    risky = {(results.action_state[sa], results.action_goal[sa]) for sa in unreliable}
     header = [
         f"- unreliable state-actions learned among the moving box (reached their goal "
         f"in < {UNRELIABLE:.0%} of >= 5 tries), state -> goal: "
         + (", ".join(f"{s_}->{g}" for s_, g in sorted(risky)) or "none"),
-        f"- problems with one risky and one safe shortest route: {len(results['problems'])}",
+        f"- problems with one risky and one safe shortest route: {len(results.problems)}",
         "",
         "| trained | greedy plans over a risky step | executed problems | actions per "
         "problem | failed transitions per problem | problems that tried a risky "
@@ -162,34 +163,32 @@ def _MovingBoxReport(output: pathlib.Path, results) -> list[str]:
         "|---|---:|---:|---:|---:|---:|---:|",
     ]
     for trained in ("moving_box", "no_box"):
-        r = results[trained]
-        crossing = sum(any(step in risky for step in zip(path, path[1:])) for path in r["plans"])
-        episodes = r["episodes"] or [dict(actions=0, failed=0, tried=[])]
+        r = results.planners[trained]
+        crossing = sum(any(step in risky for step in zip(path, path[1:])) for path in r.plans)
+        episodes = r.episodes or [dict(actions=0, failed=0, tried=[])]
         lines.append(
-            f"| {trained} | {crossing} of {len(r['plans'])} | {len(r['episodes'])} | "
+            f"| {trained} | {crossing} of {len(r.plans)} | {len(r.episodes)} | "
             f"{np.mean([e['actions'] for e in episodes]):.2f} | "
             f"{np.mean([e['failed'] for e in episodes]):.2f} | "
             f"{np.mean([bool(set(e['tried']) & set(unreliable)) for e in episodes]):.0%} | "
-            f"{r.get('penetrating_steps', 0)} |"
+            f"{r.penetrating_steps} |"
         )
     return header + lines
 
 
-def _ThreeAgentsReport(output: pathlib.Path, results) -> list[str]:
+def _ThreeAgentsReport(output: pathlib.Path, results: ExplorationRun) -> list[str]:
     """Three agents (ch. 7.4): tries, contacts and surprises per agent."""
     SaveFigure(ThreeAgentsFigure(results), output / "7.4_three_agents.png")
-    right, left = (np.array(t, dtype=float) for t in results["tries"][:2])
+    right, left = (np.array(t, dtype=float) for t in results.tries[:2])
     correlation = float(np.corrcoef(right, left)[0, 1])
     lines = [
-        f"- transitions: {sum(results['actions'])} ({results['actions']} per agent), "
-        f"{results['simulated_seconds']:.0f} s simulated in {results['wall_seconds']:.0f} s "
+        f"- transitions: {sum(results.actions)} ({results.actions} per agent), "
+        f"{results.simulated_seconds:.0f} s simulated in {results.wall_seconds:.0f} s "
         f"wall",
         f"- correlation of the right and the left arm's tries per state-action: {correlation:.3f}",
-        f"- penetrating control periods: {results['penetrating_steps']}",
+        f"- penetrating control periods: {results.penetrating_steps}",
     ]
-    for name, tries, contacts in zip(
-        results["agents"], results["tries"], results.get("table_contacts", [])
-    ):
+    for name, tries, contacts in zip(results.agents, results.tries, results.table_contacts or []):
         tries, contacts = np.array(tries), np.array(contacts)
         top = np.argsort(tries)[::-1][:20]
         # Undefined when either is constant (e.g. no contact at all in a short run).
@@ -205,7 +204,7 @@ def _ThreeAgentsReport(output: pathlib.Path, results) -> list[str]:
             f"{int((contacts > 0).sum())} of {len(tries)}"
         )
     for name, tries, misses, goals in zip(
-        results["agents"], results["tries"], results["misses"], results["goals"]
+        results.agents, results.tries, results.misses, results.goals
     ):
         tries, misses, goals = np.array(tries), np.array(misses), np.array(goals)
         top = np.argsort(tries)[::-1][:20]

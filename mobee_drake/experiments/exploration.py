@@ -1,6 +1,7 @@
 """Exploring agents on the kinematic iCub, run until a stop condition: the shared step of the
 ch. 7 experiments and of the MDP the ch. 8 reach learner starts from."""
 
+import dataclasses
 import pathlib
 import time
 
@@ -15,6 +16,54 @@ from mobee_drake.scenario import BuildScenario, ResumableConfiguration, Scenario
 from mobee_drake.station.checkpoint import HasCheckpoint, LoadCheckpoint, SaveCheckpoint
 from mobee_drake.station.runner import Advance
 from mobee_drake.station.world_events import MakeSimulator
+
+
+@dataclasses.dataclass
+class ExplorationRun:
+    """What an exploration run did (:func:`Explore`); per-agent lists follow ``agents``.
+
+    Attributes:
+        agents: The agents' names.
+        tries: Per agent, the tries of each state-action.
+        values: Per agent, each state-action's value V(s, a) at the end.
+        misses: Per agent, the share of each state-action's tries that missed its goal.
+        goals: Per agent, the centre of each state-action's goal state (fractions of the
+            joints' ranges).
+        actions: Per agent, the actions it completed.
+        snapshots: The first agent's ``tries`` and ``values`` once it had done the key's
+            number of actions.
+        coverage: After every chunk: the actions done by all, then per agent its state-actions
+            tried at least once.
+        simulated_seconds: Simulated time at the end.
+        wall_seconds: Wall time of the run (since it resumed).
+        penetrating_steps: Control periods in which two solids penetrated.
+        labels: The experiment's setting of the run (e.g. ``gamma`` and ``run``).
+        table_contacts: Ch. 7.4 only: per agent, the contact samples of each state-action.
+    """
+
+    agents: list[str]
+    tries: list[list[int]]
+    values: list[list[float]]
+    misses: list[list[float]]
+    goals: list[list[list[float]]]
+    actions: list[int]
+    snapshots: dict[int, dict[str, list]]
+    coverage: list[list[int]]
+    simulated_seconds: float
+    wall_seconds: float
+    penetrating_steps: int
+    labels: dict = dataclasses.field(default_factory=dict)
+    table_contacts: list[list[int]] | None = None
+
+    def ToJson(self) -> dict:
+        """The run as a battery job's result."""
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def FromJson(cls, data: dict) -> "ExplorationRun":
+        """A run as read back from a job's result (JSON keys are strings)."""
+        snapshots = {int(count): taken for count, taken in data["snapshots"].items()}
+        return cls(**dict(data, snapshots=snapshots))
 
 
 def ExplorationScenario(
@@ -67,14 +116,14 @@ def Explore(
     observer=None,
     progress=None,
     should_stop=None,
-) -> dict:
-    """Runs until ``stop(records)``; returns per-agent tries (and values at ``snapshots``).
+) -> ExplorationRun:
+    """Runs until ``stop(records)``; returns what the agents learned and did.
 
     With ``checkpoint`` (a checkpoint folder), the run resumes from the checkpoint there, saves
     one after every chunk in which an action was completed, and keeps the final one (the learned
     models, for a planner to reuse); the data returned then covers the run since it resumed.
     ``observer(station)``, if given, returns a callable run on the root context after every
-    chunk of the simulation and a function giving its data for the result; ``progress(n)``, if
+    chunk of the simulation and a function giving the run's ``table_contacts``; ``progress(n)``, if
     given, is told the number of actions done after every chunk; ``should_stop()``, if given, is
     asked after every chunk, and when True the run saves its checkpoint (if it has one) and raises
     :class:`~mobee_drake.experiments.battery.JobStopped`."""
@@ -83,7 +132,7 @@ def Explore(
     configuration = ResumableConfiguration(scenario) if checkpoint is not None else ""
     records = supervisor.Records(supervisor_context)
     saved = sum(r.actions_done for r in records)
-    observe, observed = observer(station) if observer else (None, dict)
+    observe, observed = observer(station) if observer else (None, lambda: None)
     taken, coverage, start = {}, [], time.perf_counter()
     while not stop(records):  # (A resumed run that was done stops at once.)
         Advance(station, simulator, context.get_time() + chunk, after_chunk=observe)
@@ -108,7 +157,7 @@ def Explore(
     if checkpoint is not None and not HasCheckpoint(checkpoint):  # (No action was completed.)
         SaveCheckpoint(station, context, checkpoint, configuration)
     report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
-    return dict(
+    return ExplorationRun(
         agents=supervisor.agent_names,
         tries=[r.explorer.tries.tolist() for r in records],
         values=[r.explorer.Values()[0].tolist() for r in records],
@@ -120,5 +169,5 @@ def Explore(
         simulated_seconds=context.get_time(),
         wall_seconds=time.perf_counter() - start,
         penetrating_steps=report.penetrating_steps,
-        **observed(),
+        table_contacts=observed(),
     )
