@@ -13,7 +13,9 @@ import unittest
 import numpy as np
 
 from mobee_drake import cli
-from mobee_drake.experiments import bench_reactive as bench
+from mobee_drake.experiments import reactive_controllers, reactive_tasks
+from mobee_drake.experiments import reactive_report as report
+from mobee_drake.experiments import reactive_runs as runs
 from mobee_drake.experiments.plots import SaveFigure
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.world.objects import Sphere
@@ -28,9 +30,9 @@ def _SegmentDistance(point, a, b) -> float:
 class TestTasks(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.scene = bench.TaskScene()
+        cls.scene = reactive_tasks.TaskScene()
         # random 0 and 2: one ball; random 1: two balls.
-        cls.tasks = [bench.RandomTask(i, 0, cls.scene) for i in range(3)]
+        cls.tasks = [reactive_tasks.RandomTask(i, 0, cls.scene) for i in range(3)]
 
     def test_balls_lie_on_the_straight_palm_path_and_clear_of_both_ends(self):
         scene = self.scene
@@ -41,7 +43,7 @@ class TestTasks(unittest.TestCase):
                 for ball in balls:
                     center = np.array(ball.position)
                     self.assertLess(_SegmentDistance(center, task.start_palm, task.goal_palm), 1e-9)
-                    low, high = bench.BALL_DIAMETER
+                    low, high = reactive_tasks.BALL_DIAMETER
                     self.assertTrue(low <= 2 * ball.shape.radius <= high)
                 # The robot's solids, posed at both ends among the task's objects.
                 scene.SetObjects(task.objects)
@@ -50,13 +52,15 @@ class TestTasks(unittest.TestCase):
                     np.testing.assert_allclose(scene.Palm(), palm, atol=1e-12)
                     closest = scene.Clearances()
                     for ball in balls:
-                        self.assertGreaterEqual(closest.get(ball.name, np.inf), bench.CLEAR)
+                        self.assertGreaterEqual(
+                            closest.get(ball.name, np.inf), reactive_tasks.CLEAR
+                        )
                 scene.SetObjects([])
 
     def test_goals_keep_the_constraints_and_out_of_every_field(self):
         params, mobee = MobeeParams(), self.scene.mobee
         lower, upper = mobee.position_limits
-        moved = [self.scene.joints.index(j) for j in bench.GOAL_JOINTS]
+        moved = [self.scene.joints.index(j) for j in reactive_tasks.GOAL_JOINTS]
         for task in self.tasks:
             with self.subTest(task.name):
                 still = np.setdiff1d(np.arange(len(task.goal)), moved)
@@ -72,16 +76,16 @@ class TestTasks(unittest.TestCase):
 
 class TestShortRun(unittest.TestCase):
     def test_two_tasks_figures_agree(self):
-        scene = bench.TaskScene()
-        tasks = bench.MakeTasks(2, 0, scene, shipped=False)
-        controllers = bench.Controllers()
+        scene = reactive_tasks.TaskScene()
+        tasks = reactive_tasks.MakeTasks(2, 0, scene, shipped=False)
+        controllers = reactive_controllers.Controllers()
         horizon, early = 3.0, 1.5
-        results = bench.RunBenchmark(tasks, controllers, horizon, scene)
+        results = runs.RunBenchmark(tasks, controllers, horizon, scene)
         summaries = {
-            name: bench.Summarize(controllers[name].label, rows, early)
+            name: runs.Summarize(controllers[name].label, rows, early)
             for name, rows in results.items()
         }
-        steps = round(horizon / bench.PERIOD)
+        steps = round(horizon / reactive_tasks.PERIOD)
         for name, summary in summaries.items():
             with self.subTest(name):
                 self.assertEqual(summary.tasks, len(tasks))
@@ -92,32 +96,36 @@ class TestShortRun(unittest.TestCase):
                     self.assertEqual(len(r.palm_error), steps + 1)
                     self.assertEqual(len(r.step_seconds), steps)
                     if r.reached_at is not None:
-                        self.assertLess(r.palm_error[round(r.reached_at / bench.PERIOD)], 0.02)
+                        self.assertLess(
+                            r.palm_error[round(r.reached_at / reactive_tasks.PERIOD)], 0.02
+                        )
                         self.assertTrue(
-                            np.all(r.palm_error[: round(r.reached_at / bench.PERIOD)] >= 0.02)
+                            np.all(
+                                r.palm_error[: round(r.reached_at / reactive_tasks.PERIOD)] >= 0.02
+                            )
                         )
         mobee = summaries["mobee"]
         self.assertEqual(mobee.penetrating_steps, 0)
         self.assertEqual(mobee.violating_tasks, 0)
         # DiffIK's speed limits, kept (to within OSQP's accuracy: 0.1-0.2 %).
         for name, limit in (
-            ("diffik_1cm", bench.SPEED_LIMIT),
-            ("diffik_field", bench.SPEED_LIMIT),
-            ("diffik_fast", bench.MOBEE_SPEED_CAP),
+            ("diffik_1cm", reactive_controllers.SPEED_LIMIT),
+            ("diffik_field", reactive_controllers.SPEED_LIMIT),
+            ("diffik_fast", reactive_controllers.MOBEE_SPEED_CAP),
         ):
             self.assertLessEqual(summaries[name].peak_speed, limit * 1.002)
         # DiffIK keeps its safety distance (to within what one period can close).
         self.assertGreater(summaries["diffik_field"].obstacle_clearance, 0.02)
-        table = bench.Table(list(summaries.values()), horizon, early)
+        table = report.Table(list(summaries.values()), horizon, early)
         rows = table.splitlines()[2:]
-        self.assertEqual(len(rows), len(bench.CONTROLLERS))
+        self.assertEqual(len(rows), len(reactive_controllers.CONTROLLERS))
         for row, summary in zip(rows, summaries.values(), strict=True):
             cells = [cell.strip() for cell in row.strip("|").split("|")]
             self.assertEqual(cells[0], summary.label)
             self.assertEqual(cells[1], f"{summary.reached_early}/2")
             self.assertEqual(cells[2], f"{summary.reached}/2")
-        self.assertEqual(len(bench.DetailRows(results)), 2 * len(bench.CONTROLLERS))
-        figure = bench.ReactiveFigure(results, {n: c.label for n, c in controllers.items()}, 3.0)
+        self.assertEqual(len(report.DetailRows(results)), 2 * len(reactive_controllers.CONTROLLERS))
+        figure = report.ReactiveFigure(results, {n: c.label for n, c in controllers.items()}, 3.0)
         for axis in figure.axes:
             self.assertTrue(axis.get_xlabel() and axis.get_ylabel() and axis.get_title())
             self.assertIsNotNone(axis.get_legend())
@@ -131,14 +139,14 @@ class TestStallsOfTheBenchmark(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        cls.scene = bench.TaskScene()
+        cls.scene = reactive_tasks.TaskScene()
 
-    def Run(self, index: int, controller: str) -> bench.RunResult:
-        task = bench.RandomTask(index, 0, self.scene)
-        run = bench.Controllers()[controller].run(task, bench.EARLY)
-        return bench.MeasureRun(self.scene, task, run, controller)
+    def Run(self, index: int, controller: str) -> runs.RunResult:
+        task = reactive_tasks.RandomTask(index, 0, self.scene)
+        run = reactive_controllers.Controllers()[controller].run(task, runs.EARLY)
+        return runs.MeasureRun(self.scene, task, run, controller)
 
-    def CheckReached(self, result: bench.RunResult) -> None:
+    def CheckReached(self, result: runs.RunResult) -> None:
         self.assertIsNotNone(result.reached_at, result.task)
         self.assertEqual(result.penetrating_steps, 0)
         self.assertEqual(result.violating_steps, 0)
@@ -169,7 +177,7 @@ class TestCommand(unittest.TestCase):
             self.assertGreater(plot.stat().st_size, 1000)
         text = out.getvalue()
         self.assertIn("| MoBeE (defaults), palm goal | 0/1 | 0/1 |", text)
-        self.assertIn(f"mobee,{bench.SHIPPED},shipped,", text)
+        self.assertIn(f"mobee,{reactive_tasks.SHIPPED},shipped,", text)
 
     def test_every_option_says_its_default(self):
         out = io.StringIO()
@@ -182,7 +190,7 @@ class TestCommand(unittest.TestCase):
                 self.assertIn("(default:", entry, entry.split()[0])
 
     def test_equal_clearance_is_the_field_margin(self):
-        self.assertTrue(math.isclose(bench.FieldMargin(), 0.03))
+        self.assertTrue(math.isclose(reactive_controllers.FieldMargin(), 0.03))
 
 
 if __name__ == "__main__":
