@@ -405,6 +405,46 @@ def _AddSafetyMonitor(
     return monitor
 
 
+def _ExportOutputs(builder: DiagramBuilder, mobee, robot_state, attractor) -> None:
+    """The station's outputs for scripts and clients beyond the diagram."""
+    for port, name in (
+        (robot_state, "robot_state"),
+        (attractor, "attractor"),
+        (mobee.GetOutputPort("marker_positions"), "marker_positions"),
+        (mobee.GetOutputPort("field_pairs"), "field_pairs"),
+    ):
+        builder.ExportOutput(port, name)
+
+
+def _AddRecords(builder, config, mobee, robot_state, attractor, client, companion_ports):
+    """What records the run: the world-event ledger of the clients' requests and the scripted
+    events, and the data log (when enabled). Returns the request ports, the ledger, the scripted
+    events in time order and the data log (or None)."""
+    # (The companions' first: they were built first, and the ledger counts in this order.)
+    request_ports = [
+        port for ports in [*companion_ports, client] if ports for port in ports.world_events
+    ]
+    event_ledger = builder.AddNamedSystem(
+        "world_event_ledger", WorldEventLedger(num_request_ports=len(request_ports))
+    )
+    scripted_events = sorted(config.world_events, key=lambda e: e.time)
+    data_log = None
+    if config.data_log.enabled:
+        data_log = AddDataLog(
+            builder,
+            config=config.data_log,
+            time_step=config.time_step,
+            mobee=mobee,
+            robot_state=robot_state,
+            attractor=attractor,
+            event_counts=event_ledger.GetOutputPort("counts"),
+            scripted_events=scripted_events,
+            request_ports=request_ports,
+            client=client.data_log if client is not None else None,
+        )
+    return request_ports, event_ledger, scripted_events, data_log
+
+
 def MakeMobeeStation(
     config: StationConfig, meshcat: Meshcat | None = None, *, prebuild_callback=None
 ) -> Station:
@@ -461,36 +501,10 @@ def MakeMobeeStation(
             attractor=attractor,
             marker_forces=marker_forces,
         )
-    # (The companions' first: they were built first, and the ledger counts in this order.)
-    request_ports = [
-        port for ports in [*companion_ports, client] if ports for port in ports.world_events
-    ]
-    event_ledger = builder.AddNamedSystem(
-        "world_event_ledger", WorldEventLedger(num_request_ports=len(request_ports))
+    request_ports, event_ledger, scripted_events, data_log = _AddRecords(
+        builder, config, mobee, robot_state, attractor, client, companion_ports
     )
-    scripted_events = sorted(config.world_events, key=lambda e: e.time)
-    data_log = None
-    if config.data_log.enabled:
-        data_log = AddDataLog(
-            builder,
-            config=config.data_log,
-            time_step=config.time_step,
-            mobee=mobee,
-            robot_state=robot_state,
-            attractor=attractor,
-            event_counts=event_ledger.GetOutputPort("counts"),
-            scripted_events=scripted_events,
-            request_ports=request_ports,
-            client=client.data_log if client is not None else None,
-        )
-    for port, name in (
-        (robot_state, "robot_state"),
-        (attractor, "attractor"),
-        (mobee.GetOutputPort("marker_positions"), "marker_positions"),
-        (mobee.GetOutputPort("field_pairs"), "field_pairs"),
-    ):
-        builder.ExportOutput(port, name)
-
+    _ExportOutputs(builder, mobee, robot_state, attractor)
     WarnOfUndeclaredHooks(builder.GetSystems(), [client, *companion_ports])
     diagram = builder.Build()
     diagram.set_name("mobee_station")
