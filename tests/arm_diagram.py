@@ -20,9 +20,16 @@ JOINTS = ["joint1", "joint2", "joint3"]
 class ArmDiagram:
     """The arm, optional fixed boxes and MoBeE, with the plant's positions set by the test."""
 
-    def __init__(self, boxes=(), params=None, joints=JOINTS, couplings=(), step=None):
+    def __init__(
+        self, boxes=(), params=None, joints=JOINTS, couplings=(), step=None, boxes_first=False
+    ):
+        """``boxes_first`` registers the boxes before the robot (lower GeometryIds: SceneGraph
+        then reports each box-robot pair with the box as its A)."""
         builder = DiagramBuilder()
         self.plant, scene_graph = AddMultibodyPlantSceneGraph(builder, 0.0)
+        world = LiveWorld(self.plant, scene_graph)
+        if boxes_first:
+            self._Register(world, boxes)
         self.robot = AddRobotWithOverlay(
             self.plant,
             scene_graph,
@@ -31,11 +38,8 @@ class ArmDiagram:
             controlled_joints=joints,
             couplings=couplings,
         )
-        world = LiveWorld(self.plant, scene_graph)
-        for i, (size, center) in enumerate(boxes):
-            world.Register(
-                SceneObject(name=f"box{i}", shape=Box(size=list(size)), position=list(center))
-            )
+        if not boxes_first:
+            self._Register(world, boxes)
         self.plant.Finalize()
         self.params = params or MobeeParams()
         self.dut = Mobee.AddToBuilder(
@@ -51,6 +55,13 @@ class ArmDiagram:
         self.root_context = self.diagram.CreateDefaultContext()
         self.context = self.dut.GetMyMutableContextFromRoot(self.root_context)
         self.plant_context = self.plant.GetMyMutableContextFromRoot(self.root_context)
+
+    @staticmethod
+    def _Register(world, boxes):
+        for i, (size, center) in enumerate(boxes):
+            world.Register(
+                SceneObject(name=f"box{i}", shape=Box(size=list(size)), position=list(center))
+            )
 
     def Set(self, q, v=(0.0, 0.0, 0.0)):
         self.plant.SetPositions(self.plant_context, np.asarray(q, dtype=float))

@@ -5,6 +5,7 @@ import unittest
 import numpy as np
 
 from mobee_drake.mobee.constraints import ClauseSet
+from mobee_drake.robots.couplings import JointCoupling
 from mobee_drake.robots.overlay import Clause, Literal
 
 JOINTS = ["a", "b", "c"]
@@ -107,6 +108,41 @@ class TestClauses(unittest.TestCase):
         )
         with self.assertRaisesRegex(ValueError, "'mixed'.*'z'"):
             ClauseSet([mixed], JOINTS)
+
+    def test_a_follower_in_a_literal_becomes_its_leader_times_the_ratio_plus_the_offset(self):
+        """With f following b as f = -0.5 b + 0.2 rad, the literal a + b + f >= 20 deg is
+        a + 0.5 b + 0.2 rad - 20 deg >= 0, of normal (1, 0.5, 0) / sqrt(1.25)."""
+        coupling = JointCoupling(follower="f", leader="b", ratio=-0.5, offset=0.2)
+        literal = Literal(coefficients={"a": 1.0, "b": 1.0, "f": 1.0}, offset=-20.0)
+        clauses = ClauseSet([Clause("x", [literal])], JOINTS, followers=[coupling])
+        q = np.radians([10.0, 12.0, 0.0])
+        g = (q[0] + 0.5 * q[1] + 0.2 - np.radians(20.0)) / np.sqrt(1.25)
+        np.testing.assert_allclose(clauses.Clearances(q), [g])
+        normal = np.array([1.0, 0.5, 0.0]) / np.sqrt(1.25)
+        np.testing.assert_allclose(
+            clauses.Force(q, DELTA, F_MAX), F_MAX * (DELTA - g) / DELTA * normal
+        )
+
+    def test_violation_sums_each_violated_clauses_least_violated_literal(self):
+        """For a >= 0 AND (b >= 0 OR c >= 0) AND c >= 10 at (-5, -3, -8) deg the clauses miss
+        by 5, min(3, 8) and 18 deg; with b at 2 deg the disjunction holds and adds nothing."""
+        clauses = ClauseSet(
+            [Clause("a", [L1]), Clause("bc", [L2, L3]), Clause("c", [_Literal("c", 10)])], JOINTS
+        )
+        self.assertAlmostEqual(clauses.Violation(np.radians([-5.0, -3.0, -8.0])), np.radians(26))
+        self.assertAlmostEqual(clauses.Violation(np.radians([-5.0, 2.0, -8.0])), np.radians(23))
+        self.assertEqual(clauses.Violation(np.radians([1.0, 2.0, 11.0])), 0.0)
+
+    def test_single_literals_are_the_clauses_of_one_literal_as_unit_constraints(self):
+        """Of a >= 0, (b >= 0 OR c >= 0) and 2 c >= 20 deg, the first and the last: rows
+        (1, 0, 0) and (0, 0, 1), offsets 0 and -10 deg (radians, over the unit normal)."""
+        double = Literal(coefficients={"c": 2.0}, offset=-20.0)
+        clauses = ClauseSet(
+            [Clause("a", [L1]), Clause("bc", [L2, L3]), Clause("c", [double])], JOINTS
+        )
+        normals, offsets = clauses.SingleLiterals()
+        np.testing.assert_allclose(normals, [[1, 0, 0], [0, 0, 1]])
+        np.testing.assert_allclose(offsets, [0.0, -np.radians(10.0)])
 
 
 if __name__ == "__main__":

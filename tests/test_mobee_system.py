@@ -173,6 +173,29 @@ class TestCollisionForce(unittest.TestCase):
             arm.Out("f_coll"), Squash(-F * np.array([0.9, 0.6, 0.3]), 1e6, 1.0), rtol=1e-4
         )
 
+    def test_a_robot_geometry_reported_as_b_is_pushed_away_all_the_same(self):
+        """The box registered before the robot: SceneGraph reports the pair as (box, link3), and
+        MoBeE turns it round (A is the robot's, the normal from the box to it), so the force and
+        witness point are the ones above."""
+        params = MobeeParams(collision_squash=SquashParams(m=1e6, k=1.0), collision_gain=1e3)
+        d = 0.02
+        arm = ArmDiagram(
+            boxes=[((0.2, 0.1, 0.1), (1.0, 0.03 + d + 0.05, 0.0))], params=params, boxes_first=True
+        )
+        arm.Set([0.0, 0.0, 0.0])
+        query = arm.dut.GetInputPort("geometry_query").Eval(arm.context)
+        (reported,) = query.ComputeSignedDistancePairwiseClosestPoints(0.05)
+        self.assertEqual(query.inspector().GetName(reported.id_A), "box0")
+        (contact,) = arm.Out("field_contacts")
+        self.assertEqual((contact.name_A, contact.name_B), ("link3", "box0"))
+        np.testing.assert_allclose(contact.p_WCa, [0.9, 0.03, 0.0], atol=1e-3)
+        np.testing.assert_allclose(contact.p_WCb, [0.9, 0.03 + d, 0.0], atol=1e-3)
+        np.testing.assert_allclose(contact.nhat_BA_W, [0, -1, 0], atol=1e-2)
+        F = 1e3 * (0.05 - d)
+        np.testing.assert_allclose(
+            arm.Out("f_coll"), Squash(-F * np.array([0.9, 0.6, 0.3]), 1e6, 1.0), rtol=1e-2
+        )
+
     def test_grows_with_penetration_and_vanishes_outside_the_field(self):
         params = MobeeParams()
         magnitudes = []

@@ -129,6 +129,49 @@ class ReflexControllerTest(unittest.TestCase):
         )
         np.testing.assert_allclose(self.Q(controller, context), np.zeros(2), atol=1e-12)
 
+    def test_the_velocity_is_the_periods_step_out_and_back(self):
+        """The state's velocity is the pose's change over the period: 10 and -5 deg/s along the
+        move to (3, -1.5) deg, the same reversed while the reflex retraces it, then zero."""
+        controller, simulator, context = self.Make()
+        controller.GetInputPort("command").FixValue(context, np.radians([3.0, -1.5]))
+        speed = np.radians([10.0, -5.0])
+
+        def V():
+            return controller.GetOutputPort("state").Eval(context)[2:]
+
+        simulator.AdvanceTo(5 * H + 1e-9)  # six steps out
+        np.testing.assert_allclose(V(), speed, atol=1e-12)
+        controller.GetInputPort("field_pairs").FixValue(context, AbstractValue.Make(ONE_PAIR))
+        for k in range(6, 12):  # six steps back
+            simulator.AdvanceTo(k * H + 1e-9)
+            np.testing.assert_allclose(V(), -speed, atol=1e-12)
+        np.testing.assert_allclose(self.Q(controller, context), 0.0, atol=1e-12)
+        simulator.AdvanceTo(12 * H + 1e-9)  # at the waypoint: the command failed
+        self.assertEqual(self.Status(controller, context)[Status.MODE], Mode.HOLDING)
+        np.testing.assert_array_equal(V(), 0.0)
+
+    def test_the_counters_count_every_command_completion_and_reflex(self):
+        """Two moves of 1 deg completed, then two that meet trouble three periods out and are
+        rewound: 4 commands, 2 completed, 2 reflexes, holding at the last waypoint."""
+        controller, simulator, context = self.Make()
+        command, pairs = controller.GetInputPort("command"), controller.GetInputPort("field_pairs")
+        t = 0.0
+        for target in ([1.0, 0.0], [1.0, 1.0]):
+            command.FixValue(context, np.radians(target))
+            t += 10 * H
+            simulator.AdvanceTo(t)
+        for target in ([0.0, 1.0], [1.0, 2.0]):
+            command.FixValue(context, np.radians(target))
+            t += 3 * H
+            simulator.AdvanceTo(t)
+            pairs.FixValue(context, AbstractValue.Make(ONE_PAIR))
+            t += 10 * H
+            simulator.AdvanceTo(t)
+            pairs.FixValue(context, AbstractValue.Make(NO_FIELD_PAIRS))
+        status = self.Status(controller, context)
+        np.testing.assert_array_equal(status, [Mode.HOLDING, 4, 2, 2, 0])
+        np.testing.assert_allclose(self.Q(controller, context), np.radians([1.0, 1.0]), atol=1e-12)
+
 
 if __name__ == "__main__":
     unittest.main()

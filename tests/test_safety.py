@@ -1,9 +1,11 @@
 """MoBeE's safety guarantee (mobee/barrier.py, docs/mobee.md): closed forms of the barrier's rows
-and of each robot's predicted displacement (the dynamic plant against its prediction), the
-parameters that would break the guarantee refused, saturated client pushes into a table, a ball
-and the robot itself for 10 s, with both presets on the kinematic robot and the dynamic robot's
-three modes, that penetrate without the barrier and never with it, babbling with random pushes,
-runs that start in penetration, and the docs' safety tables written by the benchmark."""
+(on the planar arm too: a support point, a self-collision's other solid, a pair beyond its
+field), of the lever bounds and of each robot's predicted displacement (the dynamic plant against
+its prediction), the parameters that would break the guarantee refused, saturated client pushes
+into a table, a ball and the robot itself for 10 s, with both presets on the kinematic robot and
+the dynamic robot's three modes, that penetrate without the barrier and never with it, babbling
+with random pushes, runs that start in penetration, and the docs' safety tables written by the
+benchmark."""
 
 import contextlib
 import io
@@ -13,13 +15,16 @@ import shutil
 import tempfile
 import unittest
 
+from arm_diagram import ArmDiagram
 import numpy as np
-from pydrake.multibody.tree import JacobianWrtVariable
+from pydrake.multibody.tree import BodyIndex, JacobianWrtVariable
 
 from mobee_drake.experiments import bench_safety
 from mobee_drake.experiments.bench_safety import MOVERS, PRESETS, SCENES, BabblingRun, SceneRun
 from mobee_drake.experiments.doc_tables import GeneratedTable, TableLayout
 from mobee_drake.mobee.barrier import BarrierForce, BarrierParams, JointTracking, StepModel
+from mobee_drake.mobee.flow import FlowParams
+from mobee_drake.mobee.levers import LeverBounds
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario
 from mobee_drake.station.builder import POSITION_GAIN, VELOCITY_GAIN
@@ -175,6 +180,84 @@ class TestStepModels(unittest.TestCase):
                 self.assertLess(10 * error, np.abs(h * x[n:] - moved).max())
 
 
+# The arm's period, and how a period moves it at rest (M = 1, C = 20: MobeeParams' defaults).
+ARM_PERIOD = 0.01
+_KEEP = 1.0 / (1.0 + ARM_PERIOD * 20.0)
+_GAIN = ARM_PERIOD**2 * _KEEP
+
+
+def _HeldAtTheRate(row, gap: float, v: np.ndarray) -> np.ndarray:
+    """The least force dT (M = 1: along the row) with which the arm at velocity v closes the
+    row's gap by exactly the allowed ``rate (gap - clearance)`` in the period:
+    ``n . (h v / (1 + h C) + gain dT) = -rate (gap - clearance)``."""
+    row = np.asarray(row)
+    allowed = -PARAMS.rate * (gap - PARAMS.clearance)
+    return row * (allowed - row @ (ARM_PERIOD * _KEEP * v)) / (_GAIN * row @ row)
+
+
+class TestBarrierOnTheArm(unittest.TestCase):
+    """MoBeE's barrier on the planar arm (tests/arm_diagram.py: links of 0.3 m along +x at zero,
+    capsules of radius 0.03), the kinematic robot with a period of 0.01 s. At rest on its
+    attractor with velocity v, the period moves the joints by ``h v / (1 + h C / M)`` plus
+    ``gain dT`` for the barrier's force dT (M = 1, C = 20). The fields' own force is made
+    negligible (a gain of 1e-6) and the flow is off, so where one row n (gap g) binds, dT is the
+    closed form of :func:`_HeldAtTheRate`."""
+
+    def _Arm(self, q, v, boxes=(), **params):
+        params = MobeeParams(flow=FlowParams(enabled=False), collision_gain=1e-6, **params)
+        arm = ArmDiagram(boxes=boxes, params=params, step=StepModel(ARM_PERIOD))
+        arm.dut.GetInputPort("attractor").FixValue(arm.context, q)
+        arm.Set(q, v)
+        return arm
+
+    def test_a_support_point_beyond_its_field_is_watched_as_far_as_the_period_moves_it(self):
+        """link3 tilted up by asin(0.2), its tip 2 cm below a box's edge, turns about the tip
+        (joint3 at -2.02 times joint2): the witness gap holds, the end cap at joint3 rises
+        towards the box's plane. That cap, 8 cm from the plane (beyond the 5 cm field), is
+        watched because the period's move (offset h v included) could bring it into the field;
+        its row binds: dT along -(0.6, 0.3, 0) (its lever arms about the joints)."""
+        phi = np.arcsin(0.2)
+        tip = np.array([0.6 + 0.3 * np.cos(phi), 0.06])
+        box = ((0.2, 0.1, 0.1), (tip[0] + 0.1, tip[1] + 0.03 + 0.02 + 0.05, 0.0))
+        v2 = 9.6
+        v = np.array([0.0, v2, -v2 * (tip[0] - 0.3) / (tip[0] - 0.6)])  # the tip moves along x
+        arm = self._Arm([0.0, 0.0, phi], v, boxes=[box])
+        (contact,) = arm.Out("field_contacts")
+        np.testing.assert_allclose(contact.distance, 0.02, atol=1e-4)
+        expected = _HeldAtTheRate([-0.6, -0.3, 0.0], 0.08, v)
+        np.testing.assert_allclose(arm.Out("f_barrier"), expected, rtol=5e-3, atol=1e-6)
+
+    def test_a_self_collision_holds_the_support_point_of_its_b_solid(self):
+        """link3 folded back under link1 (2 cm below it at the tip's cap, the witness point;
+        3 cm at joint3's), SceneGraph's B. Turning joint2 swings link3 about the elbow: its cap
+        at joint3 rises towards link1 at (0.3 cos q2) per rad while the witness gap opens a
+        little. The row of B's cap, against the plane through A's witness point, binds: dT on
+        joint2 alone."""
+        q2 = -np.arcsin(0.09 / 0.3)  # joint3 at (0.3 + 0.3 cos q2, -0.09)
+        q3 = np.pi - np.arcsin(0.01 / 0.3) - q2 - 2 * np.pi  # link3 points back, 1/30 rad up
+        v = np.array([0.0, 4.0, 0.0])
+        arm = self._Arm([0.0, q2, q3], v, limit_delta=0.01)  # (q3 near its limit: f_lim off)
+        (contact,) = arm.Out("field_contacts")
+        self.assertEqual((contact.name_A, contact.name_B), ("link1", "link3"))
+        np.testing.assert_allclose(contact.distance, 0.02, atol=1e-6)
+        expected = _HeldAtTheRate([0.0, -0.3 * np.cos(q2), 0.0], 0.03, v)
+        np.testing.assert_allclose(arm.Out("f_barrier"), expected, rtol=1e-4, atol=1e-6)
+
+    def test_a_pair_beyond_its_field_that_the_period_could_close_is_held(self):
+        """A box 5.5 cm above the straight arm's tip (beyond the 5 cm field, so no pair of
+        ``field_pairs``), the arm turning up at 7.2 rad/s: joint1 moves by 0.06 rad in the
+        period, which could bring link3 (0.93 m per rad at most) 5.6 cm closer, within the
+        clearance. The wide query finds the pair; its witness row binds. Turning away, none."""
+        box = ((0.2, 0.1, 0.1), (1.0, 0.03 + 0.055 + 0.05, 0.0))
+        v = np.array([0.06 / (ARM_PERIOD * _KEEP), 0.0, 0.0])
+        arm = self._Arm(np.zeros(3), v, boxes=[box])
+        self.assertEqual(len(arm.Out("field_pairs")), 0)
+        expected = _HeldAtTheRate([-0.9, -0.6, -0.3], 0.055, v)
+        np.testing.assert_allclose(arm.Out("f_barrier"), expected, rtol=1e-3)
+        arm.Set(np.zeros(3), -v)
+        np.testing.assert_array_equal(arm.Out("f_barrier"), 0.0)
+
+
 class TestLeverBounds(unittest.TestCase):
     def test_no_point_of_a_solid_outruns_its_bound_in_any_posture(self):
         """mobee/levers.py: the bound over every configuration of how fast each solid's points
@@ -207,6 +290,39 @@ class TestLeverBounds(unittest.TestCase):
                 self.assertTrue(np.all(speeds <= bounds[g] + 1e-9), robot.geometry_names[geometry])
                 closest = min(closest, np.min(bounds[g] - speeds))
         self.assertLess(closest, 0.05)  # (and not loose everywhere: some posture comes close)
+
+    def test_the_arms_bounds_are_its_lined_up_reach_and_are_attained(self):
+        """On the planar arm, the bound of a point per joint is its distance to the joint along
+        the chain (to the joint's origin, then from joint to joint) plus its ball's radius: for
+        the link capsules' end caps (radius 0.03), 0.33 m per rad of the link's own joint and
+        0.3 m more per link further up; for a ball of 1 cm around a point 4 cm off link3's axis,
+        |(0.3, 0.04)| + 0.01, plus 0.3 m per link further up.
+        With that point lined up with the links (joint3 at -atan(0.04 / 0.3)), each ball's far
+        point moves exactly that fast: no bound is loose."""
+        plant = ArmDiagram().plant
+        bodies = [int(plant.GetBodyByName(f"link{i}").index()) for i in (1, 2, 3)]
+        velocities = np.array(
+            [plant.GetJointByName(f"joint{i}").velocity_start() for i in (1, 2, 3)]
+        )
+        ends = np.array([[0.0, 0.0, 0.0], [0.3, 0.0, 0.0]])
+        off_axis = np.array([[0.3, 0.04, 0.0]])
+        radii = np.array([0.03, 0.03, 0.01])
+        bounds = LeverBounds(plant, velocities, bodies, [ends, ends, off_axis], radii)
+        far = np.hypot(0.3, 0.04) + 0.01
+        expected = [[0.33, 0.0, 0.0], [0.63, 0.33, 0.0], [far + 0.6, far + 0.3, far]]
+        np.testing.assert_allclose(bounds, expected, rtol=1e-12)
+        context = plant.CreateDefaultContext()
+        plant.SetPositions(context, [0.0, 0.0, -np.arctan2(0.04, 0.3)])
+        world = plant.world_frame()
+        for body, p_B, radius, bound in zip(bodies, [ends[1], ends[1], off_axis[0]], radii, bounds):
+            frame = plant.get_body(BodyIndex(body)).body_frame()
+            # The ball's point farthest from the base, on the +x axis of the lined-up arm.
+            p_W = frame.CalcPoseInWorld(context) @ p_B + [radius, 0.0, 0.0]
+            p_far = frame.CalcPoseInWorld(context).inverse() @ p_W
+            J = plant.CalcJacobianTranslationalVelocity(
+                context, JacobianWrtVariable.kV, frame, p_far, world, world
+            )
+            np.testing.assert_allclose(np.linalg.norm(J, axis=0), bound, rtol=1e-12, atol=1e-15)
 
 
 def _SupportPointsOf(shape) -> tuple[np.ndarray, float]:
