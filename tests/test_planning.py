@@ -218,6 +218,36 @@ class TestPlanner(unittest.TestCase):
             PlanValues(agent, {7: 1.0})
 
 
+class TestActuationNoise(unittest.TestCase):
+    def test_the_noise_is_gaussian_in_each_joints_range_and_repeats_for_a_time(self):
+        from mobee_drake.planning.actuation_noise import NoisyPosture
+
+        centre, lower, upper = np.array([0.5, 2.0]), np.array([0.0, 0.0]), np.array([1.0, 4.0])
+        draws = np.array(
+            [NoisyPosture(centre, lower, upper, 0.05, 3, 0, 0.02 * k) for k in range(4000)]
+        )
+        z = (draws - centre) / (0.05 * (upper - lower))
+        np.testing.assert_allclose(z.mean(axis=0), 0.0, atol=0.05)  # 3.2 standard errors
+        np.testing.assert_allclose(z.std(axis=0), 1.0, atol=0.05)
+        # On the rank-3 lattice a joint leaves its state (0.125 of its range away) with
+        # probability 2 Phi(-2.5) = 1.24 % at sd 0.05.
+        left = np.mean(np.abs(draws[:, 0] - 0.5) > 0.125)
+        self.assertAlmostEqual(left, 0.0124, delta=0.006)
+        np.testing.assert_array_equal(
+            NoisyPosture(centre, lower, upper, 0.05, 3, 0, 1.5),
+            NoisyPosture(centre, lower, upper, 0.05, 3, 0, 1.5),
+        )
+        self.assertFalse(
+            np.array_equal(
+                NoisyPosture(centre, lower, upper, 0.05, 3, 0, 1.5),
+                NoisyPosture(centre, lower, upper, 0.05, 3, 1, 1.5),  # another agent
+            )
+        )
+        at_limit = NoisyPosture(np.array([1.0, 4.0]), lower, upper, 0.4, 0, 0, 0.0)
+        self.assertTrue(np.all((at_limit >= lower) & (at_limit <= upper)))
+        np.testing.assert_array_equal(NoisyPosture(centre, lower, upper, 0.0, 3, 0, 1.5), centre)
+
+
 class TestSupervisor(unittest.TestCase):
     """The exploration loop as a Drake system, with the robot state fixed by the test."""
 
@@ -262,6 +292,40 @@ class TestSupervisor(unittest.TestCase):
         counts = dut.Records(context)[0].explorer.transitions.counts[record.state_action]
         self.assertEqual(counts[0], 3)  # the initialisation's failure, plus this one
         self.assertEqual(dut.Records(context)[0].explorer.tries[record.state_action], 1)
+
+    def test_transition_noise_moves_the_attractor_off_the_goals_centre(self):
+        """Issue 33: a stochastic robot's attractor is the goal's centre plus the actuation noise
+        of the action's start (NoisyPosture's closed form), the centre without noise."""
+        from mobee_drake.planning.actuation_noise import NoisyPosture
+        from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
+
+        space = Lattice([0.25, 0.75], 2)
+        lower, upper = np.array([-1.0, 0.0, 0.0]), np.array([1.0, 2.0, 4.0])
+        attractors = {}
+        for noise in (0.0, 0.1):
+            dut = ExplorationSupervisor(
+                agents=[Agent(name="arm", joints=["b", "c"], space=space, seed=5)],
+                joints=["a", "b", "c"],
+                lower=lower,
+                upper=upper,
+                home=np.array([0.5, 0.5, 1.0]),
+                transition_noise=noise,
+            )
+            context = dut.CreateDefaultContext()
+            dut.GetInputPort("robot_state").FixValue(context, np.r_[0.3, 0.5, 1.0, np.zeros(3)])
+            dut.ExecuteInitializationEvents(context)
+            record = dut.Records(context)[0]
+            attractors[noise] = dut.GetOutputPort("attractor").Eval(context)
+        centre = space.centres[space.action_goal[record.state_action]] * [2, 4]
+        np.testing.assert_allclose(attractors[0.0], [0.5, *centre])
+        noisy = NoisyPosture(centre, lower[1:], upper[1:], 0.1, 5, 0, record.started)
+        np.testing.assert_allclose(attractors[0.1], [0.5, *noisy])
+        self.assertGreater(np.abs(noisy - centre).min(), 0.0)
+        with self.assertRaisesRegex(ValueError, "transition_noise must be in \\[0, 1\\)"):
+            ExplorationSupervisor(
+                agents=[], joints=["a"], lower=lower[:1], upper=upper[:1], home=[0.0],
+                transition_noise=-0.1,
+            )  # fmt: skip
 
     def test_timeout_and_polling_copies_nothing(self):
         import copy

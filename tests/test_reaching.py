@@ -2,6 +2,7 @@
 
 import contextlib
 import io
+import itertools
 import pathlib
 import tempfile
 import unittest
@@ -514,6 +515,112 @@ class TestDiscounting(unittest.TestCase):
         self.assertGreater(abs(misses[0, 0] - misses[1, 0]), 0.03)
 
 
+class _DrawnReach:
+    """The random strategy with the drawn reach fixed: state 3's."""
+
+    babbles_goals = False
+
+    def StartTry(self, num_states, rng):
+        return 3
+
+    def ReachRewards(self, histories, target, reaches, drawn):
+        return (np.arange(len(reaches)) == drawn).astype(float)
+
+
+class TestReadings(unittest.TestCase):
+    """Issue 33: the source's ambiguities as named options, each against its closed form."""
+
+    def test_a_move_across_a_plateau_fails_only_under_the_strict_rule(self):
+        # Penalties on every transition into state 3 cut its drawn reach off: V = 0 in states
+        # 0-2. From state 0 the first 0-valued state-action is the move to state 1 (transitions
+        # come before the reach); it arrives where it was sent, and V(1) = V(0) = 0.
+        from mobee_drake.reaching.strategies import REACH_STRATEGIES
+
+        for rule, expected in (("strict", -10.0), ("arrival", 0.0)):
+            with self.subTest(rule), mock.patch.dict(REACH_STRATEGIES, drawn=_DrawnReach()):
+                space, learner = _Learner("drawn", max_actions=1)
+                learner.config.plateau_rule = rule
+                target = learner.targets[0]
+                for sa in np.flatnonzero(space.action_goal == 3):
+                    learner.histories.Record(int(sa), target, 0.0, -10.0)
+                learner.problem_tries[1:] = 1
+                robot = FakeRobot(space, PALMS, state=0)
+                learner.Explore(robot)
+                (entry,) = learner.log
+                move = int(space.Actions(0)[0])
+                self.assertEqual((entry[2], entry[4]), (move, space.action_goal[move]))
+                self.assertEqual(entry[6], expected)
+
+    def test_random_tie_breaks_ties_at_random(self):
+        space, learner = _Learner("random")
+        learner.config.plateau_rule = "random-tie"
+        q = np.zeros(learner.num_state_actions)
+        rng = np.random.default_rng(0)
+        chosen = {learner._Greedy(q, 0, rng) for _ in range(60)}
+        self.assertEqual(chosen, set(learner.Actions(0).tolist()))
+
+    def test_eq81_as_its_prose_reads_fades_with_distance(self):
+        from mobee_drake.reaching.predictors import PredictorConfig
+
+        printed = RewardHistories([False, True])
+        prose = RewardHistories([False, True], PredictorConfig(eq81="prose"))
+        for h in (printed, prose):
+            h.Record(0, [0, 0, 0], 0.0, FAILED_TRANSITION_REWARD)
+            h.Record(1, [0, 0, 0], 1.0, 0.5)
+        for distance in (0.0, 3.0, 30.0):
+            w = 1 / (1 + distance)
+            target = [distance, 0, 0]
+            self.assertAlmostEqual(printed.Predict(0, target), -10.0)  # as printed: everywhere
+            self.assertAlmostEqual(prose.Predict(0, target), -10.0 * w / (1 + w))
+            # Reaches keep eq. 8.5 under either reading.
+            self.assertAlmostEqual(prose.Predict(1, target), printed.Predict(1, target))
+        self.assertEqual(prose.Predict(0, [0, 0, 0]), -5.0)
+        empty = RewardHistories([False], PredictorConfig(eq81="prose"))
+        self.assertEqual(empty.Predict(0, [0, 0, 0]), 0.0)  # eq. 8.3
+        with self.assertRaisesRegex(ValueError, "unknown reading of eq. 8.1 'both'"):
+            PredictorConfig(eq81="both").Validate()
+
+    def test_an_evaluation_shares_its_history_only_per_evaluation(self):
+        for history, copies in (("per-problem", 3), ("per-evaluation", 1)):
+            with self.subTest(history):
+                space, learner = _Learner("greedy")
+                learner.config.evaluation_history = history
+                with mock.patch.object(learner, "_Try", wraps=learner._Try) as tries:
+                    learner.Evaluate(FakeRobot(space, PALMS), seed=1)
+                used = {id(call.args[4]) for call in tries.call_args_list}
+                self.assertEqual(len(tries.call_args_list), 3)
+                self.assertEqual(len(used), copies)
+                self.assertNotIn(id(learner.histories), used)
+
+    def test_a_failure_is_remembered_by_the_next_problem_per_evaluation(self):
+        # Reach 1 is the only good one (eq. 8.5: 1 against about 0.04) and edge 0 -> 1 is
+        # blocked; a reach puts the robot back in state 0. A problem-try from state 0 fails the
+        # edge once, then goes round by 2 and 3 (gamma^3 = 0.73). Per evaluation, the problems
+        # after the first predict -10 for the edge (eq. 8.1 as printed) and go round at once.
+        failed = {}
+        for history in ("per-problem", "per-evaluation"):
+            space, learner = _Learner("greedy")
+            learner.config.evaluation_history = history
+            for s, target in itertools.product(range(4), learner.targets):
+                for _ in range(1 if s == 1 else 20):
+                    learner.histories.Record(learner.Reach(s), target, 1.0, float(s == 1))
+            robot = FakeRobot(space, PALMS, blocked={(0, 1)}, state=0)
+            robot.Reach = lambda target, robot=robot: (setattr(robot, "state", 0), PALMS[1])[1]
+            results = learner.Evaluate(robot, seed=2)
+            self.assertTrue(all(r.reach == learner.Reach(1) for r in results))
+            failed[history] = sum(r.failed_transitions for r in results)
+        self.assertGreaterEqual(failed["per-problem"], 2)  # once per try from state 0
+        self.assertEqual(failed["per-evaluation"], 1)
+
+    def test_bad_readings(self):
+        from mobee_drake.reaching.learner import ReachLearningConfig
+
+        with self.assertRaisesRegex(ValueError, "unknown plateau_rule 'lax'; choose one of strict"):
+            ReachLearningConfig(plateau_rule="lax").Validate()
+        with self.assertRaisesRegex(ValueError, "unknown evaluation_history 'never'"):
+            ReachLearningConfig(evaluation_history="never").Validate()
+
+
 class TestTieBreak(unittest.TestCase):
     def test_first_takes_the_lowest_state_action(self):
         # From state 0 of the 2 x 2 lattice the drawn reach of state 3 lies two steps away by
@@ -535,7 +642,9 @@ class TestTieBreak(unittest.TestCase):
     def test_bad_tie_break(self):
         from mobee_drake.reaching.learner import ReachLearningConfig
 
-        with self.assertRaisesRegex(ValueError, "unknown tie_break 'last'; tie breaks are first"):
+        with self.assertRaisesRegex(
+            ValueError, "unknown tie_break 'last'; choose one of first, random"
+        ):
             ReachLearningConfig(tie_break="last").Validate()
 
 
@@ -573,8 +682,8 @@ def _BatteryArguments(*argv):
 
     captured = {}
 
-    def Fake(output, strategies, seeds, settings, mdp_tries, backend):
-        captured["settings"], captured["seeds"] = settings, seeds
+    def Fake(output, strategies, seeds, settings, mdp_tries, backend, mdps=1):
+        captured["settings"], captured["seeds"], captured["mdps"] = settings, seeds, mdps
         raise SystemExit(0)
 
     with (
@@ -716,6 +825,35 @@ class TestEvaluationSums(unittest.TestCase):
             )
         self.assertIn("| unit0.01_force300 | 1.00 | 1.00 ± 0.00 |", report)
         self.assertIn("# unit0.1_force300", report)
+
+    def test_a_sweep_of_readings_over_independent_mdps(self):
+        """Issue 33: every combination of the readings is a setting; seed k's runs use MDP
+        k mod --mdps, learned on a robot with the setting's noise."""
+        from mobee_drake.experiments import ch8_reaching as ch8
+
+        settings, seeds = _BatteryArguments(
+            "--seeds", "4", "--plateau-rule", "strict", "arrival",
+            "--transition-noise", "0", "0.05",
+        )  # fmt: skip
+        self.assertEqual(
+            [(s.plateau_rule, s.transition_noise) for s in settings],
+            [("strict", 0.0), ("strict", 0.05), ("arrival", 0.0), ("arrival", 0.05)],
+        )
+        jobs = []
+        with mock.patch.object(ch8, "RunBattery", lambda j, *a, **k: jobs.extend(j) or {}):
+            ch8.RunReachBattery(pathlib.Path("unused"), ["random"], seeds, settings, 5, None, 3)
+        runs = {j.name: j.kwargs for j in jobs if j.function is ch8.ReachJob}
+        mdps = [j.name for j in jobs if j.function is ch8.MdpJob]
+        self.assertEqual(
+            mdps,
+            ["mdp_tries5", "mdp_tries5_seed1", "mdp_tries5_seed2"]
+            + ["mdp_tries5_noise0.05", "mdp_tries5_seed1_noise0.05", "mdp_tries5_seed2_noise0.05"],
+        )
+        self.assertEqual(len(runs), 4 * 4)
+        run = runs["random_unit0.03_force300_rule-arrival_noise0.05_seed3"]
+        self.assertEqual(run["mdp"], "mdp_tries5_noise0.05")  # seed 3 on MDP 0
+        self.assertEqual(run["settings"]["mdp_seed"], 0)
+        self.assertEqual(runs["random_unit0.03_force300_seed2"]["mdp"], "mdp_tries5_seed2")
 
     def test_command_line_sweep(self):
         settings, seeds = _BatteryArguments(

@@ -4,7 +4,7 @@
 import sys
 
 from mobee_drake.atomic_files import WriteTextAtomically
-from mobee_drake.experiments.arguments import CommandParser, PositiveInt
+from mobee_drake.experiments.arguments import CommandParser, InRange, PositiveInt
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
@@ -45,6 +45,13 @@ def _Parser() -> CommandParser:
         help="7.2: per run (default 2500); 7.3: per lattice (default: the "
         "source's 14,597 and 26,963); 7.4: in all (default 18,000)",
     )
+    parser.add_argument(
+        "--transition-noise",
+        type=InRange(0.0, 0.5),
+        default=0.0,
+        help="a stochastic robot (not for 7.4.1): the actuation noise's standard deviation "
+        "per joint, a fraction of its range (runs named ..._noise<sd>)",
+    )
     AddBackendArguments(parser)
     return parser
 
@@ -53,18 +60,21 @@ def main(argv=None) -> None:
     parser = _Parser()
     argv = sys.argv[1:] if argv is None else argv
     args = parser.parse_args(argv)
+    noise = args.transition_noise
+    if noise and args.experiment == "7.4.1":
+        parser.error("--transition-noise: 7.4.1 runs on the noise-free robot only")
     output = ClaimFolder(args.output, "battery")  # (a file or a user's folder refused)
     backend = BackendOf(args)
     if args.experiment == "7.1":
-        results = RunHypercube(output, args.runs, backend)
+        results = RunHypercube(output, args.runs, backend, transition_noise=noise)
     elif args.experiment == "7.2":
-        results = RunCoverage(output, args.transitions or 2500, args.runs, backend)
+        results = RunCoverage(output, args.transitions or 2500, args.runs, backend, noise)
     elif args.experiment == "7.2i":
-        results = RunInitializations(output, args.runs, backend)
+        results = RunInitializations(output, args.runs, backend, transition_noise=noise)
     elif args.experiment == "7.3":
-        results = RunRank4(output, args.transitions, backend)
+        results = RunRank4(output, args.transitions, backend, noise)
     elif args.experiment == "7.4":
-        results = RunThreeAgents(output, args.transitions or 18000, backend)
+        results = RunThreeAgents(output, args.transitions or 18000, backend, noise)
     else:
         results = RunDynamicPlanning(output, args.transitions or 1000, args.runs, backend)
     table = REPORTS[args.experiment](output, results)

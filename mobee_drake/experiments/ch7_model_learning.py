@@ -103,13 +103,16 @@ def ExploreJob(
     chunk: float = 2.0,
     table_contacts: bool = False,
     keep_model: bool = False,
+    transition_noise: float = 0.0,
 ) -> dict:
     """The battery job of one exploration run: ``agents`` explore among ``objects`` until
     ``stop``; the result is :func:`Explore`'s data with ``labels``. With ``keep_model`` the run is
     checkpointed (and resumed after a kill) in ``run.path / "model"``, which keeps the final
-    learned models."""
+    learned models. ``transition_noise`` makes the robot stochastic (see
+    :mod:`mobee_drake.planning.actuation_noise`)."""
     scenario = ExplorationScenario(agents, objects, random_seed=random_seed)
     scenario.world_events = list(world_events)
+    scenario.attractor.transition_noise = transition_noise
     explored = Explore(
         scenario,
         stop=stop,
@@ -129,14 +132,33 @@ def _RightArm(levels, **kwargs) -> ExploringAgent:
 
 
 def _Run(
-    jobs: list[Job], output: pathlib.Path, backend: Backend, description: str
+    jobs: list[Job],
+    output: pathlib.Path,
+    backend: Backend,
+    description: str,
+    transition_noise: float = 0.0,
 ) -> list[ExplorationRun]:
+    """Runs the exploration jobs (on a stochastic robot, named ``..._noise<sd>``, with
+    ``transition_noise``) and returns their runs."""
+    if transition_noise:
+        jobs = [
+            dc.replace(
+                job,
+                name=f"{job.name}_noise{transition_noise:g}",
+                kwargs=dict(job.kwargs, transition_noise=transition_noise),
+            )
+            for job in jobs
+        ]
     results = RunBattery(jobs, output, backend=backend, description=description)
     return [ExplorationRun.FromJson(result) for result in results.values()]
 
 
 def RunHypercube(
-    output: pathlib.Path, runs: int, backend: Backend, gammas=(0.5, 0.9, 0.99)
+    output: pathlib.Path,
+    runs: int,
+    backend: Backend,
+    gammas=(0.5, 0.9, 0.99),
+    transition_noise: float = 0.0,
 ) -> list[ExplorationRun]:
     jobs = [
         Job(
@@ -154,11 +176,15 @@ def RunHypercube(
         for gamma in gammas
         for run in range(runs)
     ]
-    return _Run(jobs, output, backend, "7.1")
+    return _Run(jobs, output, backend, "7.1", transition_noise)
 
 
 def RunCoverage(
-    output: pathlib.Path, transitions: int, runs: int, backend: Backend
+    output: pathlib.Path,
+    transitions: int,
+    runs: int,
+    backend: Backend,
+    transition_noise: float = 0.0,
 ) -> list[ExplorationRun]:
     jobs = [
         Job(
@@ -179,11 +205,15 @@ def RunCoverage(
         for strategy in ("curious", "random", "least_tried")
         for run in range(runs)
     ]
-    return _Run(jobs, output, backend, "7.2")
+    return _Run(jobs, output, backend, "7.2", transition_noise)
 
 
 def RunInitializations(
-    output: pathlib.Path, runs: int, backend: Backend, gammas=(0.5, 0.9, 0.99)
+    output: pathlib.Path,
+    runs: int,
+    backend: Backend,
+    gammas=(0.5, 0.9, 0.99),
+    transition_noise: float = 0.0,
 ) -> list[ExplorationRun]:
     jobs = [
         Job(
@@ -205,7 +235,7 @@ def RunInitializations(
         for gamma in gammas
         for run in range(runs)
     ]
-    return _Run(jobs, output, backend, "7.2i")
+    return _Run(jobs, output, backend, "7.2i", transition_noise)
 
 
 RANK_4_LATTICES = {"20-80": [0.2, 0.4, 0.6, 0.8], "12.5-87.5": [0.125, 0.375, 0.625, 0.875]}
@@ -214,7 +244,10 @@ RANK_4_SOURCE_ACTIONS = {"20-80": 14597, "12.5-87.5": 26963}
 
 
 def RunRank4(
-    output: pathlib.Path, transitions: int | None, backend: Backend
+    output: pathlib.Path,
+    transitions: int | None,
+    backend: Backend,
+    transition_noise: float = 0.0,
 ) -> list[ExplorationRun]:
     """Each rank-4 lattice for ``transitions`` actions (None: the source's number)."""
     jobs = []
@@ -233,10 +266,12 @@ def RunRank4(
                 total=budget,
             )
         )
-    return _Run(jobs, output, backend, "7.3")
+    return _Run(jobs, output, backend, "7.3", transition_noise)
 
 
-def RunThreeAgents(output: pathlib.Path, transitions: int, backend: Backend) -> ExplorationRun:
+def RunThreeAgents(
+    output: pathlib.Path, transitions: int, backend: Backend, transition_noise: float = 0.0
+) -> ExplorationRun:
     rank_3 = [0.25, 0.5, 0.75]
     agents = [
         ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=rank_3, nearest=16),
@@ -257,7 +292,7 @@ def RunThreeAgents(output: pathlib.Path, transitions: int, backend: Backend) -> 
         ),
         total=transitions,
     )
-    return _Run([job], output, backend, "7.4")[0]
+    return _Run([job], output, backend, "7.4", transition_noise)[0]
 
 
 def _TableContacts(simulation, period: float = 0.1):

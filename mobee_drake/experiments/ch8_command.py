@@ -1,6 +1,7 @@
 """``mobee-drake experiment ch8``: the command line of the reach-learning battery (see
 :mod:`mobee_drake.experiments.ch8_reaching`)."""
 
+import itertools
 import pathlib
 import sys
 
@@ -27,6 +28,7 @@ from mobee_drake.experiments.ch8_reaching import (
     REACH_PRESETS,
     SOURCE_STAGES,
     SOURCE_STRATEGIES,
+    MdpName,
     RunOne,
     RunReachBattery,
     RunSettings,
@@ -36,11 +38,15 @@ from mobee_drake.experiments.ch8_reaching import (
 from mobee_drake.experiments.ch8_report import Report
 from mobee_drake.owned_folders import ClaimFolder, OwnedFolder
 from mobee_drake.reaching.learner import (
+    EVALUATION_HISTORIES,
+    PLATEAU_RULES,
     TIE_BREAKS,
     ReachLearningConfig,
 )
 from mobee_drake.reaching.predictors import (
+    EQ81_READINGS,
     PREDICTORS,
+    PredictorConfig,
 )
 from mobee_drake.reaching.strategies import REACH_STRATEGIES
 
@@ -158,6 +164,83 @@ def _AddSettingArguments(parser: CommandParser) -> None:
         help="how the greedy policy picks among state-actions of equal value: the first "
         "(transitions before the reach) or a random one (use another --output)",
     )
+    _AddReadingArguments(parser)
+
+
+def _AddReadingArguments(parser: CommandParser) -> None:
+    """The source's ambiguities (issue 33, docs/reaching.md); several values of any make a
+    sweep over every combination."""
+    parser.add_argument(
+        "--plateau-rule",
+        choices=PLATEAU_RULES,
+        nargs="+",
+        default=[ReachLearningConfig().plateau_rule],
+        help="when a transition fails: strict (8.1 as stated: its end state is not of higher "
+        "value), arrival (a move that arrives where it was sent never fails) or random-tie "
+        "(strict, ties of value broken at random)",
+    )
+    parser.add_argument(
+        "--eq81",
+        choices=EQ81_READINGS,
+        nargs="+",
+        default=[PredictorConfig().eq81],
+        help="eq. 8.1 as printed (one record predicts its reward everywhere) or as its prose "
+        "reads (a prediction that fades with the distance to the records' targets)",
+    )
+    parser.add_argument(
+        "--evaluation-history",
+        choices=EVALUATION_HISTORIES,
+        nargs="+",
+        default=[ReachLearningConfig().evaluation_history],
+        help="what an evaluation remembers of its own failed transitions: per problem-try, or "
+        "over the whole evaluation",
+    )
+    parser.add_argument(
+        "--transition-noise",
+        type=InRange(0.0, 0.5),
+        nargs="+",
+        default=[0.0],
+        help="a stochastic robot: the actuation noise's standard deviation per joint, a "
+        "fraction of its range (the MDP is learned on the same robot)",
+    )
+    parser.add_argument(
+        "--mdps",
+        type=PositiveInt,
+        default=1,
+        help="independently learned MDPs: seed k's runs use MDP k mod this",
+    )
+
+
+def _Variants(args, stages: list[int]) -> list[RunSettings]:
+    """The settings of every combination of the swept values (one unless a sweep)."""
+    preset = REACH_PRESETS[args.preset]
+    return [
+        RunSettings(
+            args.strategies[0],
+            0,
+            args.problem_tries,
+            stages,
+            args.evaluations,
+            args.checkpoint_every,
+            args.predictor,
+            args.mdp,
+            force,
+            unit,
+            args.tie_break,
+            plateau_rule=rule,
+            eq81=eq81,
+            evaluation_history=history,
+            transition_noise=noise,
+        )
+        for unit, force, rule, eq81, history, noise in itertools.product(
+            dict.fromkeys(args.distance_unit or [preset.distance_unit]),
+            dict.fromkeys(args.reach_force or [preset.reach_force]),
+            dict.fromkeys(args.plateau_rule),
+            dict.fromkeys(args.eq81),
+            dict.fromkeys(args.evaluation_history),
+            dict.fromkeys(args.transition_noise),
+        )
+    ]
 
 
 def main(argv=None) -> None:
@@ -173,31 +256,14 @@ def main(argv=None) -> None:
     if args.report_only and not output.is_dir():  # (checked before a folder is made)
         parser.error(f"--report-only: {output} is not a folder of reach-learning runs")
     ClaimFolder(output, "battery")  # (a file, or a folder of the user's, refused in one line)
-    preset = REACH_PRESETS[args.preset]
-    variants = [
-        RunSettings(
-            args.strategies[0],
-            0,
-            args.problem_tries,
-            stages,
-            args.evaluations,
-            args.checkpoint_every,
-            args.predictor,
-            args.mdp,
-            force,
-            unit,
-            args.tie_break,
-        )
-        for unit in dict.fromkeys(args.distance_unit or [preset.distance_unit])
-        for force in dict.fromkeys(args.reach_force or [preset.reach_force])
-    ]
+    variants = _Variants(args, stages)
     settings = variants[0]
     if args.watch:  # In the battery's folder, beside its runs.
         watch = output / "watch"
         with OwnedFolder(output, "battery"):
-            mdp_dir = watch / f"mdp_tries{args.mdp_tries}"
+            mdp_dir = watch / MdpName(args.mdp_tries, 0, settings.transition_noise)
             if settings.mdp == "learned_first":
-                TrainMdp(mdp_dir, args.mdp_tries)
+                TrainMdp(mdp_dir, args.mdp_tries, transition_noise=settings.transition_noise)
             RunOne(watch / settings.strategy, mdp_dir, settings, StartMeshcat())
         return
     if args.report_only:
@@ -213,6 +279,7 @@ def main(argv=None) -> None:
             variants if len(variants) > 1 else settings,
             args.mdp_tries,
             BackendOf(args),
+            mdps=args.mdps,
         )
     text = (
         f"# Reach learning (ch. 8.4)\n\n`mobee-drake experiment ch8 "

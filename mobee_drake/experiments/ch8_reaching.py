@@ -94,13 +94,22 @@ def _Robot() -> IcubConfig:
     return IcubConfig(controlled_joints=RIGHT_ARM)
 
 
-def TrainMdp(folder: pathlib.Path, min_tries: int, seed: int = 0, progress=None, should_stop=None):
+def TrainMdp(
+    folder: pathlib.Path,
+    min_tries: int,
+    seed: int = 0,
+    progress=None,
+    should_stop=None,
+    transition_noise: float = 0.0,
+):
     """The curious agent's model of the rank-3 lattice, learned once (checkpointed in ``folder``
-    as it learns, resumed from there after a kill); ``progress(n)``, if given, is told the
-    actions done as the agent learns."""
+    as it learns, resumed from there after a kill) on a robot with ``transition_noise``;
+    ``progress(n)``, if given, is told the actions done as the agent learns."""
     agent = ExploringAgent(name=AGENT, joints=RIGHT_ARM, levels=LEVELS)
+    scenario = ExplorationScenario([agent], robot=_Robot(), random_seed=seed)
+    scenario.attractor.transition_noise = transition_noise
     Explore(
-        ExplorationScenario([agent], robot=_Robot(), random_seed=seed),
+        scenario,
         chunk=5.0,
         checkpoint=folder,
         stop=lambda records: records[0].explorer.tries.min() >= min_tries,
@@ -110,12 +119,25 @@ def TrainMdp(folder: pathlib.Path, min_tries: int, seed: int = 0, progress=None,
     return LoadAgentModel(str(folder), AGENT, ExplorerConfig())
 
 
-def MdpJob(run: RunFolder, min_tries: int) -> dict:
+def MdpJob(run: RunFolder, min_tries: int, seed: int = 0, transition_noise: float = 0.0) -> dict:
     """The battery job that learns the MDP (in ``run.path / "model"``)."""
     model = TrainMdp(
-        run.path / "model", min_tries, progress=run.Progress, should_stop=StopRequested
+        run.path / "model",
+        min_tries,
+        seed,
+        progress=run.Progress,
+        should_stop=StopRequested,
+        transition_noise=transition_noise,
     )
     return dict(min_tries=int(model.tries.min()), actions=int(model.tries.sum()))
+
+
+def MdpName(min_tries: int, seed: int = 0, transition_noise: float = 0.0) -> str:
+    """The battery's job (and folder) of an MDP: ``mdp_tries<t>``, with ``_seed<m>`` and
+    ``_noise<sd>`` for another seed and a stochastic robot."""
+    seed_part = f"_seed{seed}" if seed else ""
+    noise_part = f"_noise{transition_noise:g}" if transition_noise else ""
+    return f"mdp_tries{min_tries}{seed_part}{noise_part}"
 
 
 @dc.dataclass
@@ -137,6 +159,36 @@ class RunSettings:
     distance_unit: float = PredictorConfig().distance_unit
     # How the greedy policy breaks ties of value (one of TIE_BREAKS; the source is silent).
     tie_break: str = ReachLearningConfig().tie_break
+    # The readings of issue 33 (see mobee_drake.reaching.learner and .predictors): when a
+    # transition fails, eq. 8.1 as printed or as its prose reads, and what an evaluation keeps.
+    plateau_rule: str = ReachLearningConfig().plateau_rule
+    eq81: str = PredictorConfig().eq81
+    evaluation_history: str = ReachLearningConfig().evaluation_history
+    # A stochastic robot: the actuation noise's standard deviation (fractions of each joint's
+    # range; mobee_drake.planning.actuation_noise), for the MDP and the reaches alike.
+    transition_noise: float = 0.0
+    # The seed of the run's MDP (independently learned MDPs, issue 33).
+    mdp_seed: int = 0
+
+    def Readings(self) -> dict[str, object]:
+        """The readings of the source's ambiguities that differ from the reference ones."""
+        return {n: getattr(self, n) for n, ref in READINGS.items() if getattr(self, n) != ref}
+
+
+# The readings of the source's ambiguities (issue 33): each setting's reference value, and its
+# short name in job names.
+READINGS = {
+    "plateau_rule": ReachLearningConfig().plateau_rule,
+    "eq81": PredictorConfig().eq81,
+    "evaluation_history": ReachLearningConfig().evaluation_history,
+    "transition_noise": 0.0,
+}
+READING_LABELS = {
+    "plateau_rule": "rule-",
+    "eq81": "eq81-",
+    "evaluation_history": "history-",
+    "transition_noise": "noise",
+}
 
 
 @dc.dataclass(frozen=True)
@@ -178,12 +230,25 @@ def ReachScenario(reach_force: float = ReachForcing().force) -> Scenario:
 
 
 def ReachRobot(
-    space, target_radius: float, reach_force: float = ReachForcing().force, meshcat=None
+    space,
+    target_radius: float,
+    reach_force: float = ReachForcing().force,
+    meshcat=None,
+    transition_noise: float = 0.0,
+    noise_seed: int = 0,
 ) -> SimulatedRobot:
     """The reach learner's robot on the station of :func:`ReachScenario` (shown in real time in
-    ``meshcat``, if given)."""
+    ``meshcat``, if given), with ``transition_noise`` drawn from ``noise_seed``."""
     station = BuildScenario(ReachScenario(reach_force), meshcat)
-    return SimulatedRobot(station, RIGHT_ARM, space, target_radius, realtime=meshcat is not None)
+    return SimulatedRobot(
+        station,
+        RIGHT_ARM,
+        space,
+        target_radius,
+        realtime=meshcat is not None,
+        transition_noise=transition_noise,
+        noise_seed=noise_seed,
+    )
 
 
 def _Checkpoint(
@@ -219,9 +284,13 @@ def _NewLearner(settings: RunSettings, mdp_dir: pathlib.Path):
         ReachLearningConfig(
             strategy=settings.strategy,
             seed=settings.seed,
-            predictor=PredictorConfig(settings.predictor, distance_unit=settings.distance_unit),
+            predictor=PredictorConfig(
+                settings.predictor, distance_unit=settings.distance_unit, eq81=settings.eq81
+            ),
             learn_mdp=simultaneous,
             tie_break=settings.tie_break,
+            plateau_rule=settings.plateau_rule,
+            evaluation_history=settings.evaluation_history,
         ),
     )
     return model, learner, grid
@@ -254,7 +323,14 @@ def RunOne(
     problem-try, and when True the run saves its checkpoint and raises JobStopped."""
     run_dir.mkdir(parents=True, exist_ok=True)
     model, learner, grid = _NewLearner(settings, mdp_dir)
-    robot = ReachRobot(model.space, grid.radius, settings.reach_force, meshcat)
+    robot = ReachRobot(
+        model.space,
+        grid.radius,
+        settings.reach_force,
+        meshcat,
+        transition_noise=settings.transition_noise,
+        noise_seed=settings.seed,
+    )
     checkpoint = run_dir / "checkpoint"
     data = dict(evaluations={}, wall_seconds=0.0, target=None)
     generation = CurrentGeneration(checkpoint)
@@ -325,8 +401,14 @@ def ReachJob(run: RunFolder, mdp: str, settings: dict) -> dict:
 
 
 def SettingLabel(settings: RunSettings) -> str:
-    """A sweep's name for a run's distance unit and reach force (job names, report sections)."""
-    return f"unit{settings.distance_unit:g}_force{settings.reach_force:g}"
+    """A sweep's name for a run's distance unit and reach force, and its readings that are not
+    the reference ones (job names, report sections): e.g. ``unit0.03_force300_rule-arrival``."""
+    readings = "".join(
+        f"_{READING_LABELS[name]}{value:g}" if isinstance(value, float) else
+        f"_{READING_LABELS[name]}{value}"
+        for name, value in settings.Readings().items()
+    )  # fmt: skip
+    return f"unit{settings.distance_unit:g}_force{settings.reach_force:g}{readings}"
 
 
 def RunReachBattery(
@@ -336,11 +418,15 @@ def RunReachBattery(
     settings: RunSettings | list[RunSettings],
     mdp_tries: int,
     backend: Backend,
+    mdps: int = 1,
 ) -> list[dict]:
-    """The MDP (unless learned with the reaches), then a run of ``settings`` for every strategy
+    """The MDPs (unless learned with the reaches), then a run of ``settings`` for every strategy
     and seed, on ``backend`` (see :mod:`mobee_drake.experiments.battery`). A list of settings is
-    a sweep: every setting's runs share the MDP and are named ``<strategy>_<SettingLabel>_seed<k>``
-    (a single setting's ``<strategy>_seed<k>``)."""
+    a sweep, its runs named ``<strategy>_<SettingLabel>_seed<k>`` (a single setting's
+    ``<strategy>_seed<k>``). ``mdps`` MDPs are learned independently (seeds 0 ... mdps - 1, on a
+    robot with each setting's transition noise); seed k's runs use MDP k mod ``mdps``, so the
+    runs of one seed share their MDP and their evaluation seeds (paired across strategies and
+    settings)."""
     variants = [settings] if isinstance(settings, RunSettings) else list(settings)
     if not variants:
         raise ValueError("a reach-learning battery needs at least one setting")
@@ -350,21 +436,27 @@ def RunReachBattery(
     if len(set(labels)) < len(labels):
         raise ValueError(f"a sweep's settings repeat: {sorted(labels)}")
     sweep = len(variants) > 1
-    mdp = f"mdp_tries{mdp_tries}"
+    noises = sorted({v.transition_noise for v in variants})
     if variants[0].mdp == "learned_first":
-        RunBattery(
-            [Job(mdp, MdpJob, dict(min_tries=mdp_tries))],
-            output,
-            backend=backend,
-            description="the MDP (actions)",
-        )
+        mdp_jobs = [
+            Job(
+                MdpName(mdp_tries, m, noise),
+                MdpJob,
+                dict(min_tries=mdp_tries, seed=m, transition_noise=noise),
+            )
+            for noise in noises
+            for m in range(mdps)
+        ]
+        RunBattery(mdp_jobs, output, backend=backend, description="the MDPs (actions)")
     jobs = [
         Job(
             f"{strategy}_{SettingLabel(variant)}_seed{seed}" if sweep else f"{strategy}_seed{seed}",
             ReachJob,
             dict(
-                mdp=mdp,
-                settings=dc.asdict(dc.replace(variant, strategy=strategy, seed=seed)),
+                mdp=MdpName(mdp_tries, seed % mdps, variant.transition_noise),
+                settings=dc.asdict(
+                    dc.replace(variant, strategy=strategy, seed=seed, mdp_seed=seed % mdps)
+                ),
             ),
             total=variant.problem_tries,
         )

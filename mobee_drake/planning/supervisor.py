@@ -25,6 +25,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 
 from mobee_drake.atomic_files import StrictJson
+from mobee_drake.planning.actuation_noise import NoisyPosture, ValidateNoise
 from mobee_drake.planning.explorers import (
     Explorer,
     ExplorerConfig,
@@ -94,8 +95,13 @@ class ExplorationSupervisor(LeafSystem):
         home: np.ndarray,
         timing: ActionTiming | None = None,
         period: float = 0.2,
+        transition_noise: float = 0.0,
     ):
+        """``transition_noise``: the actuation noise's standard deviation per joint, a fraction
+        of its range (see :mod:`mobee_drake.planning.actuation_noise`)."""
         super().__init__()
+        ValidateNoise(transition_noise)
+        self._noise = transition_noise
         self._agents = list(agents)
         self._timing = timing or ActionTiming()
         self._lower, self._upper, self._home = lower, upper, np.asarray(home, dtype=float)
@@ -245,13 +251,12 @@ class ExplorationSupervisor(LeafSystem):
 
     def _CalcAttractor(self, context, output) -> None:
         q_star = self._home.copy()
-        for agent, columns, record in zip(
-            self._agents, self._columns, context.get_abstract_state(int(self._records)).get_value()
-        ):
-            q_star[columns] = agent.space.Centre(
-                agent.space.action_goal[record.state_action],
-                self._lower[columns],
-                self._upper[columns],
+        records = context.get_abstract_state(int(self._records)).get_value()
+        for i, (agent, columns, record) in enumerate(zip(self._agents, self._columns, records)):
+            lower, upper = self._lower[columns], self._upper[columns]
+            centre = agent.space.Centre(agent.space.action_goal[record.state_action], lower, upper)
+            q_star[columns] = NoisyPosture(
+                centre, lower, upper, self._noise, agent.seed, i, record.started
             )
         output.SetFromVector(q_star)
 
@@ -396,9 +401,13 @@ class ExploreAttractor:
 
     agents: list[ExploringAgent] = dc.field(default_factory=list)
     timing: ActionTiming = dc.field(default_factory=ActionTiming)
+    # A stochastic robot (issue 33): the actuation noise's standard deviation, a fraction of
+    # each joint's range (0: none; see mobee_drake.planning.actuation_noise).
+    transition_noise: float = 0.0
 
     def Validate(self) -> None:
         self.timing.Validate()
+        ValidateNoise(self.transition_noise)
         names = [agent.name for agent in self.agents]
         if not names:
             raise ValueError("exploring agents: there is none")
@@ -470,6 +479,7 @@ class ExploreAttractor:
                 upper=upper,
                 home=mobee.home,
                 timing=self.timing,
+                transition_noise=self.transition_noise,
             ),
         )
         parts.builder.Connect(parts.robot_state, supervisor.GetInputPort("robot_state"))

@@ -40,6 +40,19 @@ The greedy policy takes, among state-actions of equal value, the first in state-
 (a state's transitions, then its reach: an argmax), or with ``tie_break="random"`` one drawn from
 the try's generator (the source is silent).
 
+Readings where the source is ambiguous (issue 33), each a named option with the reference first:
+
+- ``plateau_rule``, when a transition failed (ch. 8.1 says "any (s, a, s') for which s' does not
+  have a higher value than s"): ``strict``, that rule as stated, so a move across a plateau of
+  equal value fails even when it arrives where it was sent; ``arrival``, a transition that ends
+  in the state it was sent to never fails (the rule's purpose, 8.1: to catch moves the target
+  blocks); ``random-tie``, the strict rule with ties of value broken at random (what
+  ``tie_break="random"`` does), so a plateau's reach is chosen as often as its moves.
+- ``evaluation_history``, what an evaluation remembers of its own failures (ch. 8.3.3 is silent):
+  ``per-problem``, a scratch copy of the histories for each problem-try, or ``per-evaluation``,
+  one copy for the whole evaluation, so a transition that failed on one problem is predicted by
+  eq. 8.1 to fail on the next ones too (it is not penalised again on every problem).
+
 The learner draws from its own seeded generator and keeps a log of every action it took, from
 which its histories are rebuilt exactly (checkpoints, :meth:`ReachLearner.LoadArrays`).
 """
@@ -65,6 +78,10 @@ from mobee_drake.reaching.strategies import REACH_STRATEGIES
 # How the greedy policy picks among state-actions of equal value: the first in state-action order
 # (the state's transitions by index, then its reach), or one drawn at random.
 TIE_BREAKS = ("first", "random")
+# When a transition fails (see the module's docstring).
+PLATEAU_RULES = ("strict", "arrival", "random-tie")
+# What an evaluation's problem-tries remember of each other (see the module's docstring).
+EVALUATION_HISTORIES = ("per-problem", "per-evaluation")
 
 
 @dc.dataclass
@@ -86,14 +103,20 @@ class ReachLearningConfig:
     # One of TIE_BREAKS (the source is silent; "first" is what an argmax over the state's
     # state-actions does, transitions before the reach).
     tie_break: str = "first"
+    # One of PLATEAU_RULES and of EVALUATION_HISTORIES (the source is ambiguous or silent).
+    plateau_rule: str = "strict"
+    evaluation_history: str = "per-problem"
 
     def Validate(self) -> None:
         self.predictor.Validate()
         self.goals.Validate()
-        if self.tie_break not in TIE_BREAKS:
-            raise ValueError(
-                f"unknown tie_break '{self.tie_break}'; tie breaks are " + ", ".join(TIE_BREAKS)
-            )
+        for name, value, allowed in (
+            ("tie_break", self.tie_break, TIE_BREAKS),
+            ("plateau_rule", self.plateau_rule, PLATEAU_RULES),
+            ("evaluation_history", self.evaluation_history, EVALUATION_HISTORIES),
+        ):
+            if value not in allowed:
+                raise ValueError(f"unknown {name} '{value}'; choose one of " + ", ".join(allowed))
         if self.strategy not in REACH_STRATEGIES:
             raise ValueError(
                 f"unknown reach-learning strategy '{self.strategy}'; strategies "
@@ -249,7 +272,8 @@ class ReachLearner:
         actions = self.Actions(state)
         scores = q[actions]
         best = actions[scores >= scores.max() - 1e-12]
-        return int(best[0] if self.config.tie_break == "first" else rng.choice(best))
+        first = self.config.tie_break == "first" and self.config.plateau_rule != "random-tie"
+        return int(best[0] if first else rng.choice(best))
 
     # ------------------------------------------------------------------------------------------
     # Acting.
@@ -283,8 +307,10 @@ class ReachLearner:
                 reward = ReachReward(reached, target, self.config.predictor.distance_unit)
                 outcome = state
             else:
-                outcome = robot.Transition(int(self.space.action_goal[sa]))
-                reward = TransitionReward(v[state], v[outcome])
+                sent_to = int(self.space.action_goal[sa])
+                outcome = robot.Transition(sent_to)
+                arrived = self.config.plateau_rule == "arrival" and outcome == sent_to
+                reward = 0.0 if arrived else TransitionReward(v[state], v[outcome])
                 if self.config.learn_mdp and not robot.FeltObject():  # ch. 9.4.1: the model's
                     reward = 0.0
                     if learn:
@@ -342,13 +368,15 @@ class ReachLearner:
             if state == start:
                 break
             robot.Transition(int(self.space.action_goal[self._Greedy(q, state, rng)]))
+        shared = self.histories.Copy()
+        per_problem = self.config.evaluation_history == "per-problem"
         return [
             self._Try(
                 robot,
                 int(problem),
                 self.targets[problem],
                 "greedy",
-                self.histories.Copy(),
+                self.histories.Copy() if per_problem else shared,
                 rng,
                 learn=False,
             )

@@ -5,7 +5,14 @@ the reward it was expected to give and the reward it gave (eq. 8.2). A predictio
 weighs each past reward by ``1 / (1 + |x* - x*_i|)``:
 
 - state transitions, eq. 8.1: ``sum w_i r_i / sum w_i``, and 0 with no history (eq. 8.3: no news
-  is good news: a transition is expected to work, for no reward);
+  is good news: a transition is expected to work, for no reward). The formula as printed
+  predicts a single record's reward for every target however far; the prose (8.1: a failed
+  transition "estimates a negative reward, though it is small" for far targets; 8.4.4: "a much
+  smaller negative reward for far away problems") describes a prediction that fades with
+  distance. ``PredictorConfig.eq81`` chooses: ``printed`` (the default) or ``prose``, eq. 8.5's
+  form with eq. 8.3's prior, ``sum w_i r_i / (1 + sum w_i)``: a prior record of reward 0 at
+  weight 1, as eq. 8.5 has one of reward 1 (one -10 record predicts -10 w / (1 + w): -5 at its
+  own target, -0.9 ten units away);
 - reaches, eq. 8.5: ``(1 + sum w_i r_i) / (1 + sum w_i)``, optimistic both with no history and
   for targets far from every one tried (the rewards of eq. 8.4 lie in (0, 1]);
 - intrinsic, eq. 8.7: eq. 8.5 over the past prediction errors ``e_i - r_i`` (eq. 8.6).
@@ -33,6 +40,8 @@ import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
 PREDICTORS = ("weighted", "gaussian_process")
+# The readings of eq. 8.1 (see the module's docstring).
+EQ81_READINGS = ("printed", "prose")
 
 
 @dc.dataclass
@@ -45,11 +54,18 @@ class PredictorConfig:
     # The kernel's length scale (m) and the noise variance relative to the signal's.
     length_scale: float = 0.1
     noise_ratio: float = 0.25
+    # Eq. 8.1 as printed, or as its prose describes it (one of EQ81_READINGS).
+    eq81: str = "printed"
 
     def Validate(self) -> None:
         if self.kind not in PREDICTORS:
             raise ValueError(
                 f"unknown reward predictor '{self.kind}'; predictors are " + ", ".join(PREDICTORS)
+            )
+        if self.eq81 not in EQ81_READINGS:
+            raise ValueError(
+                f"unknown reading of eq. 8.1 '{self.eq81}'; readings are "
+                + ", ".join(EQ81_READINGS)
             )
         if not self.distance_unit > 0:
             raise ValueError(f"the predictor's distance_unit must be > 0, got {self.distance_unit}")
@@ -81,15 +97,23 @@ def TransitionReward(value_before: float, value_after: float) -> float:
 
 
 def WeightedEstimate(
-    target: np.ndarray, targets: np.ndarray, values: np.ndarray, prior: float, unit: float = 1.0
+    target: np.ndarray,
+    targets: np.ndarray,
+    values: np.ndarray,
+    prior: float,
+    unit: float = 1.0,
+    prior_weight: float | None = None,
 ) -> float:
-    """``(prior + sum w_i v_i) / (prior + sum w_i)`` with ``w_i = 1 / (1 + |x* - x*_i|)``, the
-    distance counted in ``unit`` (m); with ``prior`` 0 this is eq. 8.1 (0 with no history,
-    eq. 8.3), with 1 eq. 8.5 and 8.7."""
+    """``(c prior + sum w_i v_i) / (c + sum w_i)`` with ``w_i = 1 / (1 + |x* - x*_i|)``, the
+    distance counted in ``unit`` (m), and ``prior`` with no history; the prior's weight ``c`` is
+    ``prior_weight``, by default ``prior`` itself. With ``prior`` 0 this is eq. 8.1 as printed
+    (0 with no history, eq. 8.3), with 1 eq. 8.5 and 8.7, with ``prior`` 0 at weight 1 eq. 8.1
+    as its prose reads."""
     if len(values) == 0:
-        return 1.0 if prior else 0.0
+        return prior
+    weight = prior if prior_weight is None else prior_weight
     weights = Closeness(targets, target, unit)
-    return float((prior + weights @ values) / (prior + weights.sum()))
+    return float((weight * prior + weights @ values) / (weight + weights.sum()))
 
 
 class GaussianProcessFit:
@@ -138,8 +162,14 @@ class RewardHistories:
     ) -> float:
         target = np.asarray(target, dtype=float)
         if self.predictor.kind == "weighted" or len(values) == 0:
+            prose = self.predictor.eq81 == "prose" and not self.reaching[state_action]
             return WeightedEstimate(
-                target, self._targets[state_action], values, prior, self.predictor.distance_unit
+                target,
+                self._targets[state_action],
+                values,
+                prior,
+                self.predictor.distance_unit,
+                prior_weight=1.0 if prose else None,
             )
         fit = self._fits.get((state_action, intrinsic))
         if fit is None:

@@ -12,6 +12,7 @@ import numpy as np
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
 from pydrake.systems.analysis import InitializeParams
 
+from mobee_drake.planning.actuation_noise import NoisyPosture, ValidateNoise
 from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.reaching.targets import TARGET_NAME, TargetObject
 from mobee_drake.station.builder import Station
@@ -27,7 +28,10 @@ class SimulatedRobot:
 
     ``joints`` are the MDP's joints (``space``'s dimensions, in fractions of their ranges); the
     rest of MoBeE's joints stay at home. With ``realtime`` the robot moves in real time (for a
-    station shown in Meshcat).
+    station shown in Meshcat). ``transition_noise`` makes the robot stochastic: every transition
+    is commanded to its goal state's centre plus actuation noise of that standard deviation (a
+    fraction of each joint's range, drawn from ``noise_seed``; see
+    :mod:`mobee_drake.planning.actuation_noise`).
     """
 
     def __init__(
@@ -38,6 +42,8 @@ class SimulatedRobot:
         target_radius: float,
         poll: float = 0.1,
         realtime: bool = False,
+        transition_noise: float = 0.0,
+        noise_seed: int = 0,
     ):
         if not isinstance(station.client, StateActionExecutor):
             raise ValueError("the reach learner's station needs a StateActionAttractor client")
@@ -55,6 +61,8 @@ class SimulatedRobot:
             raise ValueError(
                 f"the MDP's joints {unknown} are not MoBeE's: " + ", ".join(mobee.joints)
             )
+        ValidateNoise(transition_noise)
+        self._noise, self._noise_seed = transition_noise, noise_seed
         self.space, self._poll, self._radius = space, poll, target_radius
         self._columns = np.array([mobee.joints.index(j) for j in joints])
         self._lower, self._upper = mobee.position_limits
@@ -98,7 +106,17 @@ class SimulatedRobot:
             self.simulator.AdvanceTo(self.context.get_time() + self._poll)
 
     def Transition(self, goal: int) -> int:
-        self.executor.StartTransition(self._executor_context, self._Centre(goal))
+        q_star, columns = self._Centre(goal), self._columns
+        q_star[columns] = NoisyPosture(
+            q_star[columns],
+            self._lower[columns],
+            self._upper[columns],
+            self._noise,
+            self._noise_seed,
+            0,
+            self.context.get_time(),
+        )
+        self.executor.StartTransition(self._executor_context, q_star)
         self._Finish()
         return self.State()
 
