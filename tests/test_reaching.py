@@ -706,7 +706,7 @@ class TestEvaluationSums(unittest.TestCase):
         self.assertAlmostEqual(EvaluationSum(evaluation), 0.75 - 30.0)
 
     def test_fingerprints_closed_form(self):
-        from mobee_drake.experiments.ch8_report import FAVOURITES, Fingerprints
+        from mobee_drake.experiments.ch8_measures import FAVOURITES, Fingerprints
 
         self.assertEqual(FAVOURITES, 2)
         # try, problem, state-action: tries 0-1 reach from states 0 and 1 (problems 0, 1), try 2

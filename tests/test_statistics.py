@@ -10,9 +10,12 @@ from scipy import stats
 from mobee_drake.experiments.statistics import (
     CohensD,
     CohensDInterval,
+    ComparePaired,
     CompareRuns,
     CompareToZero,
+    Holm,
     RankBiserialInterval,
+    RatioOfMeans,
     RunMeans,
     RunsForPower,
     Trend,
@@ -245,6 +248,50 @@ class TestTrends(unittest.TestCase):
         self.assertIn("0 of 2 runs above 0", same.Text())
         with self.assertRaisesRegex(ValueError, "at least 2 finite"):
             CompareToZero([1.0])
+
+
+class TestPairedAndFamilies(unittest.TestCase):
+    """Issue 33: paired comparisons on shared seeds, Holm's correction, ratios of means."""
+
+    def test_holm_by_hand(self):
+        # Sorted 0.01, 0.03, 0.04 of m = 3: 0.03, max(0.03, 0.06), max(0.06, 0.04).
+        np.testing.assert_allclose(Holm([0.01, 0.04, 0.03]), [0.03, 0.06, 0.06])
+        np.testing.assert_allclose(Holm([0.5, 0.9]), [1.0, 1.0])
+        adjusted = Holm([0.02, math.nan, 0.01])
+        self.assertTrue(math.isnan(adjusted[1]))
+        np.testing.assert_allclose(adjusted[[0, 2]], [0.02, 0.02])  # m = 2: NaN not counted
+
+    def test_paired_against_scipy(self):
+        rng = np.random.default_rng(4)
+        b = rng.normal(0, 1, 12)
+        a = b + 0.5 + rng.normal(0, 0.3, 12)
+        blocks = np.repeat([0, 1, 2], 4)
+        c = ComparePaired(a, b, blocks)
+        d = a - b
+        self.assertAlmostEqual(c.difference, d.mean())
+        self.assertAlmostEqual(c.t_p, stats.ttest_rel(a, b).pvalue)
+        self.assertAlmostEqual(c.wilcoxon_p, stats.wilcoxon(d).pvalue)
+        self.assertAlmostEqual(c.d_z, d.mean() / d.std(ddof=1))
+        half = stats.t.ppf(0.975, 11) * d.std(ddof=1) / math.sqrt(12)
+        self.assertAlmostEqual(c.high - c.low, 2 * half)
+        self.assertAlmostEqual(c.block_p, stats.f_oneway(d[:4], d[4:8], d[8:]).pvalue)
+        self.assertEqual(c.a_larger, int(np.sum(d > 0)))
+        # Pairing removes the seeds' shared variance: a paired p far below the unpaired one.
+        self.assertLess(c.t_p, stats.ttest_ind(a, b).pvalue)
+        self.assertTrue(math.isnan(ComparePaired(a, b, np.zeros(12)).block_p))
+
+    def test_ratio_of_means_and_its_interval(self):
+        a, b = np.array([2.0, 4.0, 6.0, 8.0]), np.array([1.0, 2.0, 3.0, 4.0])
+        ratio, low, high = RatioOfMeans(a, b, [0, 0, 1, 1])
+        self.assertEqual((ratio, low, high), (2.0, 2.0, 2.0))  # every pair 2:1
+        rng = np.random.default_rng(1)
+        b = rng.uniform(1, 2, 20)
+        a = 1.5 * b * rng.uniform(0.8, 1.2, 20)
+        ratio, low, high = RatioOfMeans(a, b, np.repeat([0, 1], 10), resamples=2000)
+        self.assertAlmostEqual(ratio, a.mean() / b.mean())
+        self.assertLess(low, ratio)
+        self.assertLess(ratio, high)
+        self.assertLess(high - low, 0.4)
 
 
 if __name__ == "__main__":

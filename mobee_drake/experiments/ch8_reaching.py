@@ -27,7 +27,7 @@ by the source's behavioural fingerprints) or ``metres`` (the first reading, in w
 never moves). ``--reach-force`` and ``--distance-unit`` override the preset's; several values of
 either make a sweep: one battery on one MDP, a run of every strategy and seed per combination, and a
 report that scores each combination against the source's behavioural fingerprints
-(:func:`mobee_drake.experiments.ch8_report.Fingerprints`). ``--tie-break`` chooses how the greedy
+(:func:`mobee_drake.experiments.ch8_measures.Fingerprints`). ``--tie-break`` chooses how the greedy
 policy breaks ties of value (the first state-action by default, or a random one). ``--report-only``
 rewrites the plots and report of the finished runs in ``--output`` without running anything.
 

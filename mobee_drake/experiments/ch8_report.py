@@ -9,22 +9,24 @@ import numpy as np
 
 from mobee_drake.experiments.ch8_figures import (
     CumulativeRewardFigure,
-    EvaluationSum,
     FailedTransitionsFigure,
     ProblemTriesFigure,
     ReachesFigure,
     RunLog,
 )
+from mobee_drake.experiments.ch8_measures import (
+    ALIKE_UNTIL,
+    COVERAGE_AT,
+    FAVOURITES,
+    Fingerprints,
+    RobotTimeRatio,
+    RunSums,
+    RunTrends,
+)
 from mobee_drake.experiments.ch8_reaching import SOURCE_HOURS, RunSettings, SettingLabel
 from mobee_drake.experiments.plots import SaveFigure
-from mobee_drake.experiments.statistics import CompareRuns, CompareToZero, RunMeans, Trend
+from mobee_drake.experiments.statistics import CompareRuns, CompareToZero
 from mobee_drake.reaching.strategies import REACH_STRATEGIES
-
-# The reaches a run's favourites (Fig. 8.4) and a window's vertical lines (Fig. 8.7) count.
-FAVOURITES = 2
-# Where the source's fingerprints are read (ch. 8.4.3): greedy and intrinsic alike up to about
-# 800 problem-tries; the intrinsic agent's coverage by 3200.
-ALIKE_UNTIL, COVERAGE_AT = 800, 3200
 
 
 def _BarrierPeriods(results: list[dict]) -> str:
@@ -33,57 +35,6 @@ def _BarrierPeriods(results: list[dict]) -> str:
     if not all("barrier_periods" in r for r in results):
         return "n/a"
     return str(sum(r["barrier_periods"] for r in results))
-
-
-def _TopShare(counts: np.ndarray) -> float:
-    """The share of ``counts`` in its FAVOURITES largest entries (nan when empty)."""
-    total = counts.sum()
-    return float(np.sort(counts)[::-1][:FAVOURITES].sum() / total) if total else math.nan
-
-
-def Fingerprints(run: dict) -> dict:
-    """One run's values of the behaviour the source describes (ch. 8.4.2-8.4.4).
-
-    - ``favourite_share``: at the run's last stage, the share of its evaluations' reaches made
-      from its FAVOURITES most used states (the source's intrinsic agent settles on a few, Fig.
-      8.4; its favourites 489 and 509); ``favourite_reaches``: those reaching state-actions;
-      ``reach_states``: how many states the evaluations reached from; ``evaluation_actions``:
-      actions per evaluation problem-try (1.00: exploitation never moves);
-    - ``line_share``: per window of exploratory problem-tries between consecutive stages (keyed
-      by the window's end), the share of the window's reaches that went to its FAVOURITES most
-      tried reaching state-actions: Fig. 8.7's vertical lines (a few reaches tried on every
-      problem) make it large;
-    - ``coverage``: per stage, the share of the (reach state, problem) pairs tried in the
-      exploratory problem-tries before it (the source's intrinsic agent: almost all 81 x 27 by
-      3200);
-    - ``robot_hours``: the run's simulated time, evaluations included.
-    """
-    k, m = run["num_transitions"], run["num_states"]
-    stages = sorted(int(s) for s in run["evaluations"])
-    last = run["evaluations"][str(stages[-1])]
-    tries = [t for e in last for t in e]
-    counts = np.bincount([t["reach"] - k for t in tries if t["reach"] >= 0], minlength=m)
-    log = RunLog(run)
-    reaches = log[log[:, 2] >= k]
-    line_share, coverage = {}, {}
-    for start, end in zip([0] + stages[:-1], stages):
-        window = reaches[(reaches[:, 0] >= start) & (reaches[:, 0] < end), 2].astype(int) - k
-        if end > start:
-            line_share[end] = _TopShare(np.bincount(window, minlength=m))
-        before = reaches[reaches[:, 0] < end]
-        pairs = {(int(p), int(sa)) for p, sa in zip(before[:, 1], before[:, 2])}
-        coverage[end] = len(pairs) / (len(last[0]) * m)
-    return dict(
-        favourite_share=_TopShare(counts),
-        favourite_reaches=[
-            int(k + s) for s in np.argsort(-counts, kind="stable")[:FAVOURITES] if counts[s]
-        ],
-        reach_states=int(np.count_nonzero(counts)),
-        evaluation_actions=float(np.mean([t["actions"] for t in tries])),
-        line_share=line_share,
-        coverage=coverage,
-        robot_hours=run["simulated_seconds"] / 3600,
-    )
 
 
 def _CompareToZero(values) -> str:
@@ -116,26 +67,6 @@ def _MeanSd(values) -> str:
     if not values:
         return "-"
     return f"{np.mean(values):.2f} ± {np.std(values, ddof=1) if len(values) > 1 else 0.0:.2f}"
-
-
-def _RunSums(runs: list[dict], stage: int, penalties: bool) -> np.ndarray:
-    """One value per run: the mean of its evaluations' sums at ``stage``."""
-    return RunMeans(
-        [[EvaluationSum(e, penalties) for e in r["evaluations"][str(stage)]] for r in runs]
-    )
-
-
-def _RunTrends(runs: list[dict], stages: list[int], penalties: bool) -> list[float]:
-    """One value per run: the trend (:func:`Trend`) of its evaluations' mean sums over
-    ``stages``."""
-    sums = np.array([_RunSums(runs, stage, penalties) for stage in stages])  # stages x runs
-    return [Trend(stages, sums[:, i]) for i in range(len(runs))]
-
-
-def _RobotTimeRatio(by_strategy: dict[str, list[dict]]) -> float:
-    """Random's mean robot time over that of greedy and intrinsic (the source: 1.86)."""
-    hours = {s: np.mean([r["simulated_seconds"] for r in by_strategy[s]]) for s in by_strategy}
-    return hours["random"] / np.mean([hours["greedy"], hours["intrinsic"]])
 
 
 def _WindowAtOrBefore(windows, end: int) -> int | None:
@@ -179,7 +110,7 @@ def _SweepRow(label: str, results: list[dict]) -> str:
     else:
         cells.append("-")
     cells.append(
-        f"{_RobotTimeRatio(by_strategy):.2f}"
+        f"{RobotTimeRatio(by_strategy):.2f}"
         if {"random", "greedy", "intrinsic"} <= set(by_strategy)
         else "-"
     )
@@ -282,7 +213,7 @@ def _RewardSection(results: list[dict], by_strategy: dict, stages) -> list[str]:
             runs = by_strategy[strategy]
             lines.append(
                 f"| {strategy} | {len(runs)} | "
-                + " | ".join(_MeanSd(_RunSums(runs, s, penalties)) for s in stages)
+                + " | ".join(_MeanSd(RunSums(runs, s, penalties)) for s in stages)
                 + " |"
             )
     return lines
@@ -411,13 +342,13 @@ def _ClaimsSection(by_strategy: dict, prints: dict, stages) -> list[str]:
         trended = [s for s in stages if s > 0]
         for penalties, title in ((True, "the source's sum"), (False, "reaches only")):
             for stage in stages:
-                sums = {s: _RunSums(by_strategy[s], stage, penalties) for s in strategies}
+                sums = {s: RunSums(by_strategy[s], stage, penalties) for s in strategies}
                 lines.append(
                     f"- {title}, after {stage} problem-tries, intrinsic minus "
                     + _IntrinsicMinusOthers(sums)
                 )
             if len(trended) >= 2:
-                trends = {s: _RunTrends(by_strategy[s], trended, penalties) for s in strategies}
+                trends = {s: RunTrends(by_strategy[s], trended, penalties) for s in strategies}
                 lines.append(
                     f"- {title}, change per doubling of the problem-tries (per run, the slope of "
                     f"its stage means over log2 of {trended[0]}...{trended[-1]}): intrinsic "
@@ -429,7 +360,7 @@ def _ClaimsSection(by_strategy: dict, prints: dict, stages) -> list[str]:
         lines += [
             "- the source: intrinsic motivation is the least competent after 100 problem-tries, "
             "improves steadily and is clearly the best from about 800 on;",
-            f"- random exploration took {_RobotTimeRatio(by_strategy):.2f} times the robot time "
+            f"- random exploration took {RobotTimeRatio(by_strategy):.2f} times the robot time "
             "of the other two (source: 207 h against 109 and 113 h, 1.86 times); robot hours per "
             "run, random minus the other two's runs: "
             + _Compare(hours["random"], hours["greedy"] + hours["intrinsic"])

@@ -339,3 +339,92 @@ def RunMeans(values_per_run) -> np.ndarray:
             raise ValueError(f"run {i} has no values to average")
         means.append(values.mean())
     return np.array(means)
+
+
+def Holm(p_values) -> np.ndarray:
+    """Holm's step-down adjustment of a family's p-values (in their order; NaN stays NaN and is
+    not counted): the k-th smallest of m becomes max over j <= k of min(1, (m - j + 1) p_(j))."""
+    p = np.asarray(p_values, dtype=float)
+    adjusted = np.full(p.shape, math.nan)
+    finite = np.flatnonzero(np.isfinite(p))
+    order = finite[np.argsort(p[finite], kind="stable")]
+    m, running = len(order), 0.0
+    for rank, index in enumerate(order):
+        running = max(running, min(1.0, (m - rank) * p[index]))
+        adjusted[index] = running
+    return adjusted
+
+
+@dc.dataclass
+class PairedComparison:
+    """Group a against group b on matched runs (the same seed: the same MDP and evaluation
+    seeds), the fields of :func:`ComparePaired`."""
+
+    n: int
+    # The mean of the paired differences a - b, its 95 % t interval and standard deviation.
+    difference: float
+    low: float
+    high: float
+    sd: float
+    # Cohen's d_z: the mean difference over the differences' standard deviation.
+    d_z: float
+    # The paired t-test and Wilcoxon's signed-rank test, two-sided.
+    t_p: float
+    wilcoxon_p: float
+    # Pairs in which a is larger.
+    a_larger: int
+    # Whether the difference depends on the block (the MDP): one-way ANOVA of the differences
+    # over the blocks (NaN with one block, or a block of one pair).
+    block_p: float
+
+    def Text(self, p: float | None = None) -> str:
+        """One line: the difference with its interval, d_z, the paired t-test's p (or ``p``, an
+        adjusted one) and the pairs in a's favour."""
+        shown = self.t_p if p is None else p
+        return (
+            f"{self.difference:+.2f} [{self.low:+.2f}, {self.high:+.2f}] (d_z = "
+            f"{_Number(self.d_z)}, p = {_Number(shown, '.2g')}; {self.a_larger} of {self.n} "
+            "pairs)"
+        )
+
+
+def ComparePaired(a, b, blocks) -> PairedComparison:
+    """Paired comparison of run values ``a`` and ``b`` (run i of a matched with run i of b) in
+    ``blocks`` (one label per pair: its MDP)."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    blocks = np.asarray(blocks)
+    if a.shape != b.shape or a.ndim != 1 or a.size < 2 or blocks.shape != a.shape:
+        raise ValueError(f"pair at least 2 runs, one block each; got {a.size} and {b.size}")
+    d = a - b
+    n, mean, sd = d.size, float(d.mean()), float(d.std(ddof=1))
+    half = stats.t.ppf(0.975, n - 1) * sd / math.sqrt(n)
+    groups = [d[blocks == label] for label in dict.fromkeys(blocks.tolist())]
+    varied = len(groups) > 1 and all(g.size > 1 for g in groups) and np.ptp(d) > 0
+    return PairedComparison(
+        n=n,
+        difference=mean,
+        low=mean - half,
+        high=mean + half,
+        sd=sd,
+        d_z=mean / sd if sd > 0 else math.nan,
+        t_p=float(stats.ttest_rel(a, b).pvalue) if sd > 0 else math.nan,
+        wilcoxon_p=float(stats.wilcoxon(d).pvalue) if np.any(d != 0) else math.nan,
+        a_larger=int(np.sum(d > 0)),
+        block_p=float(stats.f_oneway(*groups).pvalue) if varied else math.nan,
+    )
+
+
+def RatioOfMeans(a, b, blocks, resamples: int = BOOTSTRAP_RESAMPLES) -> tuple[float, float, float]:
+    """mean(a) / mean(b) of matched runs, with a 95 % percentile bootstrap interval that
+    resamples the pairs within each block (seeded: BOOTSTRAP_SEED)."""
+    a, b, blocks = np.asarray(a, dtype=float), np.asarray(b, dtype=float), np.asarray(blocks)
+    if a.shape != b.shape or a.size < 2:
+        raise ValueError(f"a ratio needs at least 2 matched runs, got {a.size} and {b.size}")
+    rng = np.random.default_rng(BOOTSTRAP_SEED)
+    members = [np.flatnonzero(blocks == label) for label in dict.fromkeys(blocks.tolist())]
+    picks = np.concatenate(
+        [rng.choice(m, size=(resamples, m.size)) for m in members], axis=1
+    )  # resamples x pairs
+    ratios = a[picks].mean(axis=1) / b[picks].mean(axis=1)
+    low, high = np.percentile(ratios, [2.5, 97.5])
+    return float(a.mean() / b.mean()), float(low), float(high)
