@@ -206,6 +206,23 @@ class TestBattery(unittest.TestCase):
         robot.Transition(goal)
         self.assertTrue(robot.FeltObject())
 
+    def test_a_noisy_robot_sometimes_settles_in_another_state(self):
+        """Issue 33: with actuation noise (sd 0.2 of each joint's range: a joint leaves its state
+        with probability 2 Phi(-0.625) = 53 %) transitions end elsewhere; without, never."""
+        from mobee_drake.experiments.ch8_reaching import ReachRobot
+
+        space = self.model.space
+        arrived = {}
+        for noise in (0.0, 0.2):
+            robot = ReachRobot(space, 0.05, transition_noise=noise, noise_seed=3)
+            robot.SetProblem(np.array([1.0, 1.0, 1.0]))  # far away
+            arrived[noise] = []
+            for _ in range(6):
+                goal = int(space.action_goal[space.Actions(robot.State())[0]])
+                arrived[noise].append(robot.Transition(goal) == goal)
+        self.assertTrue(all(arrived[0.0]))
+        self.assertFalse(all(arrived[0.2]))
+
     def test_weaker_reach_stops_farther(self):
         from mobee_drake.experiments.ch8_reaching import ReachRobot
 
@@ -284,6 +301,9 @@ class TestBattery(unittest.TestCase):
 
         report = Report(self.output, results)
         self.assertIn("| intrinsic |", report)
+        self.assertIn(
+            "| the source's claim | value compared | unit1_force300 | holds under |", report
+        )
         self.assertIn("| goal_babbling |", report)
         for figure in (
             "8.2_cumulative_reward.png",

@@ -21,6 +21,7 @@ from mobee_drake.experiments.battery import (
     BackendOf,
     Provenance,
 )
+from mobee_drake.experiments.ch8_claims import ClaimsTables
 from mobee_drake.experiments.ch8_reaching import (
     DISTANCE_UNIT_RANGE,
     MDPS,
@@ -36,6 +37,7 @@ from mobee_drake.experiments.ch8_reaching import (
     TrainMdp,
 )
 from mobee_drake.experiments.ch8_report import Report
+from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.owned_folders import ClaimFolder, OwnedFolder
 from mobee_drake.reaching.learner import (
     EVALUATION_HISTORIES,
@@ -49,6 +51,9 @@ from mobee_drake.reaching.predictors import (
     PredictorConfig,
 )
 from mobee_drake.reaching.strategies import REACH_STRATEGIES
+
+# The generated block of docs/reaching.md that --doc rewrites.
+DOC_TABLE = "ch8-claims"
 
 
 def _Parser() -> CommandParser:
@@ -111,6 +116,10 @@ def _Parser() -> CommandParser:
         action="store_true",
         help="run nothing: write the plots and report.md of the finished runs in --output "
         "(runs/*/result.json; batteries of earlier versions too)",
+    )
+    parser.add_argument(
+        "--doc",
+        help="a doc whose generated claims table (block 'ch8-claims') to rewrite from the runs",
     )
     AddBackendArguments(parser, workers=2)
     return parser
@@ -255,6 +264,11 @@ def main(argv=None) -> None:
     output = pathlib.Path(args.output)
     if args.report_only and not output.is_dir():  # (checked before a folder is made)
         parser.error(f"--report-only: {output} is not a folder of reach-learning runs")
+    if args.doc:
+        try:
+            GeneratedTable(args.doc, DOC_TABLE)
+        except (OSError, ValueError) as error:
+            parser.error(f"--doc: {error}")
     ClaimFolder(output, "battery")  # (a file, or a folder of the user's, refused in one line)
     variants = _Variants(args, stages)
     settings = variants[0]
@@ -287,6 +301,9 @@ def main(argv=None) -> None:
     )
     WriteTextAtomically(output / "report.md", text)
     print(text)
+    if args.doc:
+        command = f"mobee-drake experiment ch8 --report-only --output {output} --doc {args.doc}"
+        WriteGeneratedTable(args.doc, DOC_TABLE, command, "\n".join(ClaimsTables(results)))
 
 
 if __name__ == "__main__":

@@ -7,6 +7,7 @@ import pathlib
 
 import numpy as np
 
+from mobee_drake.experiments.ch8_claims import ClaimsTables
 from mobee_drake.experiments.ch8_figures import (
     CumulativeRewardFigure,
     FailedTransitionsFigure,
@@ -124,9 +125,16 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
     groups: dict[str, list[dict]] = {}
     for r in results:
         groups.setdefault(SettingLabel(RunSettings(**r["settings"])), []).append(r)
+    claims = [
+        "## The source's claims, marked per setting (issue 33)",
+        "",
+        *ClaimsTables(results),
+        "",
+    ]
     if len(groups) == 1:
-        return _SettingReport(output, results)
+        return "\n".join(claims) + "\n" + _SettingReport(output, results)
     lines = [
+        *claims,
         "## The source's behavioural fingerprints across the settings (issue 23, point 6)",
         "",
         "Per setting: evaluation actions per problem-try (all strategies; 1.00 means "

@@ -1,0 +1,300 @@
+"""The source's claims of ch. 8.4-8.5 marked from a battery's result files (issue 33).
+
+Each claim is a comparison of strategies on one value per run. Runs are paired by seed: runs of
+one seed share their MDP (:func:`mobee_drake.experiments.ch8_reaching.RunReachBattery`: seed k
+uses MDP k mod ``--mdps``) and their evaluation seeds, so strategies are compared on paired
+differences (:func:`~mobee_drake.experiments.statistics.ComparePaired`, the MDP a block), and a
+claim's comparisons (two other strategies, several stages) are one family under Holm's
+correction. Every setting of the battery (a reading of the source's ambiguities, a distance
+unit, a reach force) is marked on its own; a claim then *holds under* the settings where it is
+reproduced.
+
+Marks: ``reproduced`` (every comparison of the claim in the claimed direction, Holm-adjusted
+p < 0.05), ``not reproduced`` (otherwise; the evidence says whether the difference is reversed
+or not found), ``not testable`` (the runs lack what the claim needs, e.g. the stage or the
+strategy).
+"""
+
+from collections.abc import Callable
+import dataclasses as dc
+import math
+
+import numpy as np
+
+from mobee_drake.experiments.ch8_figures import RunLog
+from mobee_drake.experiments.ch8_measures import Fingerprints, RunSums, RunTrends
+from mobee_drake.experiments.ch8_reaching import RunSettings, SettingLabel
+from mobee_drake.experiments.statistics import (
+    ComparePaired,
+    CompareToZero,
+    Holm,
+    PairedComparison,
+    RatioOfMeans,
+)
+
+REPRODUCED, NOT_REPRODUCED, NOT_TESTABLE = "reproduced", "not reproduced", "not testable"
+ALPHA = 0.05
+# The source's robot hours of random exploration over the other two strategies' (207 h against
+# 109 and 113 h, ch. 8.4.4).
+SOURCE_TIME_RATIO = 207 / np.mean([109, 113])
+# "From about 800 on" (ch. 8.4.1).
+BEST_FROM = 800
+
+
+@dc.dataclass
+class Verdict:
+    """One claim marked on one setting's runs."""
+
+    claim: str
+    setting: str
+    mark: str
+    evidence: str
+
+
+# A setting's runs: per strategy, per seed, the run's result.
+Runs = dict[str, dict[int, dict]]
+
+
+def _Pairs(runs: Runs, a: str, b: str, value: Callable[[dict], float]):
+    """The values of the runs of ``a`` and ``b`` of every seed both have, and the seeds'
+    MDPs."""
+    seeds = sorted(set(runs.get(a, {})) & set(runs.get(b, {})))
+    values_a = [value(runs[a][s]) for s in seeds]
+    values_b = [value(runs[b][s]) for s in seeds]
+    blocks = [runs[a][s]["settings"].get("mdp_seed", 0) for s in seeds]
+    return values_a, values_b, blocks
+
+
+def _Family(runs: Runs, comparisons, larger: bool) -> tuple[str, str]:
+    """Marks a claim made of paired comparisons ``(label, a, b, value)``, each claiming that a's
+    value is ``larger`` (or smaller) than b's; Holm over the family."""
+    done: list[tuple[str, PairedComparison]] = []
+    for label, a, b, value in comparisons:
+        values_a, values_b, blocks = _Pairs(runs, a, b, value)
+        if len(values_a) < 2:
+            return NOT_TESTABLE, f"{label}: fewer than 2 paired runs"
+        done.append((label, ComparePaired(values_a, values_b, blocks)))
+    adjusted = Holm([c.t_p for _, c in done])
+    held = [
+        (c.difference > 0) == larger and p < ALPHA for (_, c), p in zip(done, adjusted, strict=True)
+    ]
+    reversed_ = [
+        (c.difference > 0) != larger and p < ALPHA for (_, c), p in zip(done, adjusted, strict=True)
+    ]
+    evidence = "; ".join(
+        f"{label} {c.Text(p)}" for (label, c), p in zip(done, adjusted, strict=True)
+    )
+    if all(held):
+        return REPRODUCED, evidence
+    found = f"{sum(held)} of {len(held)} comparisons as claimed, {sum(reversed_)} reversed"
+    return NOT_REPRODUCED, f"{found}: {evidence}"
+
+
+def _StageMean(stage: int, penalties: bool) -> Callable[[dict], float]:
+    return lambda run: float(RunSums([run], stage, penalties)[0])
+
+
+def _Trend(penalties: bool) -> Callable[[dict], float]:
+    def Value(run: dict) -> float:
+        stages = sorted(int(s) for s in run["evaluations"] if int(s) > 0)
+        return RunTrends([run], stages, penalties)[0] if len(stages) > 1 else math.nan
+
+    return Value
+
+
+def _Stages(runs: Runs) -> list[int]:
+    """The stages every run of the setting was evaluated at."""
+    every = [set(map(int, r["evaluations"])) for seeds in runs.values() for r in seeds.values()]
+    return sorted(set.intersection(*every)) if every else []
+
+
+def _Trended(runs: Runs) -> list[int]:
+    """The stages a trend is taken over: those after 0."""
+    return [s for s in _Stages(runs) if s > 0]
+
+
+def _OthersThan(runs: Runs, strategy: str) -> list[str]:
+    return [s for s in ("random", "greedy", "intrinsic") if s != strategy and s in runs]
+
+
+def LeastCompetentFirst(runs: Runs, penalties: bool) -> tuple[str, str]:
+    """Ch. 8.4.1: intrinsic motivation is the least competent after 100 problem-tries."""
+    if 100 not in _Stages(runs) or "intrinsic" not in runs:
+        return NOT_TESTABLE, "no evaluations at 100 problem-tries"
+    value = _StageMean(100, penalties)
+    comparisons = [(f"minus {o}", "intrinsic", o, value) for o in _OthersThan(runs, "intrinsic")]
+    return _Family(runs, comparisons, larger=False)
+
+
+def ImprovesSteadily(runs: Runs, penalties: bool) -> tuple[str, str]:
+    """Ch. 8.4.1: intrinsic motivation improves steadily (its trend per doubling > 0)."""
+    if len(runs.get("intrinsic", {})) < 2 or len(_Trended(runs)) < 2:
+        return NOT_TESTABLE, "fewer than 2 intrinsic runs or 2 stages after 0"
+    trends = [_Trend(penalties)(r) for r in runs["intrinsic"].values()]
+    test = CompareToZero(trends)
+    mark = REPRODUCED if test.mean > 0 and test.t_p < ALPHA else NOT_REPRODUCED
+    return mark, f"per doubling {test.Text()}"
+
+
+def ImprovesMoreThanOthers(runs: Runs, penalties: bool) -> tuple[str, str]:
+    """Ch. 8.4.1 read with Fig. 8.2: it improves more than the other strategies."""
+    if len(_Trended(runs)) < 2:
+        return NOT_TESTABLE, "fewer than 2 stages after 0"
+    comparisons = [
+        (f"minus {o}", "intrinsic", o, _Trend(penalties)) for o in _OthersThan(runs, "intrinsic")
+    ]
+    return _Family(runs, comparisons, larger=True)
+
+
+def BestFrom800(runs: Runs, penalties: bool) -> tuple[str, str]:
+    """Ch. 8.4.1: intrinsic motivation is clearly the best from about 800 on (every stage from
+    800, against both others: one family)."""
+    stages = [s for s in _Stages(runs) if s >= BEST_FROM]
+    if not stages or "intrinsic" not in runs:
+        return NOT_TESTABLE, f"no evaluations at {BEST_FROM} or later"
+    comparisons = [
+        (f"at {stage} minus {o}", "intrinsic", o, _StageMean(stage, penalties))
+        for stage in stages
+        for o in _OthersThan(runs, "intrinsic")
+    ]
+    return _Family(runs, comparisons, larger=True)
+
+
+def _Hours(run: dict) -> float:
+    return run["simulated_seconds"] / 3600
+
+
+def RandomTakesLonger(runs: Runs) -> tuple[str, str]:
+    """Ch. 8.4.4: random exploration takes about 1.86 times the robot time of the others."""
+    if not {"random", "greedy", "intrinsic"} <= set(runs):
+        return NOT_TESTABLE, "needs random, greedy and intrinsic runs"
+    seeds = sorted(set(runs["random"]) & set(runs["greedy"]) & set(runs["intrinsic"]))
+    if len(seeds) < 2:
+        return NOT_TESTABLE, "fewer than 2 seeds with all three strategies"
+    random = [_Hours(runs["random"][s]) for s in seeds]
+    others = [np.mean([_Hours(runs[o][s]) for o in ("greedy", "intrinsic")]) for s in seeds]
+    blocks = [runs["random"][s]["settings"].get("mdp_seed", 0) for s in seeds]
+    ratio, low, high = RatioOfMeans(random, others, blocks)
+    evidence = (
+        f"{ratio:.2f} times [{low:.2f}, {high:.2f}] (95 % bootstrap over {len(seeds)} seeds; "
+        f"the source: {SOURCE_TIME_RATIO:.2f})"
+    )
+    return (REPRODUCED if low <= SOURCE_TIME_RATIO <= high else NOT_REPRODUCED), evidence
+
+
+def _FailedPerTry(run: dict) -> float:
+    log = RunLog(run)
+    return float(np.sum(log[:, 6] < 0) / run["settings"]["problem_tries"])
+
+
+def RandomFailsMore(runs: Runs) -> tuple[str, str]:
+    """Fig. 8.8: the random explorer accumulates many more failed transitions."""
+    comparisons = [(f"minus {o}", "random", o, _FailedPerTry) for o in _OthersThan(runs, "random")]
+    if "random" not in runs or not comparisons:
+        return NOT_TESTABLE, "needs random runs and another strategy's"
+    return _Family(runs, comparisons, larger=True)
+
+
+def _LastLineShare(run: dict) -> float:
+    shares = Fingerprints(run)["line_share"]
+    return shares[max(shares)]
+
+
+def GreedysLines(runs: Runs) -> tuple[str, str]:
+    """Fig. 8.7: after about 800, greedy tries a few reaches on every problem (vertical lines),
+    more than the intrinsic agent (the last window's top-2 share of its reaches)."""
+    if not {"greedy", "intrinsic"} <= set(runs) or max(_Stages(runs), default=0) <= BEST_FROM:
+        return NOT_TESTABLE, f"needs greedy and intrinsic runs past {BEST_FROM}"
+    mark, evidence = _Family(
+        runs, [("greedy minus intrinsic", "greedy", "intrinsic", _LastLineShare)], larger=True
+    )
+    level = np.mean([_LastLineShare(r) for r in runs["greedy"].values()])
+    return mark, f"greedy's last-window share {level:.2f}; {evidence}"
+
+
+# (claim as the source makes it, the value compared, the test).
+CLAIMS: tuple[tuple[str, str, Callable[[Runs], tuple[str, str]]], ...] = (
+    (
+        "intrinsic motivation is the least competent after 100 problem-tries (8.4.1)",
+        "the source's sum",
+        lambda runs: LeastCompetentFirst(runs, penalties=True),
+    ),
+    (
+        "the same",
+        "reaches only",
+        lambda runs: LeastCompetentFirst(runs, penalties=False),
+    ),
+    (
+        "it improves steadily (8.4.1)",
+        "the source's sum, change per doubling",
+        lambda runs: ImprovesSteadily(runs, penalties=True),
+    ),
+    (
+        "it improves more than the others (8.4.1, Fig. 8.2)",
+        "the source's sum, change per doubling",
+        lambda runs: ImprovesMoreThanOthers(runs, penalties=True),
+    ),
+    (
+        "it is clearly the best from about 800 on (8.4.1)",
+        "the source's sum",
+        lambda runs: BestFrom800(runs, penalties=True),
+    ),
+    ("the same", "reaches only", lambda runs: BestFrom800(runs, penalties=False)),
+    (
+        "random exploration needs about 1.86 times the robot time (8.4.4)",
+        "robot hours",
+        RandomTakesLonger,
+    ),
+    (
+        "random accumulates many more failed transitions (8.4.4, Fig. 8.8)",
+        "failed transitions per problem-try",
+        RandomFailsMore,
+    ),
+    (
+        "greedy tries a few reaches on every problem after about 800 (Fig. 8.7)",
+        "top-2 share of the last window's reaches",
+        GreedysLines,
+    ),
+)
+
+
+def _BySetting(results: list[dict]) -> dict[str, Runs]:
+    settings: dict[str, Runs] = {}
+    for r in results:
+        run = RunSettings(**r["settings"])
+        by_strategy = settings.setdefault(SettingLabel(run), {})
+        by_strategy.setdefault(run.strategy, {})[run.seed] = r
+    return settings
+
+
+def Verdicts(results: list[dict]) -> list[Verdict]:
+    """Every claim of :data:`CLAIMS` marked on every setting's runs."""
+    return [
+        Verdict(claim, label, *Test(runs))
+        for label, runs in _BySetting(results).items()
+        for claim, _, Test in CLAIMS
+    ]
+
+
+def ClaimsTables(results: list[dict]) -> list[str]:
+    """Markdown: per claim its mark under every setting and the settings it holds under, then
+    the evidence per claim and setting."""
+    verdicts = Verdicts(results)
+    settings = list(dict.fromkeys(v.setting for v in verdicts))
+    lines = [
+        "| the source's claim | value compared | " + " | ".join(settings) + " | holds under |",
+        "|---|---|" + "---|" * (len(settings) + 1),
+    ]
+    for i, (claim, value, _) in enumerate(CLAIMS):
+        marks = verdicts[i :: len(CLAIMS)]  # (setting-major: claim i of every setting)
+        holds = [v.setting for v in marks if v.mark == REPRODUCED]
+        lines.append(
+            f"| {claim} | {value} | "
+            + " | ".join(v.mark for v in marks)
+            + f" | {', '.join(holds) or 'none'} |"
+        )
+    lines += ["", "Evidence (paired by seed; Holm-adjusted p over each claim's comparisons):", ""]
+    for i, (claim, value, _) in enumerate(CLAIMS):
+        for v in verdicts[i :: len(CLAIMS)]:
+            lines.append(f"- {claim} ({value}), {v.setting}: {v.mark}; {v.evidence}")
+    return lines

@@ -1,0 +1,143 @@
+"""The ch. 8 claims table from constructed result files (issue 33): each claim's mark follows
+the constructed runs, paired by seed, under each setting."""
+
+import unittest
+
+import numpy as np
+
+from mobee_drake.experiments import ch8_claims as claims
+from mobee_drake.experiments.statistics import RatioOfMeans
+
+STAGES = (100, 800, 1600)
+PROBLEMS = 3
+# Per strategy, a try's reach reward at each stage (intrinsic: worst first, best from 800).
+REWARDS = {
+    "random": {100: 0.5, 800: 0.5, 1600: 0.5},
+    "greedy": {100: 0.5, 800: 0.55, 1600: 0.6},
+    "intrinsic": {100: 0.2, 800: 0.8, 1600: 0.9},
+}
+HOURS = {"random": 3.0, "greedy": 1.0, "intrinsic": 1.0}
+
+
+def _Log(strategy: str, tries: int, rng) -> list[list[float]]:
+    """Reaches 4-7 (4 transitions, 4 states): greedy on reach 4 alone, the others spread; random
+    fails a transition before every reach."""
+    log = []
+    for t in range(tries):
+        reach = 4 if strategy == "greedy" else 4 + int(rng.integers(4))
+        if strategy == "random" and rng.random() < 0.8:
+            log.append([t, t % PROBLEMS, 0, 0, 0, 0.0, -10.0, 0, 0, 0])
+        log.append([t, t % PROBLEMS, reach, reach - 4, reach - 4, 1.0, 0.5, 0, 0, 0])
+    return log
+
+
+def _Run(strategy: str, seed: int, rule: str = "strict", shift: float = 0.0) -> dict:
+    rng = np.random.default_rng([seed, len(strategy)])
+    # The seed's shared luck (the same for every strategy), and the run's own.
+    noise = 0.01 * (seed % 3) + 0.01 * rng.standard_normal()
+    evaluations = {
+        str(stage): [
+            [
+                dict(problem=p, actions=1, reward=REWARDS[strategy][stage] + noise + shift,
+                     reach=4, failed_transitions=0)
+                for p in range(PROBLEMS)
+            ]
+            for _ in range(2)
+        ]
+        for stage in STAGES
+    }  # fmt: skip
+    return dict(
+        settings=dict(
+            strategy=strategy, seed=seed, problem_tries=STAGES[-1], stages=list(STAGES),
+            evaluations=2, checkpoint_every=50, plateau_rule=rule, distance_unit=0.03,
+            reach_force=300.0, mdp_seed=seed % 2,
+        ),
+        evaluations=evaluations,
+        log=_Log(strategy, STAGES[-1], rng),
+        simulated_seconds=3600.0 * HOURS[strategy] * (1 + 0.03 * rng.standard_normal()),
+        wall_seconds=1.0,
+        penetrating_steps=0,
+        num_transitions=4,
+        num_states=4,
+    )  # fmt: skip
+
+
+def _Marks(results) -> dict[tuple[int, str], str]:
+    verdicts = claims.Verdicts(results)
+    n = len(claims.CLAIMS)
+    return {(i % n, v.setting): v.mark for i, v in enumerate(verdicts)}
+
+
+class TestClaims(unittest.TestCase):
+    def setUp(self):
+        self.strict = [_Run(s, k) for s in REWARDS for k in range(6)]
+
+    def test_marks_follow_the_constructed_runs(self):
+        marks = _Marks(self.strict)
+        setting = "unit0.03_force300"
+        self.assertEqual(
+            [marks[i, setting] for i in range(len(claims.CLAIMS))],
+            [
+                claims.REPRODUCED,  # least competent at 100 (the source's sum)
+                claims.REPRODUCED,  # the same, reaches only
+                claims.REPRODUCED,  # improves
+                claims.REPRODUCED,  # more than the others
+                claims.REPRODUCED,  # best from 800 (both sums)
+                claims.REPRODUCED,
+                claims.NOT_REPRODUCED,  # 3 times the robot time, not the source's 1.86
+                claims.REPRODUCED,  # random's failed transitions
+                claims.REPRODUCED,  # greedy's lines
+            ],
+        )
+
+    def test_a_setting_where_intrinsic_is_level_is_marked_on_its_own(self):
+        level = [
+            _Run(s, k, rule="arrival", shift=0.5 - REWARDS[s][100])
+            for s in REWARDS
+            for k in range(6)
+        ]
+        for run in level:  # every strategy 0.5 at every stage
+            for evaluations in run["evaluations"].values():
+                for evaluation in evaluations:
+                    for t in evaluation:
+                        t["reward"] = 0.5 + 0.01 * (run["settings"]["seed"] % 3)
+                        t["reward"] += 0.01 * np.sin(run["simulated_seconds"])  # the run's own
+        marks = _Marks(self.strict + level)
+        arrival = "unit0.03_force300_rule-arrival"
+        self.assertEqual(marks[0, arrival], claims.NOT_REPRODUCED)
+        self.assertEqual(marks[4, arrival], claims.NOT_REPRODUCED)
+        self.assertEqual(marks[0, "unit0.03_force300"], claims.REPRODUCED)
+        table = claims.ClaimsTables(self.strict + level)
+        row = next(line for line in table if line.startswith("| intrinsic motivation is the least"))
+        self.assertTrue(row.endswith("| reproduced | not reproduced | unit0.03_force300 |"))
+
+    def test_the_ratio_and_a_missing_stage(self):
+        verdicts = claims.Verdicts(self.strict)
+        ratio = next(v for v in verdicts if v.claim.startswith("random exploration needs"))
+        by = {s: {r["settings"]["seed"]: r for r in self.strict if r["settings"]["strategy"] == s}
+              for s in REWARDS}  # fmt: skip
+        random = [by["random"][k]["simulated_seconds"] / 3600 for k in range(6)]
+        others = [
+            np.mean([by[s][k]["simulated_seconds"] / 3600 for s in ("greedy", "intrinsic")])
+            for k in range(6)
+        ]
+        value, low, high = RatioOfMeans(random, others, [k % 2 for k in range(6)])
+        self.assertTrue(ratio.evidence.startswith(f"{value:.2f} times [{low:.2f}, {high:.2f}]"))
+        self.assertGreater(low, claims.SOURCE_TIME_RATIO)
+        # Random at the source's ratio of the others' time, run by run: reproduced.
+        for run in self.strict:
+            if run["settings"]["strategy"] == "random":
+                seed = run["settings"]["seed"]
+                run["simulated_seconds"] = claims.SOURCE_TIME_RATIO * np.mean(
+                    [by[s][seed]["simulated_seconds"] for s in ("greedy", "intrinsic")]
+                )
+        self.assertEqual(_Marks(self.strict)[6, "unit0.03_force300"], claims.REPRODUCED)
+        late = [r for r in self.strict]
+        for run in late:
+            run["evaluations"].pop("100")
+        marks = _Marks(late)
+        self.assertEqual(marks[0, "unit0.03_force300"], claims.NOT_TESTABLE)
+
+
+if __name__ == "__main__":
+    unittest.main()
