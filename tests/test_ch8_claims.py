@@ -6,6 +6,7 @@ import unittest
 import numpy as np
 
 from mobee_drake.experiments import ch8_claims as claims
+from mobee_drake.experiments.ch8_reaching import ReachRun
 from mobee_drake.experiments.statistics import RatioOfMeans
 
 STAGES = (100, 800, 1600)
@@ -46,7 +47,7 @@ def _Run(strategy: str, seed: int, rule: str = "strict", shift: float = 0.0) -> 
         ]
         for stage in STAGES
     }  # fmt: skip
-    return dict(
+    return ReachRun.FromJson(dict(
         settings=dict(
             strategy=strategy, seed=seed, problem_tries=STAGES[-1], stages=list(STAGES),
             evaluations=2, checkpoint_every=50, plateau_rule=rule, distance_unit=0.03,
@@ -59,7 +60,7 @@ def _Run(strategy: str, seed: int, rule: str = "strict", shift: float = 0.0) -> 
         penetrating_steps=0,
         num_transitions=4,
         num_states=4,
-    )  # fmt: skip
+    ))  # fmt: skip
 
 
 def _Marks(results) -> dict[tuple[int, str], str]:
@@ -97,11 +98,11 @@ class TestClaims(unittest.TestCase):
             for k in range(6)
         ]
         for run in level:  # every strategy 0.5 at every stage
-            for evaluations in run["evaluations"].values():
+            for evaluations in run.evaluations.values():
                 for evaluation in evaluations:
                     for t in evaluation:
-                        t["reward"] = 0.5 + 0.01 * (run["settings"]["seed"] % 3)
-                        t["reward"] += 0.01 * np.sin(run["simulated_seconds"])  # the run's own
+                        t["reward"] = 0.5 + 0.01 * (run.settings.seed % 3)
+                        t["reward"] += 0.01 * np.sin(run.simulated_seconds)  # the run's own
         marks = _Marks(self.strict + level)
         arrival = "unit0.03_force300_rule-arrival"
         self.assertEqual(marks[0, arrival], claims.NOT_REPRODUCED)
@@ -114,11 +115,11 @@ class TestClaims(unittest.TestCase):
     def test_the_ratio_and_a_missing_stage(self):
         verdicts = claims.Verdicts(self.strict)
         ratio = next(v for v in verdicts if v.claim.startswith("random exploration needs"))
-        by = {s: {r["settings"]["seed"]: r for r in self.strict if r["settings"]["strategy"] == s}
+        by = {s: {r.settings.seed: r for r in self.strict if r.settings.strategy == s}
               for s in REWARDS}  # fmt: skip
-        random = [by["random"][k]["simulated_seconds"] / 3600 for k in range(6)]
+        random = [by["random"][k].simulated_seconds / 3600 for k in range(6)]
         others = [
-            np.mean([by[s][k]["simulated_seconds"] / 3600 for s in ("greedy", "intrinsic")])
+            np.mean([by[s][k].simulated_seconds / 3600 for s in ("greedy", "intrinsic")])
             for k in range(6)
         ]
         value, low, high = RatioOfMeans(random, others, [k % 2 for k in range(6)])
@@ -126,15 +127,15 @@ class TestClaims(unittest.TestCase):
         self.assertGreater(low, claims.SOURCE_TIME_RATIO)
         # Random at the source's ratio of the others' time, run by run: reproduced.
         for run in self.strict:
-            if run["settings"]["strategy"] == "random":
-                seed = run["settings"]["seed"]
-                run["simulated_seconds"] = claims.SOURCE_TIME_RATIO * np.mean(
-                    [by[s][seed]["simulated_seconds"] for s in ("greedy", "intrinsic")]
+            if run.settings.strategy == "random":
+                seed = run.settings.seed
+                run.simulated_seconds = claims.SOURCE_TIME_RATIO * np.mean(
+                    [by[s][seed].simulated_seconds for s in ("greedy", "intrinsic")]
                 )
         self.assertEqual(_Marks(self.strict)[6, "unit0.03_force300"], claims.REPRODUCED)
         late = [r for r in self.strict]
         for run in late:
-            run["evaluations"].pop("100")
+            run.evaluations.pop(100)
         marks = _Marks(late)
         self.assertEqual(marks[0, "unit0.03_force300"], claims.NOT_TESTABLE)
 

@@ -19,6 +19,7 @@ from mobee_drake.experiments import (
     trm_roadmaps,
 )
 from mobee_drake.experiments.ch7_model_learning import MovingBoxResult, PlanningRun
+from mobee_drake.experiments.ch8_reaching import ReachRun
 from mobee_drake.experiments.exploration import ExplorationRun
 from mobee_drake.experiments.plots import SaveFigure
 from mobee_drake.planning.state_space import Lattice
@@ -198,7 +199,7 @@ class TestCh7Figures(FigureTest):
 class TestCh8Figures(FigureTest):
     K, M, PROBLEMS, STAGES = 12, 4, 5, [0, 10]
 
-    def Run(self, strategy: str, seed: int) -> dict:
+    def Run(self, strategy: str, seed: int) -> ReachRun:
         """A run of 10 problem-tries, each a transition (some failing) then a reach."""
         log = []
         for attempt in range(10):
@@ -222,11 +223,18 @@ class TestCh8Figures(FigureTest):
             ]
             for stage in self.STAGES
         }
-        return dict(
-            settings=dict(strategy=strategy, seed=seed, problem_tries=10),
-            log=log,
-            evaluations=evaluations,
-        )
+        return ReachRun.FromJson(
+            dict(
+                settings=dict(
+                    strategy=strategy, seed=seed, problem_tries=10, stages=self.STAGES,
+                    evaluations=2, checkpoint_every=5,
+                ),
+                log=log,
+                evaluations=evaluations,
+                simulated_seconds=1.0, wall_seconds=1.0, penetrating_steps=0,
+                num_transitions=self.K, num_states=self.M,
+            )
+        )  # fmt: skip
 
     def test_figures(self):
         by_strategy = {s: [self.Run(s, seed) for seed in range(2)] for s in ("random", "intrinsic")}

@@ -297,9 +297,10 @@ class TestBattery(unittest.TestCase):
                 self.assertEqual(sorted(t["problem"] for t in evaluation[0]), list(range(27)))
         # Fresh learners evaluate alike (same start, same greedy ties from the same seed).
         self.assertEqual(len({json.dumps(r["evaluations"]["0"]) for r in results}), 1)
+        from mobee_drake.experiments.ch8_reaching import ReachRun
         from mobee_drake.experiments.ch8_report import Report
 
-        report = Report(self.output, results)
+        report = Report(self.output, [ReachRun.FromJson(r) for r in results])
         self.assertIn("| intrinsic |", report)
         self.assertIn(
             "| the source's claim | value compared | unit1_force300 | holds under |", report

@@ -23,7 +23,7 @@ import numpy as np
 
 from mobee_drake.experiments.ch8_figures import RunLog
 from mobee_drake.experiments.ch8_measures import Fingerprints, RunSums, RunTrends
-from mobee_drake.experiments.ch8_reaching import RunSettings, SettingLabel
+from mobee_drake.experiments.ch8_reaching import ReachRun, SettingLabel
 from mobee_drake.experiments.statistics import (
     ComparePaired,
     CompareToZero,
@@ -52,16 +52,16 @@ class Verdict:
 
 
 # A setting's runs: per strategy, per seed, the run's result.
-Runs = dict[str, dict[int, dict]]
+Runs = dict[str, dict[int, ReachRun]]
 
 
-def _Pairs(runs: Runs, a: str, b: str, value: Callable[[dict], float]):
+def _Pairs(runs: Runs, a: str, b: str, value: Callable[[ReachRun], float]):
     """The values of the runs of ``a`` and ``b`` of every seed both have, and the seeds'
     MDPs."""
     seeds = sorted(set(runs.get(a, {})) & set(runs.get(b, {})))
     values_a = [value(runs[a][s]) for s in seeds]
     values_b = [value(runs[b][s]) for s in seeds]
-    blocks = [runs[a][s]["settings"].get("mdp_seed", 0) for s in seeds]
+    blocks = [runs[a][s].settings.mdp_seed for s in seeds]
     return values_a, values_b, blocks
 
 
@@ -90,13 +90,13 @@ def _Family(runs: Runs, comparisons, larger: bool) -> tuple[str, str]:
     return NOT_REPRODUCED, f"{found}: {evidence}"
 
 
-def _StageMean(stage: int, penalties: bool) -> Callable[[dict], float]:
+def _StageMean(stage: int, penalties: bool) -> Callable[[ReachRun], float]:
     return lambda run: float(RunSums([run], stage, penalties)[0])
 
 
-def _Trend(penalties: bool) -> Callable[[dict], float]:
-    def Value(run: dict) -> float:
-        stages = sorted(int(s) for s in run["evaluations"] if int(s) > 0)
+def _Trend(penalties: bool) -> Callable[[ReachRun], float]:
+    def Value(run: ReachRun) -> float:
+        stages = [s for s in run.stages if s > 0]
         return RunTrends([run], stages, penalties)[0] if len(stages) > 1 else math.nan
 
     return Value
@@ -104,7 +104,7 @@ def _Trend(penalties: bool) -> Callable[[dict], float]:
 
 def _Stages(runs: Runs) -> list[int]:
     """The stages every run of the setting was evaluated at."""
-    every = [set(map(int, r["evaluations"])) for seeds in runs.values() for r in seeds.values()]
+    every = [set(r.evaluations) for seeds in runs.values() for r in seeds.values()]
     return sorted(set.intersection(*every)) if every else []
 
 
@@ -160,8 +160,8 @@ def BestFrom800(runs: Runs, penalties: bool) -> tuple[str, str]:
     return _Family(runs, comparisons, larger=True)
 
 
-def _Hours(run: dict) -> float:
-    return run["simulated_seconds"] / 3600
+def _Hours(run: ReachRun) -> float:
+    return run.simulated_seconds / 3600
 
 
 def RandomTakesLonger(runs: Runs) -> tuple[str, str]:
@@ -173,7 +173,7 @@ def RandomTakesLonger(runs: Runs) -> tuple[str, str]:
         return NOT_TESTABLE, "fewer than 2 seeds with all three strategies"
     random = [_Hours(runs["random"][s]) for s in seeds]
     others = [np.mean([_Hours(runs[o][s]) for o in ("greedy", "intrinsic")]) for s in seeds]
-    blocks = [runs["random"][s]["settings"].get("mdp_seed", 0) for s in seeds]
+    blocks = [runs["random"][s].settings.mdp_seed for s in seeds]
     ratio, low, high = RatioOfMeans(random, others, blocks)
     evidence = (
         f"{ratio:.2f} times [{low:.2f}, {high:.2f}] (95 % bootstrap over {len(seeds)} seeds; "
@@ -182,9 +182,9 @@ def RandomTakesLonger(runs: Runs) -> tuple[str, str]:
     return (REPRODUCED if low <= SOURCE_TIME_RATIO <= high else NOT_REPRODUCED), evidence
 
 
-def _FailedPerTry(run: dict) -> float:
+def _FailedPerTry(run: ReachRun) -> float:
     log = RunLog(run)
-    return float(np.sum(log[:, 6] < 0) / run["settings"]["problem_tries"])
+    return float(np.sum(log[:, 6] < 0) / run.settings.problem_tries)
 
 
 def RandomFailsMore(runs: Runs) -> tuple[str, str]:
@@ -195,7 +195,7 @@ def RandomFailsMore(runs: Runs) -> tuple[str, str]:
     return _Family(runs, comparisons, larger=True)
 
 
-def _LastLineShare(run: dict) -> float:
+def _LastLineShare(run: ReachRun) -> float:
     shares = Fingerprints(run)["line_share"]
     return shares[max(shares)]
 
@@ -258,16 +258,15 @@ CLAIMS: tuple[tuple[str, str, Callable[[Runs], tuple[str, str]]], ...] = (
 )
 
 
-def _BySetting(results: list[dict]) -> dict[str, Runs]:
+def _BySetting(results: list[ReachRun]) -> dict[str, Runs]:
     settings: dict[str, Runs] = {}
     for r in results:
-        run = RunSettings(**r["settings"])
-        by_strategy = settings.setdefault(SettingLabel(run), {})
-        by_strategy.setdefault(run.strategy, {})[run.seed] = r
+        by_strategy = settings.setdefault(SettingLabel(r.settings), {})
+        by_strategy.setdefault(r.strategy, {})[r.settings.seed] = r
     return settings
 
 
-def Verdicts(results: list[dict]) -> list[Verdict]:
+def Verdicts(results: list[ReachRun]) -> list[Verdict]:
     """Every claim of :data:`CLAIMS` marked on every setting's runs."""
     return [
         Verdict(claim, label, *Test(runs))
@@ -276,7 +275,7 @@ def Verdicts(results: list[dict]) -> list[Verdict]:
     ]
 
 
-def ClaimsTables(results: list[dict]) -> list[str]:
+def ClaimsTables(results: list[ReachRun]) -> list[str]:
     """Markdown: per claim its mark under every setting and the settings it holds under, then
     the evidence per claim and setting."""
     verdicts = Verdicts(results)

@@ -23,7 +23,7 @@ from mobee_drake.experiments.arguments import (
     PositiveFloat,
     PositiveInt,
 )
-from mobee_drake.experiments.ch8_reaching import AGENT, ReachRobot
+from mobee_drake.experiments.ch8_reaching import AGENT, ReachRobot, ReachRun
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
 from mobee_drake.reaching.discounting import (
     BestOverOwn,
@@ -169,14 +169,14 @@ def _PrintReplays(args, model) -> None:
     """Each run of ``--runs`` replayed: its rewards, eq. 8.5's spread and where greedy moves."""
     space, counts = model.space, model.transitions.counts
     for path in args.runs:
-        run = json.loads(pathlib.Path(path).read_text())
-        settings = run["settings"]
-        unit = settings.get("distance_unit", 1.0)
+        run = ReachRun.FromJson(json.loads(pathlib.Path(path).read_text()))
+        unit = run.settings.distance_unit
         config = ReachLearningConfig(
-            gamma=args.gamma, predictor=PredictorConfig(settings["predictor"], distance_unit=unit)
+            gamma=args.gamma,
+            predictor=PredictorConfig(run.settings.predictor, distance_unit=unit),
         )
         replay = ReachLearner(space, counts, LoadTargetGrid().Centres(), config)
-        log = np.array(run["log"])
+        log = np.array(run.log)
         for row in log:
             replay.histories.Record(int(row[2]), row[7:], row[5], row[6])
         rewards = log[log[:, 2] >= replay.num_transitions, 6]

@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 
+from mobee_drake.experiments.ch8_reaching import ReachRun
 from mobee_drake.experiments.plots import Figure, StackedBars, plt
 from mobee_drake.reaching.learner import (
     LOG_COLUMNS,
@@ -26,31 +27,28 @@ def EvaluationSum(evaluation: list[dict], penalties: bool = True) -> float:
     return reaches + FAILED_TRANSITION_REWARD * sum(r["failed_transitions"] for r in evaluation)
 
 
-def RunLog(run: dict) -> np.ndarray:
+def RunLog(run: ReachRun) -> np.ndarray:
     """A run's log of actions, one row per action (columns: LOG_COLUMNS)."""
-    return np.array(run["log"]).reshape(-1, len(LOG_COLUMNS))
+    return np.array(run.log).reshape(-1, len(LOG_COLUMNS))
 
 
-def _Cumulatives(runs: list[dict], stages: list[int], penalties: bool = True) -> np.ndarray:
+def _Cumulatives(runs: list[ReachRun], stages: list[int], penalties: bool = True) -> np.ndarray:
     """The summed reward of every evaluation (:func:`EvaluationSum`): runs x stages x
     evaluations."""
     return np.array(
         [
-            [
-                [EvaluationSum(e, penalties) for e in r["evaluations"][str(stage)]]
-                for stage in stages
-            ]
+            [[EvaluationSum(e, penalties) for e in r.evaluations[stage]] for stage in stages]
             for r in runs
         ]
     )
 
 
-def _Seeds(runs: list[dict], repeat: int = 1) -> list[str]:
+def _Seeds(runs: list[ReachRun], repeat: int = 1) -> list[str]:
     """Legend labels of the runs' seeds, each ``repeat`` times (one per stacked row)."""
-    return [f"seed {r['settings']['seed']}" for r in runs for _ in range(repeat)]
+    return [f"seed {r.settings.seed}" for r in runs for _ in range(repeat)]
 
 
-def CumulativeRewardFigure(by_strategy: dict[str, list[dict]], stages: list[int]) -> Figure:
+def CumulativeRewardFigure(by_strategy: dict[str, list[ReachRun]], stages: list[int]) -> Figure:
     """Fig. 8.2: the cumulative reward of every evaluation, stacked per stage, one colour per
     seed (its evaluations split by white edges): the reaches' rewards as bars, and a black tick
     where the stack ends with the failed transitions' penalties counted (the source's sum)."""
@@ -87,7 +85,7 @@ def CumulativeRewardFigure(by_strategy: dict[str, list[dict]], stages: list[int]
     return figure
 
 
-def ReachesFigure(strategy: str, runs: list[dict], stages: list[int], k: int, m: int) -> Figure:
+def ReachesFigure(strategy: str, runs: list[ReachRun], stages: list[int], k: int, m: int) -> Figure:
     """Fig. 8.4-8.6: the reaching state-actions chosen in evaluations, per stage, seeds
     stacked (``k`` transitions, ``m`` states)."""
     figure, axes = plt.subplots(len(stages), 1, figsize=(12, 2.6 * len(stages)), squeeze=False)
@@ -95,12 +93,7 @@ def ReachesFigure(strategy: str, runs: list[dict], stages: list[int], k: int, m:
         counts = np.array(
             [
                 np.bincount(
-                    [
-                        t["reach"] - k
-                        for e in r["evaluations"][str(stage)]
-                        for t in e
-                        if t["reach"] >= 0
-                    ],
+                    [t["reach"] - k for e in r.evaluations[stage] for t in e if t["reach"] >= 0],
                     minlength=m,
                 )
                 for r in runs
@@ -117,7 +110,7 @@ def ReachesFigure(strategy: str, runs: list[dict], stages: list[int], k: int, m:
 
 
 def ProblemTriesFigure(
-    by_strategy: dict[str, list[dict]], stages: list[int], k: int, m: int
+    by_strategy: dict[str, list[ReachRun]], stages: list[int], k: int, m: int
 ) -> Figure:
     """Fig. 8.7: exploratory tries per problem (row) and state-action (column) before each
     stage, mean over seeds, one column of images per strategy."""
@@ -127,7 +120,7 @@ def ProblemTriesFigure(
         figsize=(6.5 * len(by_strategy), 2.6 * len(stages)),
         squeeze=False,
     )
-    num_problems = len(next(iter(by_strategy.values()))[0]["evaluations"][str(stages[0])][0])
+    num_problems = len(next(iter(by_strategy.values()))[0].evaluations[stages[0]][0])
     for column, (strategy, runs) in enumerate(by_strategy.items()):
         for row, stage in enumerate(stages):
             image = np.zeros((num_problems, k + m))
@@ -148,7 +141,7 @@ def ProblemTriesFigure(
     return figure
 
 
-def FailedTransitionsFigure(by_strategy: dict[str, list[dict]], k: int) -> Figure:
+def FailedTransitionsFigure(by_strategy: dict[str, list[ReachRun]], k: int) -> Figure:
     """Fig. 8.8: failed transitions (reward -10) per transition state-action, seeds stacked."""
     figure, axes = plt.subplots(
         len(by_strategy), 1, figsize=(12, 3.2 * len(by_strategy)), squeeze=False
@@ -163,6 +156,6 @@ def FailedTransitionsFigure(by_strategy: dict[str, list[dict]], k: int) -> Figur
             xlabel="transition state-action [index]",
             ylabel="failed transitions [count]",
             title=f"{strategy}: failed transitions (reward -10) in "
-            f"{runs[0]['settings']['problem_tries']} problem-tries per seed, seeds stacked",
+            f"{runs[0].settings.problem_tries} problem-tries per seed, seeds stacked",
         )
     return figure

@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from mobee_drake.experiments.ch8_figures import EvaluationSum, RunLog
+from mobee_drake.experiments.ch8_reaching import ReachRun
 from mobee_drake.experiments.statistics import RunMeans, Trend
 
 # The reaches a run's favourites (Fig. 8.4) and a window's vertical lines (Fig. 8.7) count.
@@ -22,7 +23,7 @@ def _TopShare(counts: np.ndarray) -> float:
     return float(np.sort(counts)[::-1][:FAVOURITES].sum() / total) if total else math.nan
 
 
-def Fingerprints(run: dict) -> dict:
+def Fingerprints(run: ReachRun) -> dict:
     """One run's values of the behaviour the source describes (ch. 8.4.2-8.4.4).
 
     - ``favourite_share``: at the run's last stage, the share of its evaluations' reaches made
@@ -39,9 +40,9 @@ def Fingerprints(run: dict) -> dict:
       3200);
     - ``robot_hours``: the run's simulated time, evaluations included.
     """
-    k, m = run["num_transitions"], run["num_states"]
-    stages = sorted(int(s) for s in run["evaluations"])
-    last = run["evaluations"][str(stages[-1])]
+    k, m = run.num_transitions, run.num_states
+    stages = run.stages
+    last = run.evaluations[stages[-1]]
     tries = [t for e in last for t in e]
     counts = np.bincount([t["reach"] - k for t in tries if t["reach"] >= 0], minlength=m)
     log = RunLog(run)
@@ -63,25 +64,23 @@ def Fingerprints(run: dict) -> dict:
         evaluation_actions=float(np.mean([t["actions"] for t in tries])),
         line_share=line_share,
         coverage=coverage,
-        robot_hours=run["simulated_seconds"] / 3600,
+        robot_hours=run.simulated_seconds / 3600,
     )
 
 
-def RunSums(runs: list[dict], stage: int, penalties: bool) -> np.ndarray:
+def RunSums(runs: list[ReachRun], stage: int, penalties: bool) -> np.ndarray:
     """One value per run: the mean of its evaluations' sums at ``stage``."""
-    return RunMeans(
-        [[EvaluationSum(e, penalties) for e in r["evaluations"][str(stage)]] for r in runs]
-    )
+    return RunMeans([[EvaluationSum(e, penalties) for e in r.evaluations[stage]] for r in runs])
 
 
-def RunTrends(runs: list[dict], stages: list[int], penalties: bool) -> list[float]:
+def RunTrends(runs: list[ReachRun], stages: list[int], penalties: bool) -> list[float]:
     """One value per run: the trend (:func:`Trend`) of its evaluations' mean sums over
     ``stages``."""
     sums = np.array([RunSums(runs, stage, penalties) for stage in stages])  # stages x runs
     return [Trend(stages, sums[:, i]) for i in range(len(runs))]
 
 
-def RobotTimeRatio(by_strategy: dict[str, list[dict]]) -> float:
+def RobotTimeRatio(by_strategy: dict[str, list[ReachRun]]) -> float:
     """Random's mean robot time over that of greedy and intrinsic (the source: 1.86)."""
-    hours = {s: np.mean([r["simulated_seconds"] for r in by_strategy[s]]) for s in by_strategy}
+    hours = {s: np.mean([r.simulated_seconds for r in by_strategy[s]]) for s in by_strategy}
     return hours["random"] / np.mean([hours["greedy"], hours["intrinsic"]])

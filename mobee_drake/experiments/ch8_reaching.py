@@ -216,6 +216,67 @@ REACH_PRESETS = {
 }
 
 
+@dc.dataclass
+class ReachRun:
+    """What one reach-learning run produced (:func:`RunOne`; a battery job's result).
+
+    Attributes:
+        settings: The run's settings.
+        evaluations: Per stage (problem-tries done), its evaluations, each a list of the
+            problem-tries' :class:`~mobee_drake.reaching.learner.TryResult` as dicts.
+        log: The learner's log of actions (columns: ``reaching.learner.LOG_COLUMNS``).
+        simulated_seconds: Robot time, evaluations included.
+        wall_seconds: Wall time of the run (over its resumptions).
+        penetrating_steps: Control periods in which two solids penetrated.
+        num_transitions: The MDP's transition state-actions (the reaches follow them).
+        num_states: The MDP's states.
+        barrier_periods: Periods the safety barrier acted (None: a run from before it was
+            counted).
+        mdp: ``--mdp simultaneous``: the MDP learned with the reaches (see ``_LearnedMdp``).
+    """
+
+    settings: RunSettings
+    evaluations: dict[int, list[list[dict]]]
+    log: list[list[float]]
+    simulated_seconds: float
+    wall_seconds: float
+    penetrating_steps: int
+    num_transitions: int
+    num_states: int
+    barrier_periods: int | None = None
+    mdp: dict | None = None
+
+    @property
+    def strategy(self) -> str:
+        return self.settings.strategy
+
+    @property
+    def stages(self) -> list[int]:
+        """The stages the run was evaluated at, in order."""
+        return sorted(self.evaluations)
+
+    def ToJson(self) -> dict:
+        """The result as written to the run's folder (stages as JSON's string keys)."""
+        data = dc.asdict(self)
+        data["evaluations"] = {str(stage): e for stage, e in self.evaluations.items()}
+        return data
+
+    @classmethod
+    def FromJson(cls, data: dict) -> "ReachRun":
+        """A result as read back (runs of earlier versions too: before the tie-break option,
+        ties were drawn at random)."""
+        settings = dict(data["settings"])
+        settings.setdefault("tie_break", "random")
+        fields = {f.name for f in dc.fields(cls)}
+        return cls(
+            **{key: value for key, value in data.items() if key in fields}
+            | dict(
+                settings=RunSettings(**settings),
+                evaluations={int(stage): e for stage, e in data["evaluations"].items()},
+            )
+        )
+
+
 def ReachScenario(reach_force: float = ReachForcing().force) -> Scenario:
     """The reach learner's headless kinematic iCub: MoBeE on the right shoulder and elbow,
     reaching with ``reach_force`` on the palm."""
@@ -372,9 +433,9 @@ def RunOne(
     if settings.mdp == "simultaneous":
         extra = dict(mdp=_LearnedMdp(run_dir, learner, model))
     safety = robot.Safety()
-    result = dict(
-        settings=dc.asdict(settings),
-        evaluations=data["evaluations"],
+    result = ReachRun(
+        settings=settings,
+        evaluations={int(stage): e for stage, e in data["evaluations"].items()},
         log=arrays["log"].tolist(),
         simulated_seconds=robot.simulated_seconds,
         wall_seconds=data["wall_seconds"],
@@ -384,7 +445,7 @@ def RunOne(
         num_states=learner.space.num_states,
         **extra,
     )
-    return result
+    return result.ToJson()
 
 
 def ReachJob(run: RunFolder, mdp: str, settings: dict) -> dict:
@@ -419,7 +480,7 @@ def RunReachBattery(
     mdp_tries: int,
     backend: Backend,
     mdps: int = 1,
-) -> list[dict]:
+) -> list["ReachRun"]:
     """The MDPs (unless learned with the reaches), then a run of ``settings`` for every strategy
     and seed, on ``backend`` (see :mod:`mobee_drake.experiments.battery`). A list of settings is
     a sweep, its runs named ``<strategy>_<SettingLabel>_seed<k>`` (a single setting's
@@ -460,18 +521,21 @@ def RunReachBattery(
             ),
             total=variant.problem_tries,
         )
+        # Seed by seed: a battery stopped part-way leaves whole pairs (every setting and strategy
+        # of its first seeds).
+        for seed in seeds
         for variant in variants
         for strategy in strategies
-        for seed in seeds
     ]
-    return list(RunBattery(jobs, output, backend=backend, description="reach learning").values())
+    results = RunBattery(jobs, output, backend=backend, description="reach learning")
+    return [ReachRun.FromJson(result) for result in results.values()]
 
 
-def StoredResults(output: pathlib.Path) -> list[dict]:
+def StoredResults(output: pathlib.Path) -> list[ReachRun]:
     """The results of the finished reach-learning runs in a battery folder, in name order."""
     results = []
     for path in sorted(pathlib.Path(output).glob("runs/*/result.json")):
         result = json.loads(path.read_text())
         if "evaluations" in result:  # (Not the MDP's.)
-            results.append(result)
+            results.append(ReachRun.FromJson(result))
     return results

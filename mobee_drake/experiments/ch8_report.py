@@ -24,18 +24,18 @@ from mobee_drake.experiments.ch8_measures import (
     RunSums,
     RunTrends,
 )
-from mobee_drake.experiments.ch8_reaching import SOURCE_HOURS, RunSettings, SettingLabel
+from mobee_drake.experiments.ch8_reaching import SOURCE_HOURS, ReachRun, SettingLabel
 from mobee_drake.experiments.plots import SaveFigure
 from mobee_drake.experiments.statistics import CompareRuns, CompareToZero
 from mobee_drake.reaching.strategies import REACH_STRATEGIES
 
 
-def _BarrierPeriods(results: list[dict]) -> str:
+def _BarrierPeriods(results: list[ReachRun]) -> str:
     """The periods the safety barrier acted in ``results`` (n/a for runs from before it was
     counted)."""
-    if not all("barrier_periods" in r for r in results):
+    if any(r.barrier_periods is None for r in results):
         return "n/a"
-    return str(sum(r["barrier_periods"] for r in results))
+    return str(sum(r.barrier_periods for r in results))
 
 
 def _CompareToZero(values) -> str:
@@ -75,14 +75,12 @@ def _WindowAtOrBefore(windows, end: int) -> int | None:
     return max(ends) if ends else None
 
 
-def _Group(results: list[dict]) -> dict[str, list[dict]]:
-    strategies = [
-        s for s in REACH_STRATEGIES if any(r["settings"]["strategy"] == s for r in results)
-    ]
-    return {s: [r for r in results if r["settings"]["strategy"] == s] for s in strategies}
+def _Group(results: list[ReachRun]) -> dict[str, list[ReachRun]]:
+    strategies = [s for s in REACH_STRATEGIES if any(r.settings.strategy == s for r in results)]
+    return {s: [r for r in results if r.settings.strategy == s] for s in strategies}
 
 
-def _SweepRow(label: str, results: list[dict]) -> str:
+def _SweepRow(label: str, results: list[ReachRun]) -> str:
     """A row of the sweep's fingerprint table for one setting's runs."""
     by_strategy = _Group(results)
     prints = {s: [Fingerprints(r) for r in runs] for s, runs in by_strategy.items()}
@@ -118,13 +116,13 @@ def _SweepRow(label: str, results: list[dict]) -> str:
     return "| " + " | ".join(cells) + " |"
 
 
-def Report(output: pathlib.Path, results: list[dict]) -> str:
+def Report(output: pathlib.Path, results: list[ReachRun]) -> str:
     """Plots like Fig. 8.2, 8.4-8.8 and a markdown report; returns the report. Results of
     several settings (a sweep: distance unit, reach force) get a fingerprint table across the
     settings, then a section each, their figures in ``output/<SettingLabel>/``."""
-    groups: dict[str, list[dict]] = {}
+    groups: dict[str, list[ReachRun]] = {}
     for r in results:
-        groups.setdefault(SettingLabel(RunSettings(**r["settings"])), []).append(r)
+        groups.setdefault(SettingLabel(r.settings), []).append(r)
     claims = [
         "## The source's claims, marked per setting (issue 33)",
         "",
@@ -161,11 +159,11 @@ def Report(output: pathlib.Path, results: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def _SettingReport(output: pathlib.Path, results: list[dict]) -> str:
+def _SettingReport(output: pathlib.Path, results: list[ReachRun]) -> str:
     """Plots and the report of one setting's runs."""
     by_strategy = _Group(results)
-    stages = sorted({int(k) for r in results for k in r["evaluations"]})
-    k, m = results[0]["num_transitions"], results[0]["num_states"]
+    stages = sorted({stage for r in results for stage in r.evaluations})
+    k, m = results[0].num_transitions, results[0].num_states
     _SaveSettingFigures(output, by_strategy, stages, k, m)
     prints = {s: [Fingerprints(r) for r in runs] for s, runs in by_strategy.items()}
     sections = (
@@ -190,7 +188,7 @@ def _SaveSettingFigures(output: pathlib.Path, by_strategy: dict, stages, k: int,
     SaveFigure(FailedTransitionsFigure(by_strategy, k), output / "8.8_failed_transitions.png")
 
 
-def _RewardSection(results: list[dict], by_strategy: dict, stages) -> list[str]:
+def _RewardSection(results: list[ReachRun], by_strategy: dict, stages) -> list[str]:
     """Fig. 8.2's cumulative reward per strategy and stage, with and without the penalties."""
     strategies = list(by_strategy)
     lines = [
@@ -201,14 +199,7 @@ def _RewardSection(results: list[dict], by_strategy: dict, stages) -> list[str]:
         "none) and the -10 of every failed transition; then the reaches' rewards alone. One "
         "value per run (the mean of its evaluations at the stage), mean ± sd over the runs.",
         "Ties of value broken by: "
-        + ", ".join(
-            sorted(
-                {
-                    r["settings"].get("tie_break", "random (a run made before the option)")
-                    for r in results
-                }
-            )
-        )
+        + ", ".join(sorted({r.settings.tie_break for r in results}))
         + ".",
     ]
     for penalties, title in ((True, "with the penalties"), (False, "reaches only")):
@@ -246,24 +237,24 @@ def _EffortSection(by_strategy: dict, k: int) -> list[str]:
             log = RunLog(r)
             actions += len(log)
             failed += int(np.sum(log[:, 6] < 0))
-            tries += r["settings"]["problem_tries"]
+            tries += r.settings.problem_tries
             reaches = log[log[:, 2] >= k]
-            timeouts += r["settings"]["problem_tries"] - len(reaches)
-        hours = sum(r["simulated_seconds"] for r in by_strategy[strategy]) / 3600
+            timeouts += r.settings.problem_tries - len(reaches)
+        hours = sum(r.simulated_seconds for r in by_strategy[strategy]) / 3600
         lines.append(
             f"| {strategy} | {len(by_strategy[strategy])} | {hours:.1f} | "
             f"{SOURCE_HOURS.get(strategy, '-')} | {actions / tries:.2f} | {failed / tries:.2f} | "
-            f"{timeouts} | {sum(r['wall_seconds'] for r in by_strategy[strategy]) / 3600:.2f} | "
-            f"{sum(r['penetrating_steps'] for r in by_strategy[strategy])} | "
+            f"{timeouts} | {sum(r.wall_seconds for r in by_strategy[strategy]) / 3600:.2f} | "
+            f"{sum(r.penetrating_steps for r in by_strategy[strategy])} | "
             f"{_BarrierPeriods(by_strategy[strategy])} |"
         )
 
     return lines
 
 
-def _MdpSection(results: list[dict], by_strategy: dict, k: int) -> list[str]:
+def _MdpSection(results: list[ReachRun], by_strategy: dict, k: int) -> list[str]:
     """The MDP learned with the reaches (ch. 9.4.1), when the runs recorded it."""
-    if not all("mdp" in r for r in results):
+    if any(r.mdp is None for r in results):
         return []
     lines = [
         "",
@@ -277,7 +268,7 @@ def _MdpSection(results: list[dict], by_strategy: dict, k: int) -> list[str]:
         "|---|---:|---:|",
     ]
     for strategy, strategy_runs in by_strategy.items():
-        runs = [r["mdp"] for r in strategy_runs]
+        runs = [r.mdp for r in strategy_runs]
         success = [r["success_probability"] for r in runs if r["success_probability"] is not None]
         lines.append(
             f"| {strategy} | "
@@ -287,7 +278,7 @@ def _MdpSection(results: list[dict], by_strategy: dict, k: int) -> list[str]:
     return lines
 
 
-def _FingerprintSection(results: list[dict], prints: dict, stages, m: int) -> list[str]:
+def _FingerprintSection(results: list[ReachRun], prints: dict, stages, m: int) -> list[str]:
     """The behavioural fingerprints of ch. 8.4.2-8.4.4 per strategy."""
     strategies = list(prints)
     lines = [
@@ -298,7 +289,7 @@ def _FingerprintSection(results: list[dict], prints: dict, stages, m: int) -> li
         "most used states; line share: exploratory reaches on the window's "
         f"{FAVOURITES} most tried reaching state-actions, per window of problem-tries; "
         "coverage: (reach state, problem) pairs tried, of "
-        f"{m} x {len(next(iter(results))['evaluations'][str(stages[0])][0])}.",
+        f"{m} x {len(results[0].evaluations[stages[0]][0])}.",
         "",
         "| strategy | evaluation actions per try | states reached from | favourite share | "
         "favourite reaches (per run) | "
