@@ -139,6 +139,32 @@ class TestClaims(unittest.TestCase):
         marks = _Marks(late)
         self.assertEqual(marks[0, "unit0.03_force300"], claims.NOT_TESTABLE)
 
+    def test_parameter_tuning_across_distance_units(self):
+        # Greedy loses 0.3 per try in the coarser unit, intrinsic keeps its level.
+        def Swept(unit, greedy_shift):
+            runs = []
+            for strategy in ("greedy", "intrinsic"):
+                for k in range(4):
+                    run = _Run(strategy, k, shift=greedy_shift if strategy == "greedy" else 0.0)
+                    run.settings.distance_unit = unit
+                    runs.append(run)
+            return runs
+
+        results = Swept(0.03, 0.0) + Swept(0.1, -0.3)
+        mark, evidence = claims.LessTuning(results)
+        self.assertEqual(mark, claims.REPRODUCED, evidence)
+        reversed_ = (
+            Swept(0.03, 0.0)
+            + [r for r in Swept(0.1, 0.0) if r.strategy == "greedy"]
+            + [_Run("intrinsic", k, shift=-0.3) for k in range(4)]
+        )
+        for run in reversed_[-4:]:
+            run.settings.distance_unit = 0.1
+        self.assertEqual(claims.LessTuning(reversed_)[0], claims.NOT_REPRODUCED)
+        self.assertEqual(claims.LessTuning(self.strict)[0], claims.NOT_TESTABLE)
+        table = claims.ClaimsTables(self.strict)
+        self.assertTrue(any(line.startswith("| intrinsic motivation alleviates") for line in table))
+
 
 if __name__ == "__main__":
     unittest.main()
