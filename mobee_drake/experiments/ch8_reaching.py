@@ -31,6 +31,13 @@ report that scores each combination against the source's behavioural fingerprint
 policy breaks ties of value (the first state-action by default, or a random one). ``--report-only``
 rewrites the plots and report of the finished runs in ``--output`` without running anything.
 
+The source's ambiguities (issue 33) are settings too, swept like the unit and the force:
+``--plateau-rule``, ``--eq81``, ``--evaluation-history`` and a stochastic robot,
+``--transition-noise`` (:data:`READINGS`; their meaning in :mod:`mobee_drake.reaching.learner`,
+:mod:`mobee_drake.reaching.predictors` and :mod:`mobee_drake.planning.actuation_noise`).
+``--mdps N`` learns N MDPs independently, seed k's runs on MDP k mod N, so that the report can
+pair runs of one seed and treat the MDP as a block (:mod:`mobee_drake.experiments.ch8_claims`).
+
 The report sums every evaluation as the source does (the reaches' rewards and the -10 of every
 failed transition, ch. 8.3.1 and 8.3.3) and also without the penalties, and tests the source's
 claims at run level (:mod:`mobee_drake.experiments.statistics`: one value per run and stage, the
