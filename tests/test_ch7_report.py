@@ -90,6 +90,15 @@ class TestCh7Reports(unittest.TestCase):
         self.assertEqual(rows["moving_box"][1:], ["1 of 2", "2", "3.00", "0.50", "50%", "3"])
         self.assertEqual(rows["no_box"][1:], ["2 of 2", "0", "0.00", "0.00", "0%", "0"])
 
+    def test_a_result_of_an_earlier_version_reads_its_labels(self):
+        # Before ExplorationRun, a job's labels (gamma, run) sat beside its data.
+        data = _Run(labels={}).ToJson()
+        del data["labels"]
+        data |= dict(gamma=0.5, run=2, snapshots={"320": dict(tries=[1], values=[0.0])})
+        run = ExplorationRun.FromJson(data)
+        self.assertEqual(run.labels, dict(gamma=0.5, run=2))
+        self.assertEqual(list(run.snapshots), [320])
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -112,6 +112,12 @@ class TestClaims(unittest.TestCase):
         row = next(line for line in table if line.startswith("| intrinsic motivation is the least"))
         self.assertTrue(row.endswith("| reproduced | not reproduced | unit0.03_force300 |"))
 
+    def test_a_claim_with_nothing_to_compare_is_not_testable(self):
+        alone = [r for r in self.strict if r.strategy == "intrinsic"]
+        marks = _Marks(alone)
+        for i in (0, 3, 4, 6, 7, 8):
+            self.assertEqual(marks[i, "unit0.03_force300"], claims.NOT_TESTABLE, i)
+
     def test_the_ratio_and_a_missing_stage(self):
         verdicts = claims.Verdicts(self.strict)
         ratio = next(v for v in verdicts if v.claim.startswith("random exploration needs"))
@@ -151,8 +157,8 @@ class TestClaims(unittest.TestCase):
             return runs
 
         results = Swept(0.03, 0.0) + Swept(0.1, -0.3)
-        mark, evidence = claims.LessTuning(results)
-        self.assertEqual(mark, claims.REPRODUCED, evidence)
+        ((group, mark, evidence),) = claims.LessTuning(results)
+        self.assertEqual((group, mark), ("force300", claims.REPRODUCED), evidence)
         reversed_ = (
             Swept(0.03, 0.0)
             + [r for r in Swept(0.1, 0.0) if r.strategy == "greedy"]
@@ -160,8 +166,17 @@ class TestClaims(unittest.TestCase):
         )
         for run in reversed_[-4:]:
             run.settings.distance_unit = 0.1
-        self.assertEqual(claims.LessTuning(reversed_)[0], claims.NOT_REPRODUCED)
-        self.assertEqual(claims.LessTuning(self.strict)[0], claims.NOT_TESTABLE)
+        self.assertEqual(claims.LessTuning(reversed_)[0][1], claims.NOT_REPRODUCED)
+        self.assertEqual(claims.LessTuning(self.strict)[0][1], claims.NOT_TESTABLE)
+        # Runs of another force are another group, not a unit's effect.
+        other = Swept(0.03, 0.0)
+        for run in other:
+            run.settings.reach_force = 100.0
+        groups = claims.LessTuning(results + other)
+        self.assertEqual(
+            [g[:2] for g in groups],
+            [("force300", claims.REPRODUCED), ("force100", claims.NOT_TESTABLE)],
+        )
         table = claims.ClaimsTables(self.strict)
         self.assertTrue(any(line.startswith("| intrinsic motivation alleviates") for line in table))
 

@@ -581,17 +581,17 @@ class TestReadings(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "unknown reading of eq. 8.1 'both'"):
             PredictorConfig(eq81="both").Validate()
 
-    def test_an_evaluation_shares_its_history_only_per_evaluation(self):
-        for history, copies in (("per-problem", 3), ("per-evaluation", 1)):
+    def test_an_evaluation_never_writes_to_the_learner(self):
+        for history in ("per-problem", "per-evaluation"):
             with self.subTest(history):
                 space, learner = _Learner("greedy")
                 learner.config.evaluation_history = history
                 with mock.patch.object(learner, "_Try", wraps=learner._Try) as tries:
                     learner.Evaluate(FakeRobot(space, PALMS), seed=1)
                 used = {id(call.args[4]) for call in tries.call_args_list}
-                self.assertEqual(len(tries.call_args_list), 3)
-                self.assertEqual(len(used), copies)
+                self.assertEqual(len(used), 3)  # a scratch copy per problem-try
                 self.assertNotIn(id(learner.histories), used)
+                self.assertEqual(sum(len(learner.histories.History(sa)[2]) for sa in range(8)), 0)
 
     def test_a_failure_is_remembered_by_the_next_problem_per_evaluation(self):
         # Reach 1 is the only good one (eq. 8.5: 1 against about 0.04) and edge 0 -> 1 is
@@ -607,7 +607,21 @@ class TestReadings(unittest.TestCase):
                     learner.histories.Record(learner.Reach(s), target, 1.0, float(s == 1))
             robot = FakeRobot(space, PALMS, blocked={(0, 1)}, state=0)
             robot.Reach = lambda target, robot=robot: (setattr(robot, "state", 0), PALMS[1])[1]
+            blocked = int(np.flatnonzero((space.action_state == 0) & (space.action_goal == 1))[0])
+            seen = []  # per problem-try, its copy's records of the edge and of reach 1 at the start
+
+            reach = learner.Reach(1)
+
+            def Try(*args, real=learner._Try, seen=seen, edge=blocked, reach=reach, **kwargs):
+                histories = args[4]
+                seen.append((len(histories.History(edge)[2]), len(histories.History(reach)[2])))
+                return real(*args, **kwargs)
+
+            learner._Try = Try
             results = learner.Evaluate(robot, seed=2)
+            if history == "per-evaluation":  # the failure carried over, the reaches' records not
+                self.assertEqual([edge for edge, _ in seen], [0, 1, 1])
+                self.assertEqual({reach for _, reach in seen}, {3})  # the learner's own 3
             self.assertTrue(all(r.reach == learner.Reach(1) for r in results))
             failed[history] = sum(r.failed_transitions for r in results)
         self.assertGreaterEqual(failed["per-problem"], 2)  # once per try from state 0
@@ -620,6 +634,14 @@ class TestReadings(unittest.TestCase):
             ReachLearningConfig(plateau_rule="lax").Validate()
         with self.assertRaisesRegex(ValueError, "unknown evaluation_history 'never'"):
             ReachLearningConfig(evaluation_history="never").Validate()
+        with self.assertRaisesRegex(ValueError, "random-tie' breaks ties at random already"):
+            ReachLearningConfig(plateau_rule="random-tie", tie_break="random").Validate()
+        from mobee_drake.reaching.predictors import PredictorConfig
+
+        with self.assertRaisesRegex(ValueError, "eq81 'prose' is a reading of the weighted"):
+            ReachLearningConfig(
+                predictor=PredictorConfig(kind="gaussian_process", eq81="prose")
+            ).Validate()
 
 
 class TestTieBreak(unittest.TestCase):

@@ -261,24 +261,33 @@ class TestPairedAndFamilies(unittest.TestCase):
         self.assertTrue(math.isnan(adjusted[1]))
         np.testing.assert_allclose(adjusted[[0, 2]], [0.02, 0.02])  # m = 2: NaN not counted
 
-    def test_paired_against_scipy(self):
+    def test_paired_against_scipy_and_the_blocked_closed_form(self):
         rng = np.random.default_rng(4)
         b = rng.normal(0, 1, 12)
         a = b + 0.5 + rng.normal(0, 0.3, 12)
+        d = a - b
+        one = ComparePaired(a, b, np.zeros(12))  # one MDP: the paired t-test
+        self.assertAlmostEqual(one.t_p, stats.ttest_rel(a, b).pvalue)
+        self.assertAlmostEqual(one.wilcoxon_p, stats.wilcoxon(d).pvalue)
+        self.assertAlmostEqual(one.d_z, d.mean() / d.std(ddof=1))
+        half = stats.t.ppf(0.975, 11) * d.std(ddof=1) / math.sqrt(12)
+        self.assertAlmostEqual(one.high - one.low, 2 * half)
+        self.assertTrue(math.isnan(one.block_p))
+        # Three MDPs: the error is the variance within them, 12 - 3 degrees of freedom.
         blocks = np.repeat([0, 1, 2], 4)
         c = ComparePaired(a, b, blocks)
-        d = a - b
-        self.assertAlmostEqual(c.difference, d.mean())
-        self.assertAlmostEqual(c.t_p, stats.ttest_rel(a, b).pvalue)
-        self.assertAlmostEqual(c.wilcoxon_p, stats.wilcoxon(d).pvalue)
-        self.assertAlmostEqual(c.d_z, d.mean() / d.std(ddof=1))
-        half = stats.t.ppf(0.975, 11) * d.std(ddof=1) / math.sqrt(12)
-        self.assertAlmostEqual(c.high - c.low, 2 * half)
+        within = sum(np.sum((d[k : k + 4] - d[k : k + 4].mean()) ** 2) for k in (0, 4, 8)) / 9
+        t = d.mean() / math.sqrt(within / 12)
+        self.assertAlmostEqual(c.t_p, 2 * stats.t.sf(abs(t), 9))
         self.assertAlmostEqual(c.block_p, stats.f_oneway(d[:4], d[4:8], d[8:]).pvalue)
         self.assertEqual(c.a_larger, int(np.sum(d > 0)))
-        # Pairing removes the seeds' shared variance: a paired p far below the unpaired one.
-        self.assertLess(c.t_p, stats.ttest_ind(a, b).pvalue)
-        self.assertTrue(math.isnan(ComparePaired(a, b, np.zeros(12)).block_p))
+        # An MDP's own shift of the difference (summing to 0) is not noise to the blocked test.
+        shifted = a + np.repeat([-1.0, 0.0, 1.0], 4)
+        self.assertAlmostEqual(ComparePaired(shifted, b, blocks).t_p, c.t_p)
+        self.assertGreater(ComparePaired(shifted, b, np.zeros(12)).t_p, 10 * c.t_p)
+        self.assertLess(c.t_p, stats.ttest_ind(a, b).pvalue)  # pairing removes the seeds' luck
+        with self.assertRaisesRegex(ValueError, "more pairs than blocks"):
+            ComparePaired(a[:3], b[:3], [0, 1, 2])
 
     def test_ratio_of_means_and_its_interval(self):
         a, b = np.array([2.0, 4.0, 6.0, 8.0]), np.array([1.0, 2.0, 3.0, 4.0])
@@ -292,6 +301,15 @@ class TestPairedAndFamilies(unittest.TestCase):
         self.assertLess(low, ratio)
         self.assertLess(ratio, high)
         self.assertLess(high - low, 0.4)
+        # One pair per MDP: the MDPs are resampled, so the interval is not a point.
+        ratio, low, high = RatioOfMeans(a, b, np.arange(20), resamples=2000)
+        self.assertLess(low, ratio)
+        self.assertLess(ratio, high)
+        # MDPs that differ widen the interval beyond resampling pairs within them could.
+        scaled = a * np.repeat([0.8, 1.2], 10)
+        _, low_mdp, high_mdp = RatioOfMeans(scaled, b, np.repeat([0, 1], 10), resamples=2000)
+        _, low_one, high_one = RatioOfMeans(scaled, b, np.zeros(20), resamples=2000)
+        self.assertGreater(high_mdp - low_mdp, high_one - low_one)
 
 
 if __name__ == "__main__":

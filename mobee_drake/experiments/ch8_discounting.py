@@ -173,7 +173,9 @@ def _PrintReplays(args, model) -> None:
         unit = run.settings.distance_unit
         config = ReachLearningConfig(
             gamma=args.gamma,
-            predictor=PredictorConfig(run.settings.predictor, distance_unit=unit),
+            predictor=PredictorConfig(
+                run.settings.predictor, distance_unit=unit, eq81=run.settings.eq81
+            ),
         )
         replay = ReachLearner(space, counts, LoadTargetGrid().Centres(), config)
         log = np.array(run.log)

@@ -503,8 +503,11 @@ def RunReachBattery(
     labels = [SettingLabel(v) for v in variants]
     if len(set(labels)) < len(labels):
         raise ValueError(f"a sweep's settings repeat: {sorted(labels)}")
+    if variants[0].mdp == "simultaneous" and mdps > 1:
+        raise ValueError("--mdps: runs that learn the MDP with the reaches share none")
     sweep = len(variants) > 1
     noises = sorted({v.transition_noise for v in variants})
+    used = sorted({seed % mdps for seed in seeds})  # (fewer seeds than MDPs: only theirs)
     if variants[0].mdp == "learned_first":
         mdp_jobs = [
             Job(
@@ -513,7 +516,7 @@ def RunReachBattery(
                 dict(min_tries=mdp_tries, seed=m, transition_noise=noise),
             )
             for noise in noises
-            for m in range(mdps)
+            for m in used
         ]
         RunBattery(mdp_jobs, output, backend=backend, description="the MDPs (actions)")
     jobs = [

@@ -61,9 +61,13 @@ class ExplorationRun:
 
     @classmethod
     def FromJson(cls, data: dict) -> "ExplorationRun":
-        """A run as read back from a job's result (JSON keys are strings)."""
+        """A run as read back from a job's result (JSON keys are strings; results written
+        before the labels had a field of their own hold them at the top level)."""
+        fields = {f.name for f in dataclasses.fields(cls)}
+        labels = {k: v for k, v in data.items() if k not in fields} | data.get("labels", {})
         snapshots = {int(count): taken for count, taken in data["snapshots"].items()}
-        return cls(**dict(data, snapshots=snapshots))
+        known = {k: v for k, v in data.items() if k in fields}
+        return cls(**dict(known, snapshots=snapshots, labels=labels))
 
 
 def ExplorationScenario(

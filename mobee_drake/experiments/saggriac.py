@@ -213,7 +213,7 @@ class BabblingRun:
     @classmethod
     def FromJson(cls, data: dict) -> "BabblingRun":
         """A result as read back from a run's folder."""
-        # Results written before 0.3.1 also hold the goal log's column names.
+        # Results written before BabblingRun also hold the goal log's column names.
         data = {key: value for key, value in data.items() if key != "goal_log_columns"}
         return cls(**dict(data, spec=RunSpec(**data["spec"])))
 

@@ -358,17 +358,20 @@ def Holm(p_values) -> np.ndarray:
 @dc.dataclass
 class PairedComparison:
     """Group a against group b on matched runs (the same seed: the same MDP and evaluation
-    seeds), the fields of :func:`ComparePaired`."""
+    seeds), the MDP a block (the fields of :func:`ComparePaired`)."""
 
     n: int
-    # The mean of the paired differences a - b, its 95 % t interval and standard deviation.
+    blocks: int
+    # The mean of the paired differences a - b, its 95 % interval and their standard deviation.
     difference: float
     low: float
     high: float
     sd: float
     # Cohen's d_z: the mean difference over the differences' standard deviation.
     d_z: float
-    # The paired t-test and Wilcoxon's signed-rank test, two-sided.
+    # The test of the mean difference with the block as a factor (a randomised block design:
+    # the error is the differences' variance within the blocks, n - blocks degrees of freedom;
+    # with one block, the paired t-test), and Wilcoxon's signed-rank test, two-sided.
     t_p: float
     wilcoxon_p: float
     # Pairs in which a is larger.
@@ -378,36 +381,52 @@ class PairedComparison:
     block_p: float
 
     def Text(self, p: float | None = None) -> str:
-        """One line: the difference with its interval, d_z, the paired t-test's p (or ``p``, an
-        adjusted one) and the pairs in a's favour."""
+        """One line: the difference with its interval, d_z, the test's p (or ``p``, an adjusted
+        one), the pairs in a's favour and, with several blocks, whether the difference depends
+        on them."""
         shown = self.t_p if p is None else p
+        blocks = (
+            f"; over {self.blocks} MDPs, the MDP's effect p = {_Number(self.block_p, '.2g')}"
+            if self.blocks > 1
+            else ""
+        )
         return (
             f"{self.difference:+.2f} [{self.low:+.2f}, {self.high:+.2f}] (d_z = "
             f"{_Number(self.d_z)}, p = {_Number(shown, '.2g')}; {self.a_larger} of {self.n} "
-            "pairs)"
+            f"pairs{blocks})"
         )
 
 
 def ComparePaired(a, b, blocks) -> PairedComparison:
     """Paired comparison of run values ``a`` and ``b`` (run i of a matched with run i of b) in
-    ``blocks`` (one label per pair: its MDP)."""
+    ``blocks`` (one label per pair: its MDP). The mean difference is tested against the
+    differences' variance within the blocks (so the MDPs' own differences are not taken for
+    noise, nor pairs of one MDP for independent MDPs); with one block this is the paired
+    t-test."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     blocks = np.asarray(blocks)
-    if a.shape != b.shape or a.ndim != 1 or a.size < 2 or blocks.shape != a.shape:
-        raise ValueError(f"pair at least 2 runs, one block each; got {a.size} and {b.size}")
+    if a.shape != b.shape or a.ndim != 1 or blocks.shape != a.shape:
+        raise ValueError(f"pair runs one to one, one block each; got {a.size}, {b.size}")
     d = a - b
-    n, mean, sd = d.size, float(d.mean()), float(d.std(ddof=1))
-    half = stats.t.ppf(0.975, n - 1) * sd / math.sqrt(n)
-    groups = [d[blocks == label] for label in dict.fromkeys(blocks.tolist())]
-    varied = len(groups) > 1 and all(g.size > 1 for g in groups) and np.ptp(d) > 0
+    labels = list(dict.fromkeys(blocks.tolist()))
+    groups = [d[blocks == label] for label in labels]
+    n, j = d.size, len(groups)
+    if n - j < 1:
+        raise ValueError(f"a paired test needs more pairs than blocks, got {n} in {j}")
+    mean, sd = float(d.mean()), float(d.std(ddof=1))
+    within = math.sqrt(sum(np.sum((g - g.mean()) ** 2) for g in groups) / (n - j))
+    se = within / math.sqrt(n)
+    half = stats.t.ppf(0.975, n - j) * se
+    varied = j > 1 and all(g.size > 1 for g in groups) and within > 0
     return PairedComparison(
         n=n,
+        blocks=j,
         difference=mean,
         low=mean - half,
         high=mean + half,
         sd=sd,
         d_z=mean / sd if sd > 0 else math.nan,
-        t_p=float(stats.ttest_rel(a, b).pvalue) if sd > 0 else math.nan,
+        t_p=float(2 * stats.t.sf(abs(mean) / se, n - j)) if se > 0 else math.nan,
         wilcoxon_p=float(stats.wilcoxon(d).pvalue) if np.any(d != 0) else math.nan,
         a_larger=int(np.sum(d > 0)),
         block_p=float(stats.f_oneway(*groups).pvalue) if varied else math.nan,
@@ -415,16 +434,18 @@ def ComparePaired(a, b, blocks) -> PairedComparison:
 
 
 def RatioOfMeans(a, b, blocks, resamples: int = BOOTSTRAP_RESAMPLES) -> tuple[float, float, float]:
-    """mean(a) / mean(b) of matched runs, with a 95 % percentile bootstrap interval that
-    resamples the pairs within each block (seeded: BOOTSTRAP_SEED)."""
+    """mean(a) / mean(b) of matched runs, with a 95 % percentile bootstrap interval of two
+    stages: the blocks (MDPs) resampled, then the pairs within each block drawn (seeded:
+    BOOTSTRAP_SEED); with one block, the pairs alone."""
     a, b, blocks = np.asarray(a, dtype=float), np.asarray(b, dtype=float), np.asarray(blocks)
-    if a.shape != b.shape or a.size < 2:
-        raise ValueError(f"a ratio needs at least 2 matched runs, got {a.size} and {b.size}")
+    if a.shape != b.shape or blocks.shape != a.shape or a.size < 2:
+        raise ValueError(f"a ratio needs at least 2 matched runs, one block each; got {a.size}")
     rng = np.random.default_rng(BOOTSTRAP_SEED)
     members = [np.flatnonzero(blocks == label) for label in dict.fromkeys(blocks.tolist())]
-    picks = np.concatenate(
-        [rng.choice(m, size=(resamples, m.size)) for m in members], axis=1
-    )  # resamples x pairs
-    ratios = a[picks].mean(axis=1) / b[picks].mean(axis=1)
+    ratios = np.empty(resamples)
+    for k in range(resamples):
+        chosen = rng.integers(len(members), size=len(members)) if len(members) > 1 else [0]
+        picks = np.concatenate([rng.choice(members[c], members[c].size) for c in chosen])
+        ratios[k] = a[picks].mean() / b[picks].mean()
     low, high = np.percentile(ratios, [2.5, 97.5])
     return float(a.mean() / b.mean()), float(low), float(high)

@@ -4,9 +4,11 @@ The source's robot was stochastic (dissertation ch. 7.2.5 and 7.3: a state-actio
 iCub does not always end in the same state), ours is not: a kinematic robot under MoBeE settles
 where its attractor is. The model: a transition's commanded posture is its goal state's centre
 plus independent Gaussian noise of standard deviation ``sd`` times each joint's range, clipped to
-the joint limits, so the robot sometimes settles in a neighbouring state (on the rank-3 lattice,
-whose centres are a quarter of the range apart, a joint leaves its state with probability
-2 Phi(-0.125 / sd): 1.2 % at sd 0.05, 21 % at sd 0.1). The noise of one action is drawn from a
+the joint limits, so the robot sometimes settles in a neighbouring state. On the rank-3 lattice,
+whose centres are a quarter of the range apart, a joint sent to the middle level leaves its state
+with probability 2 Phi(-0.125 / sd), to an end level (the limit clips the far side's noise)
+Phi(-0.125 / sd): 1.2 % and 0.6 % at sd 0.05, 21 % and 11 % at sd 0.1; a state of 4 joints
+changes when any of them does. The noise of one action is drawn from a
 generator seeded with the run's seed, the agent's index and the action's start time in
 milliseconds: the same run draws the same noise, and a run resumed from a checkpoint (which
 keeps the time) continues exactly.

@@ -42,16 +42,17 @@ the try's generator (the source is silent).
 
 Readings where the source is ambiguous (issue 33), each a named option with the reference first:
 
-- ``plateau_rule``, when a transition failed (ch. 8.1 says "any (s, a, s') for which s' does not
-  have a higher value than s"): ``strict``, that rule as stated, so a move across a plateau of
-  equal value fails even when it arrives where it was sent; ``arrival``, a transition that ends
-  in the state it was sent to never fails (the rule's purpose, 8.1: to catch moves the target
-  blocks); ``random-tie``, the strict rule with ties of value broken at random (what
-  ``tie_break="random"`` does), so a plateau's reach is chosen as often as its moves.
+- ``plateau_rule``, when a transition failed (ch. 8.1: whenever the state it ends in has no higher
+  value than the state it left): ``strict``, that rule as stated, so a move across a plateau of
+  equal value fails even when it arrives where it was sent; ``arrival``, a transition that ends in
+  the state it was sent to never fails (the rule's purpose, 8.1: to catch moves the target blocks);
+  ``random-tie``, the strict rule with ties of value broken at random (what ``tie_break="random"``
+  does), so a plateau's reach is chosen as often as its moves.
 - ``evaluation_history``, what an evaluation remembers of its own failures (ch. 8.3.3 is silent):
-  ``per-problem``, a scratch copy of the histories for each problem-try, or ``per-evaluation``,
-  one copy for the whole evaluation, so a transition that failed on one problem is predicted by
-  eq. 8.1 to fail on the next ones too (it is not penalised again on every problem).
+  ``per-problem``, nothing beyond its problem-try (each gets a scratch copy of the histories),
+  or ``per-evaluation``, the records of the transitions that failed in its earlier problem-tries
+  (added to each later copy), so eq. 8.1 predicts their failure on the next problems too; the
+  reaches' rewards stay within their problem-try either way.
 
 The learner draws from its own seeded generator and keeps a log of every action it took, from
 which its histories are rebuilt exactly (checkpoints, :meth:`ReachLearner.LoadArrays`).
@@ -107,6 +108,10 @@ class ReachLearningConfig:
     plateau_rule: str = "strict"
     evaluation_history: str = "per-problem"
 
+    def EffectiveTieBreak(self) -> str:
+        """How ties of value are broken: ``tie_break``, or "random" under ``random-tie``."""
+        return "random" if self.plateau_rule == "random-tie" else self.tie_break
+
     def Validate(self) -> None:
         self.predictor.Validate()
         self.goals.Validate()
@@ -117,6 +122,12 @@ class ReachLearningConfig:
         ):
             if value not in allowed:
                 raise ValueError(f"unknown {name} '{value}'; choose one of " + ", ".join(allowed))
+        if self.plateau_rule == "random-tie" and self.tie_break == "random":
+            raise ValueError(
+                "plateau_rule 'random-tie' breaks ties at random already; keep tie_break 'first'"
+            )
+        if self.predictor.eq81 == "prose" and self.predictor.kind != "weighted":
+            raise ValueError("eq81 'prose' is a reading of the weighted average (eq. 8.1) only")
         if self.strategy not in REACH_STRATEGIES:
             raise ValueError(
                 f"unknown reach-learning strategy '{self.strategy}'; strategies "
@@ -272,8 +283,7 @@ class ReachLearner:
         actions = self.Actions(state)
         scores = q[actions]
         best = actions[scores >= scores.max() - 1e-12]
-        first = self.config.tie_break == "first" and self.config.plateau_rule != "random-tie"
-        return int(best[0] if first else rng.choice(best))
+        return int(best[0] if self.config.EffectiveTieBreak() == "first" else rng.choice(best))
 
     # ------------------------------------------------------------------------------------------
     # Acting.
@@ -291,9 +301,11 @@ class ReachLearner:
         histories: RewardHistories,
         rng,
         learn: bool,
+        failures: list | None = None,
     ) -> TryResult:
         """One problem-try for ``target``; ``learn`` says whether it is exploration (logged; with
-        ``learn_mdp`` the model learns) or an evaluation (``histories`` a scratch copy)."""
+        ``learn_mdp`` the model learns) or an evaluation (``histories`` a scratch copy; the
+        records of its failed transitions are appended to ``failures``, if given)."""
         robot.SetProblem(target)
         drawn = REACH_STRATEGIES[strategy].StartTry(self.space.num_states, rng)
         failed = 0
@@ -318,6 +330,8 @@ class ReachLearner:
                         self._RefreshT()
                 failed += reward < 0
             histories.Record(sa, target, estimate, reward)
+            if failures is not None and not self.reaching[sa] and reward < 0:
+                failures.append((sa, target, estimate, reward))
             if learn:
                 self.log.append(
                     (
@@ -359,6 +373,10 @@ class ReachLearner:
         state, then every problem, shuffled, greedily; the learner's state is not changed."""
         rng = np.random.default_rng(seed)
         start = int(rng.integers(self.space.num_states))
+        order = rng.permutation(len(self.targets))
+        # Ties draw from a generator of their own, so that the start and the order are the same
+        # for every learner evaluated with this seed (paired runs), however the walk goes.
+        ties = np.random.default_rng(np.random.SeedSequence(seed).spawn(1)[0])
         into_start = np.append(
             (self.space.action_goal == start).astype(float), np.zeros(self.space.num_states)
         )
@@ -367,21 +385,27 @@ class ReachLearner:
             state = robot.State()
             if state == start:
                 break
-            robot.Transition(int(self.space.action_goal[self._Greedy(q, state, rng)]))
-        shared = self.histories.Copy()
-        per_problem = self.config.evaluation_history == "per-problem"
-        return [
-            self._Try(
-                robot,
-                int(problem),
-                self.targets[problem],
-                "greedy",
-                self.histories.Copy() if per_problem else shared,
-                rng,
-                learn=False,
+            robot.Transition(int(self.space.action_goal[self._Greedy(q, state, ties)]))
+        # Per evaluation, the failed transitions of its earlier problem-tries (their records).
+        failures = None if self.config.evaluation_history == "per-problem" else []
+        results = []
+        for problem in order:
+            histories = self.histories.Copy()
+            for record in failures or ():
+                histories.Record(*record)
+            results.append(
+                self._Try(
+                    robot,
+                    int(problem),
+                    self.targets[problem],
+                    "greedy",
+                    histories,
+                    ties,
+                    learn=False,
+                    failures=failures,
+                )
             )
-            for problem in rng.permutation(len(self.targets))
-        ]
+        return results
 
     # ------------------------------------------------------------------------------------------
     # Saving and resuming.

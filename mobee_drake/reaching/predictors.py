@@ -4,15 +4,14 @@ Every state-action keeps a history ``H_{s,a}`` of the reach targets ``x*_i`` it 
 the reward it was expected to give and the reward it gave (eq. 8.2). A prediction for a new target
 weighs each past reward by ``1 / (1 + |x* - x*_i|)``:
 
-- state transitions, eq. 8.1: ``sum w_i r_i / sum w_i``, and 0 with no history (eq. 8.3: no news
-  is good news: a transition is expected to work, for no reward). The formula as printed
-  predicts a single record's reward for every target however far; the prose (8.1: a failed
-  transition "estimates a negative reward, though it is small" for far targets; 8.4.4: "a much
-  smaller negative reward for far away problems") describes a prediction that fades with
-  distance. ``PredictorConfig.eq81`` chooses: ``printed`` (the default) or ``prose``, eq. 8.5's
-  form with eq. 8.3's prior, ``sum w_i r_i / (1 + sum w_i)``: a prior record of reward 0 at
-  weight 1, as eq. 8.5 has one of reward 1 (one -10 record predicts -10 w / (1 + w): -5 at its
-  own target, -0.9 ten units away);
+- state transitions, eq. 8.1: ``sum w_i r_i / sum w_i``, and 0 with no history (eq. 8.3: no news is
+  good news: a transition is expected to work, for no reward). The formula as printed predicts a
+  single record's reward for every target however far; the prose describes a prediction that fades
+  with distance (8.1: after a failure the estimate is negative but small for targets far from it;
+  8.4.4: far problems get a much smaller penalty than near ones). ``PredictorConfig.eq81`` chooses:
+  ``printed`` (the default) or ``prose``, eq. 8.5's form with eq. 8.3's prior, ``sum w_i r_i / (1 +
+  sum w_i)``: a prior record of reward 0 at weight 1, as eq. 8.5 has one of reward 1 (one -10 record
+  predicts -10 w / (1 + w): -5 at its own target, -10 / 12 = -0.83 ten units away);
 - reaches, eq. 8.5: ``(1 + sum w_i r_i) / (1 + sum w_i)``, optimistic both with no history and
   for targets far from every one tried (the rewards of eq. 8.4 lie in (0, 1]);
 - intrinsic, eq. 8.7: eq. 8.5 over the past prediction errors ``e_i - r_i`` (eq. 8.6).
