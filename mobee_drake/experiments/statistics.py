@@ -442,10 +442,15 @@ def RatioOfMeans(a, b, blocks, resamples: int = BOOTSTRAP_RESAMPLES) -> tuple[fl
         raise ValueError(f"a ratio needs at least 2 matched runs, one block each; got {a.size}")
     rng = np.random.default_rng(BOOTSTRAP_SEED)
     members = [np.flatnonzero(blocks == label) for label in dict.fromkeys(blocks.tolist())]
-    ratios = np.empty(resamples)
-    for k in range(resamples):
-        chosen = rng.integers(len(members), size=len(members)) if len(members) > 1 else [0]
-        picks = np.concatenate([rng.choice(members[c], members[c].size) for c in chosen])
-        ratios[k] = a[picks].mean() / b[picks].mean()
-    low, high = np.percentile(ratios, [2.5, 97.5])
+    j = len(members)
+    # Per resample, the blocks in its j slots, then in each slot the block's pairs drawn.
+    chosen = rng.integers(j, size=(resamples, j)) if j > 1 else np.zeros((resamples, 1), int)
+    sum_a, sum_b = np.zeros(resamples), np.zeros(resamples)
+    for slot in range(j):
+        for block, pairs in enumerate(members):
+            rows = np.flatnonzero(chosen[:, slot] == block)
+            picks = pairs[rng.integers(pairs.size, size=(rows.size, pairs.size))]
+            sum_a[rows] += a[picks].sum(axis=1)
+            sum_b[rows] += b[picks].sum(axis=1)
+    low, high = np.percentile(sum_a / sum_b, [2.5, 97.5])
     return float(a.mean() / b.mean()), float(low), float(high)
