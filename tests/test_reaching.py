@@ -931,6 +931,21 @@ class TestEvaluationSums(unittest.TestCase):
             self.assertIn("| greedy | 2 | 1.50 ± 0.00 |", report)
             # Runs from before the tie-break option drew ties at random.
             self.assertIn("Ties of value broken by: random.", report)
+            # --doc writes the claims table into the doc's generated block, naming the command.
+            doc = pathlib.Path(folder) / "doc.md"
+            doc.write_text(
+                "before\n<!-- generated: ch8-claims, by x -->\nold\n"
+                "<!-- end generated: ch8-claims -->\nafter\n"
+            )
+            with contextlib.redirect_stdout(io.StringIO()):
+                ch8.main(["--output", folder, "--report-only", "--doc", str(doc)])
+            text = doc.read_text()
+            self.assertIn(f"by mobee-drake experiment ch8 --report-only --output {folder}", text)
+            self.assertIn("| the source's claim | value compared | unit1_force300 |", text)
+            self.assertNotIn("STALE-TABLE", text)
+            self.assertTrue(text.startswith("before") and text.endswith("after\n"))
+            with contextlib.redirect_stderr(io.StringIO()), self.assertRaises(SystemExit):
+                ch8.main(["--output", folder, "--report-only", "--doc", str(folder)])
         with tempfile.TemporaryDirectory() as folder, contextlib.redirect_stderr(io.StringIO()):
             with self.assertRaises(SystemExit):
                 ch8.main(["--output", folder, "--report-only"])
