@@ -934,7 +934,7 @@ class TestEvaluationSums(unittest.TestCase):
             # --doc writes the claims table into the doc's generated block, naming the command.
             doc = pathlib.Path(folder) / "doc.md"
             doc.write_text(
-                "before\n<!-- generated: ch8-claims, by x -->\nold\n"
+                "before\n<!-- generated: ch8-claims, by x -->\nSTALE-TABLE\n"
                 "<!-- end generated: ch8-claims -->\nafter\n"
             )
             with contextlib.redirect_stdout(io.StringIO()):
