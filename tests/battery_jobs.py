@@ -23,6 +23,13 @@ from mobee_drake.experiments.battery import (
 )
 
 
+def DefaultSigint() -> None:
+    """A child's ``preexec_fn``: Ctrl-C acts on it as in a terminal, even when the tests run in a
+    shell's background job, whose children inherit SIGINT ignored (Python then installs no
+    KeyboardInterrupt handler)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def Count(run, x: int, calls: str) -> dict:
     """Appends the run's name to the file ``calls``; returns numbers of ``x``."""
     with open(calls, "a") as stream:

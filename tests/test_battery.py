@@ -19,7 +19,7 @@ import time
 import unittest
 from unittest import mock
 
-from battery_jobs import Count, FullDisk, Nan, Walk
+from battery_jobs import Count, DefaultSigint, FullDisk, Nan, Walk
 
 from mobee_drake.experiments import battery, saggriac
 from mobee_drake.experiments.battery import (
@@ -312,6 +312,7 @@ class NoOrphansTest(TemporaryFolder):
             env=environment,
             stdout=log,
             stderr=log,
+            preexec_fn=DefaultSigint,
         )
         self.addCleanup(parent.kill)
         ready = WaitFor(

@@ -17,7 +17,7 @@ import textwrap
 import time
 import unittest
 
-from battery_jobs import Count, StopWalk
+from battery_jobs import Count, DefaultSigint, StopWalk
 import numpy as np
 
 from mobee_drake import cli
@@ -297,6 +297,7 @@ class TestInterrupts(TemporaryFolder):
              "--workers", "1", "--output", str(output)],
             stderr=subprocess.PIPE,
             text=True,
+            preexec_fn=DefaultSigint,
         )  # fmt: skip
         self.addCleanup(battery.kill)
         deadline = time.monotonic() + 60
@@ -345,6 +346,7 @@ class TestGracefulStop(TemporaryFolder):
             ],
             env={**os.environ, "PYTHONPATH": str(pathlib.Path(__file__).parent)},
             stderr=subprocess.DEVNULL,
+            preexec_fn=DefaultSigint,
         )
         self.addCleanup(battery.kill)
         progress = output / "runs" / "walk" / "progress.json"
