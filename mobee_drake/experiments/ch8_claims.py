@@ -321,8 +321,9 @@ def LessTuning(results: list[ReachRun]) -> list[tuple[str, str, str]]:
 
 
 def _BySetting(results: list[ReachRun]) -> dict[str, Runs]:
+    """The runs per setting, the reference readings' settings first."""
     settings: dict[str, Runs] = {}
-    for r in results:
+    for r in sorted(results, key=lambda r: (len(r.settings.Readings()), SettingLabel(r.settings))):
         by_strategy = settings.setdefault(SettingLabel(r.settings), {})
         by_strategy.setdefault(r.strategy, {})[r.settings.seed] = r
     return settings
