@@ -27,6 +27,7 @@ from mobee_drake.experiments.ch8_reaching import (
     MDPS,
     REACH_FORCE_RANGE,
     REACH_PRESETS,
+    READINGS,
     SOURCE_STAGES,
     SOURCE_STRATEGIES,
     MdpName,
@@ -48,7 +49,6 @@ from mobee_drake.reaching.learner import (
 from mobee_drake.reaching.predictors import (
     EQ81_READINGS,
     PREDICTORS,
-    PredictorConfig,
 )
 from mobee_drake.reaching.strategies import REACH_STRATEGIES
 
@@ -183,7 +183,7 @@ def _AddReadingArguments(parser: CommandParser) -> None:
         "--plateau-rule",
         choices=PLATEAU_RULES,
         nargs="+",
-        default=[ReachLearningConfig().plateau_rule],
+        default=[READINGS["plateau_rule"]],
         help="when a transition fails: strict (8.1 as stated: its end state is not of higher "
         "value), arrival (a move that arrives where it was sent never fails) or random-tie "
         "(strict, ties of value broken at random)",
@@ -192,7 +192,7 @@ def _AddReadingArguments(parser: CommandParser) -> None:
         "--eq81",
         choices=EQ81_READINGS,
         nargs="+",
-        default=[PredictorConfig().eq81],
+        default=[READINGS["eq81"]],
         help="eq. 8.1 as printed (one record predicts its reward everywhere) or as its prose "
         "reads (a prediction that fades with the distance to the records' targets)",
     )
@@ -200,7 +200,7 @@ def _AddReadingArguments(parser: CommandParser) -> None:
         "--evaluation-history",
         choices=EVALUATION_HISTORIES,
         nargs="+",
-        default=[ReachLearningConfig().evaluation_history],
+        default=[READINGS["evaluation_history"]],
         help="what an evaluation remembers of its own failed transitions: per problem-try, or "
         "over the whole evaluation",
     )
@@ -208,7 +208,7 @@ def _AddReadingArguments(parser: CommandParser) -> None:
         "--transition-noise",
         type=InRange(0.0, 0.5),
         nargs="+",
-        default=[0.0],
+        default=[READINGS["transition_noise"]],
         help="a stochastic robot: the actuation noise's standard deviation per joint, a "
         "fraction of its range (the MDP is learned on the same robot)",
     )
