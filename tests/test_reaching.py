@@ -946,6 +946,18 @@ class TestEvaluationSums(unittest.TestCase):
             self.assertTrue(text.startswith("before") and text.endswith("after\n"))
             with contextlib.redirect_stderr(io.StringIO()), self.assertRaises(SystemExit):
                 ch8.main(["--output", folder, "--report-only", "--doc", str(folder)])
+            # --doc-table names another block of the same doc; the first is left alone.
+            doc.write_text(
+                text + "<!-- generated: other, by x -->\nOLD\n<!-- end generated: other -->\n"
+            )
+            with contextlib.redirect_stdout(io.StringIO()):
+                ch8.main(
+                    ["--output", folder, "--report-only", "--doc", str(doc), "--doc-table", "other"]
+                )
+            both = doc.read_text()
+            self.assertTrue(both.startswith(text))
+            self.assertNotIn("OLD", both)
+            self.assertIn(f"--doc {doc} --doc-table other -->", both)
         with tempfile.TemporaryDirectory() as folder, contextlib.redirect_stderr(io.StringIO()):
             with self.assertRaises(SystemExit):
                 ch8.main(["--output", folder, "--report-only"])

@@ -52,7 +52,7 @@ from mobee_drake.reaching.predictors import (
 )
 from mobee_drake.reaching.strategies import REACH_STRATEGIES
 
-# The generated block of docs/reaching.md that --doc rewrites.
+# The generated block of docs/reaching.md that --doc rewrites by default.
 DOC_TABLE = "ch8-claims"
 
 
@@ -119,7 +119,12 @@ def _Parser() -> CommandParser:
     )
     parser.add_argument(
         "--doc",
-        help="a doc whose generated claims table (block 'ch8-claims') to rewrite from the runs",
+        help="a doc whose generated claims table (block --doc-table) to rewrite from the runs",
+    )
+    parser.add_argument(
+        "--doc-table",
+        default=DOC_TABLE,
+        help="the name of --doc's generated block (several batteries' tables in one doc)",
     )
     AddBackendArguments(parser, workers=2)
     return parser
@@ -266,7 +271,7 @@ def main(argv=None) -> None:
         parser.error(f"--report-only: {output} is not a folder of reach-learning runs")
     if args.doc:
         try:
-            GeneratedTable(args.doc, DOC_TABLE)
+            GeneratedTable(args.doc, args.doc_table)
         except (OSError, ValueError) as error:
             parser.error(f"--doc: {error}")
     ClaimFolder(output, "battery")  # (a file, or a folder of the user's, refused in one line)
@@ -303,7 +308,9 @@ def main(argv=None) -> None:
     print(text)
     if args.doc:
         command = f"mobee-drake experiment ch8 --report-only --output {output} --doc {args.doc}"
-        WriteGeneratedTable(args.doc, DOC_TABLE, command, "\n".join(ClaimsTables(results)))
+        if args.doc_table != DOC_TABLE:
+            command += f" --doc-table {args.doc_table}"
+        WriteGeneratedTable(args.doc, args.doc_table, command, "\n".join(ClaimsTables(results)))
 
 
 if __name__ == "__main__":
