@@ -10,7 +10,9 @@ from whatever results exist.
 
 A variant (``--variants``) is a named set of settings: ``paper`` (the reference row), the
 goal-selection options ``stall``, ``model-error``, ``stall+model-error``, ``weighted-split``
-(SAGG methods) and the drift-free ``set`` reading of the actuator-space methods; see VARIANTS.
+(SAGG methods), the controls of issue 34 (``variance-only``, the window sweep ``window-10``,
+``window-40``, ``window-80``) and the drift-free ``set`` reading of the actuator-space methods;
+see VARIANTS.
 
 Usage::
 
@@ -45,6 +47,7 @@ from mobee_drake.goal_babbling.config import (
     GoalBabblingConfig,
 )
 from mobee_drake.goal_babbling.evaluation import Evaluator
+from mobee_drake.goal_babbling.interest_null import LeafInterests
 from mobee_drake.goal_babbling.sagg_riac import SaggRiac
 
 # A battery's size: the paper's budgets (30 seeds where it ran 15), and --smoke's.
@@ -90,6 +93,21 @@ def _Set(config: GoalBabblingConfig) -> None:
     config.actuator.reading = "set"
 
 
+def _VarianceOnly(config: GoalBabblingConfig) -> None:
+    config.interest.region_measure = "variance"
+
+
+def _Window(window: int) -> Callable[[GoalBabblingConfig], None]:
+    def Apply(config: GoalBabblingConfig) -> None:
+        config.interest.window = window  # (min_child_goals stays 10: splits stay possible)
+
+    return Apply
+
+
+# The window sweep of issue 34 (zeta; the reference is 20).
+SWEPT_WINDOWS = (10, 40, 80)
+
+
 @dataclasses.dataclass(frozen=True)
 class Variant:
     """A named set of settings applied to the experiment's configuration.
@@ -127,6 +145,17 @@ VARIANTS = {
         ACTUATOR_METHODS,
         _Set,
     ),
+    "variance-only": Variant(
+        "eq. 3 draws regions by the spread of their last zeta competences, not by eq. 2",
+        ("SAGG-RIAC",),
+        _VarianceOnly,
+    ),
+    **{
+        f"window-{window}": Variant(
+            f"zeta = {window} (eq. 2's window; the reference 20)", ("SAGG-RIAC",), _Window(window)
+        )
+        for window in SWEPT_WINDOWS
+    },
 }
 
 
@@ -182,6 +211,8 @@ class BabblingRun:
         goal_log: Goal-space methods: one row per goal or subgoal (GOAL_LOG_COLUMNS).
         region_snapshots: SAGG-RIAC: the regions at the end of each goal window (Fig. 3).
         num_regions: RIAC methods: the leaves of the region tree at the end.
+        leaf_interests: SAGG methods: every final leaf's interest against its permutation null
+            (:class:`mobee_drake.goal_babbling.interest_null.LeafInterest` as a dict).
     """
 
     spec: RunSpec
@@ -195,6 +226,7 @@ class BabblingRun:
     goal_log: list[list[float]] | None = None
     region_snapshots: list[dict] | None = None
     num_regions: int | None = None
+    leaf_interests: list[dict] | None = None
 
     @property
     def label(self) -> str:
@@ -319,6 +351,9 @@ def RunOne(run: RunFolder, spec: dict) -> dict:
     if isinstance(learner, SaggRiac):
         result.goal_log = [list(map(float, row)) for row in learner.goal_log]
         result.region_snapshots = _RegionSnapshots(learner)
+        result.leaf_interests = [
+            dataclasses.asdict(leaf) for leaf in LeafInterests(learner.tree, spec.seed)
+        ]
     if isinstance(learner, (SaggRiac, ActuatorRiac)):
         result.num_regions = len(learner.tree.leaves)
     return result.ToJson()

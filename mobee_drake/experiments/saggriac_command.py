@@ -12,7 +12,9 @@ from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
 )
+from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.saggriac import FULL, METHODS, SMOKE, VARIANTS, RunAll, RunSpec
+from mobee_drake.experiments.saggriac_interest import Issue34Lines
 from mobee_drake.experiments.saggriac_report import Analyse
 from mobee_drake.owned_folders import OwnedFolder
 
@@ -84,6 +86,16 @@ def _Parser() -> CommandParser:
         "--analyse-only", action="store_true", help="only rebuild the report from run files"
     )
     parser.add_argument(
+        "--doc",
+        help="a doc whose generated block (--doc-table) to rewrite with the interest tables and "
+        "marks of the runs",
+    )
+    parser.add_argument(
+        "--doc-table",
+        default="saggriac-interest",
+        help="the name of --doc's generated block",
+    )
+    parser.add_argument(
         "--smoke",
         action="store_true",
         help="tiny battery, unless the flags say otherwise: "
@@ -111,6 +123,11 @@ def main(argv=None) -> None:
                 f"--checkpoints {args.checkpoints}: more evaluations than experiment "
                 f"{experiment}'s budget of {budgets[experiment]}"
             )
+    if args.doc:
+        try:
+            GeneratedTable(args.doc, args.doc_table)
+        except (OSError, ValueError) as error:
+            parser.error(f"--doc: {error}")
     # Seed-major order: an interrupted battery leaves every group with about as many seeds.
     specs = [
         RunSpec(experiment, method, seed, budgets[experiment], args.checkpoints, variant)
@@ -134,7 +151,13 @@ def main(argv=None) -> None:
     with OwnedFolder(args.output, "battery"):
         if not any((args.output / "runs" / spec.Name() / RESULT).exists() for spec in specs):
             parser.error(f"--output {args.output}: holds no SAGG-RIAC run of these arguments")
-        Analyse(specs, args.output, command)
+        all_runs = Analyse(specs, args.output, command)
+    if args.doc:  # (The command that rewrites the block runs nothing.)
+        again = command if args.analyse_only else f"{command} --analyse-only"
+        groups = list(dict.fromkeys(spec.Label() for spec in specs))
+        WriteGeneratedTable(
+            args.doc, args.doc_table, again, "\n".join(Issue34Lines(all_runs, groups))
+        )
     print(
         f"done in {time.perf_counter() - started:.1f} s; report: {args.output / 'report.md'}",
         flush=True,

@@ -84,12 +84,13 @@ def EffectsFigure(statistics: list[dict], experiment: int, measures: list[str]) 
         squeeze=False,
         sharey=True,
     )
-    colours = {"1": "C0", "2": "C3", "3": "C2", "option": "C4"}
+    colours = {"1": "C0", "2": "C3", "3": "C2", "option": "C4", "mechanism": "C1"}
     names = {
         "1": "claim 1 (goal vs actuator space)",
         "2": "claim 2 (ACTUATOR-RIAC vs -Random)",
         "3": "claim 3 (SAGG-RIAC vs SAGG-Random)",
         "option": "option vs paper settings",
+        "mechanism": "variance-only vs SAGG-Random (issue 34)",
     }
     for axis, measure in zip(axes[0], measures, strict=True):
         rows = [r for r in statistics if r["measure"] == measure and r["test"] == "pair"]

@@ -29,6 +29,7 @@ from mobee_drake.experiments.saggriac_figures import (
     GoalsFigure,
     TipsFigure,
 )
+from mobee_drake.experiments.saggriac_interest import Issue34Lines
 from mobee_drake.experiments.statistics import CompareRuns
 from mobee_drake.goal_babbling.config import (
     ConfigFromDict,
@@ -50,6 +51,7 @@ CLAIM_PAIRS = (
     ("ACTUATOR-RIAC", "ACTUATOR-Random", "2"),
     ("ACTUATOR-RIAC [set]", "ACTUATOR-Random [set]", "2"),
     ("SAGG-RIAC", "SAGG-Random", "3"),
+    ("SAGG-RIAC [variance-only]", "SAGG-Random", "mechanism"),
 )
 
 
@@ -344,6 +346,15 @@ def WriteReport(
         + "; ".join(f"`{name}`: {variant.description}" for name, variant in VARIANTS.items()),
         "",
     ]
+    if any(r.leaf_interests for runs in all_runs.values() for r in runs):
+        lines += [
+            "## The interest against its noise floor (issue 34)",
+            "",
+            *Issue34Lines(all_runs, groups),
+            "Per final leaf: eq. 2's interest against 999 reorderings of its own competences; "
+            "rho per run over its leaves.",
+            "",
+        ]
     for experiment, runs in all_runs.items():
         if not runs:
             continue
@@ -408,8 +419,11 @@ def _NoNan(value):
     return value
 
 
-def Analyse(specs: list[RunSpec], output: pathlib.Path, command: str) -> None:
-    """Writes curves CSV, plots, statistics JSON and report.md from the run files present."""
+def Analyse(
+    specs: list[RunSpec], output: pathlib.Path, command: str
+) -> dict[int, list[BabblingRun]]:
+    """Writes curves CSV, plots, statistics JSON and report.md from the run files present;
+    returns the runs per experiment."""
     experiments = sorted({spec.experiment for spec in specs})
     groups = list(dict.fromkeys(spec.Label() for spec in specs))
     all_runs, statistics = {}, {}
@@ -447,3 +461,4 @@ def Analyse(specs: list[RunSpec], output: pathlib.Path, command: str) -> None:
         StrictJson({str(key): _NoNan(value) for key, value in statistics.items()}, indent=1),
     )
     WriteReport(all_runs, statistics, groups, command, output / "report.md")
+    return all_runs

@@ -97,3 +97,21 @@ def Interest(competences: np.ndarray, window: int) -> float:
     return float(
         MaskedInterests(competences, np.ones((1, competences.size), dtype=bool), window)[0]
     )
+
+
+def CompetenceSpread(competences: np.ndarray, window: int) -> float:
+    """The standard deviation of the last ``window`` competences (0 with fewer than 2): a
+    region's measure for the variance-only selector (InterestConfig.region_measure = "variance",
+    not the paper's). It is blind to time order, and like eq. 2's value on competences without a
+    trend it grows in proportion to their spread, so eq. 3 over it draws regions by competence
+    variance alone.
+
+    Args:
+        competences: The region's competences in time order.
+        window: zeta.
+
+    Returns:
+        The spread (>= 0).
+    """
+    recent = np.asarray(competences, dtype=float)[-window:]
+    return float(recent.std()) if recent.size > 1 else 0.0

@@ -34,6 +34,7 @@ class ArmConfig:
 
 EXPLORATION_TRIGGERS = ("task", "model")
 SPLIT_CRITERIA = ("difference", "weighted")
+REGION_MEASURES = ("progress", "variance")
 ACTUATOR_READINGS = ("walk", "set")
 
 
@@ -130,12 +131,19 @@ class InterestConfig:
     competence_tolerance: float = -0.05
     min_competence: float = -1.0
     split_criterion: str = "difference"
+    region_measure: str = "progress"
 
     def __post_init__(self):
         if self.split_criterion not in SPLIT_CRITERIA:
             raise ValueError(
                 f"split_criterion must be one of {SPLIT_CRITERIA}, got {self.split_criterion!r}"
             )
+        if self.region_measure not in REGION_MEASURES:
+            raise ValueError(
+                f"region_measure must be one of {REGION_MEASURES}, got {self.region_measure!r}"
+            )
+        if self.window < 2:
+            raise ValueError(f"window (zeta) must be at least 2, got {self.window}")
 
 
 @dataclasses.dataclass

@@ -10,7 +10,7 @@ import dataclasses
 
 import numpy as np
 
-from mobee_drake.goal_babbling.competence import Interest, MaskedInterests
+from mobee_drake.goal_babbling.competence import CompetenceSpread, Interest, MaskedInterests
 from mobee_drake.goal_babbling.config import InterestConfig
 
 
@@ -24,7 +24,8 @@ class Region:
         born: Number of points the whole tree held when the region was created.
         points: Attempted points in time order.
         values: Their competences, in the same order.
-        interest: eq. 2 over values.
+        interest: What eq. 3 draws regions by: eq. 2 over values (or their spread, with
+            InterestConfig.region_measure = "variance").
         split_at: Number of points the tree held when this region was split (None while a leaf).
         split_dimension: Dimension of the cut (None while a leaf).
         split_value: Coordinate of the cut (None while a leaf).
@@ -175,6 +176,14 @@ class RegionTree:
                 stack.extend(region.children)
         return found
 
+    def Measure(self, values: list[float]) -> float:
+        """A region's measure for eq. 3 from its competences in time order: eq. 2 (the paper), or
+        their spread (InterestConfig.region_measure)."""
+        window = self.config.window
+        if self.config.region_measure == "variance":
+            return CompetenceSpread(values, window)
+        return Interest(values[-window:], window)
+
     def Add(self, point: np.ndarray, value: float) -> Region:
         """Records a competence at a point, updates its leaf's interest (eq. 2); splits past g_max.
 
@@ -188,7 +197,7 @@ class RegionTree:
         leaf = self.Leaf(point)
         leaf.points.append(np.asarray(point, dtype=float))
         leaf.values.append(float(value))
-        leaf.interest = Interest(leaf.values[-self.config.window :], self.config.window)
+        leaf.interest = self.Measure(leaf.values)
         self.num_points += 1
         if len(leaf.values) > self.config.max_region_goals:
             self._Split(leaf)
@@ -218,7 +227,7 @@ class RegionTree:
             child.points.append(point)
             child.values.append(value)
         for child in children:
-            child.interest = Interest(child.values[-self.config.window :], self.config.window)
+            child.interest = self.Measure(child.values)
         region.children, region.split_dimension, region.split_value = children, dimension, cut
         region.split_at = self.num_points
         index = next(i for i, leaf in enumerate(self.leaves) if leaf is region)
