@@ -99,6 +99,7 @@ class TestMistakes(unittest.TestCase):
                 "the robot starts in penetration: the robot: 'r_hand'",
             ),  # fmt: skip
             (["bench", "safety", "--doc", str(notes)], "no generated block 'safety scenes'"),
+            (["bench", "ik", "--doc", str(notes)], "no generated block 'ngik-benchmark'"),
             (["bench", "safety", "--report-only"], "--report-only needs --output"),
             # Issue 31, item 11: nonsense that ran silently, or ended in a Python type error.
             (["run", "reach_around_ball", "--set", ""], "overrides '': not a YAML mapping"),

@@ -239,3 +239,84 @@ class IcubIkTest(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+def _Rows(evaluations: dict[str, list[int]], solved: dict[str, float] | None = None) -> list:
+    """Benchmark rows of one family from each solver's evaluations per problem."""
+    return [
+        {
+            "family": "position",
+            "solver": solver,
+            "evaluations": float(np.mean(each)),
+            "evaluations_each": each,
+            "solved": (solved or {}).get(solver, 1.0),
+        }
+        for solver, each in evaluations.items()
+    ]
+
+
+class OptimiserMarkTest(unittest.TestCase):
+    def test_the_claim_follows_the_evaluations_per_problem(self):
+        from mobee_drake.experiments.bench_ik import OptimiserMark
+
+        fewer = [100 + k for k in range(12)]
+        more = [400 + 3 * k for k in range(12)]
+        # NES needs fewer evaluations on every problem: reproduced.
+        mark, evidence = OptimiserMark(
+            _Rows({"ngik_xnes": fewer, "ngik_snes": more, "cma_es": more})
+        )
+        self.assertEqual(mark, "reproduced", evidence)
+        # CMA-ES's evaluations as a ratio of each variant's means.
+        ratio = np.mean(more) / np.mean(fewer)
+        self.assertIn(
+            f"CMA-ES's evaluations {ratio:.2f} of ngik_xnes's, 1.00 of ngik_snes's", evidence
+        )
+        # CMA-ES needs fewer: not reproduced.
+        mark, _ = OptimiserMark(_Rows({"ngik_xnes": more, "ngik_snes": more, "cma_es": fewer}))
+        self.assertEqual(mark, "not reproduced")
+        # Fewer evaluations, but fewer problems solved: not reproduced.
+        mark, _ = OptimiserMark(
+            _Rows({"ngik_xnes": fewer, "ngik_snes": more, "cma_es": more}, {"ngik_xnes": 0.9})
+        )
+        self.assertEqual(mark, "not reproduced")
+        # Fewer on 7 problems by 1, more on 5 by 50: a negative median, not significant.
+        mixed = [m - 1 if k < 7 else m + 50 for k, m in enumerate(more)]
+        mark, evidence = OptimiserMark(
+            _Rows({"ngik_xnes": [m + 100 for m in more], "ngik_snes": mixed, "cma_es": more})
+        )
+        self.assertEqual(mark, "not reproduced", evidence)
+        self.assertIn("ngik_snes minus CMA-ES per problem, median -1", evidence)
+        # Two families that disagree: the mark names the one where the claim holds.
+        rows = _Rows({"ngik_xnes": fewer, "ngik_snes": more, "cma_es": more})
+        for row in _Rows({"ngik_xnes": more, "ngik_snes": more, "cma_es": fewer}):
+            rows.append(dict(row, family="all joints"))
+        self.assertEqual(OptimiserMark(rows)[0], "reproduced only on: position")
+        # Equal on every problem: no difference, not reproduced.
+        mark, evidence = OptimiserMark(
+            _Rows({"ngik_xnes": more, "ngik_snes": more, "cma_es": more})
+        )
+        self.assertEqual(mark, "not reproduced", evidence)
+
+    def test_the_benchmark_writes_its_table_and_mark_into_the_doc(self):
+        import contextlib
+        import io
+        import pathlib
+        import tempfile
+
+        from mobee_drake.experiments import bench_ik
+
+        with tempfile.TemporaryDirectory() as folder:
+            doc = pathlib.Path(folder) / "doc.md"
+            doc.write_text(
+                "a\n<!-- generated: ngik-benchmark, by x -->\nOLD\n"
+                "<!-- end generated: ngik-benchmark -->\nb\n"
+            )
+            with contextlib.redirect_stdout(io.StringIO()):
+                bench_ik.main(["--problems", "1", "--doc", str(doc)])
+            text = doc.read_text()
+        self.assertNotIn("OLD", text)
+        self.assertIn(f"by mobee-drake bench ik --problems 1 --seed 0 --doc {doc} -->", text)
+        for family, _, _ in bench_ik.FAMILIES:
+            for solver in bench_ik.SOLVERS:
+                self.assertIn(f"| {family} | {solver} | ", text)
+        self.assertRegex(text, r"NES outperforms the other samplers \(ch. 3.2\): \*\*[a-z]")
