@@ -16,7 +16,14 @@ from mobee_drake.station.world_events import MakeSimulator
 from mobee_drake.trm.display import PathMotion
 from mobee_drake.trm.examples import JOINTS, ReachInto
 from mobee_drake.trm.roadmap import BuildTrm, CoveredRegion, TaskRelevantRoadmap, TrmConfig
-from mobee_drake.trm.task_space import JointCoordinates, MarkerAlong, MarkerCoordinates, TaskSpace
+from mobee_drake.trm.task_space import (
+    JointCoordinates,
+    MarkerAlong,
+    MarkerAngle,
+    MarkerCoordinates,
+    MarkerHeading,
+    TaskSpace,
+)
 
 FAST_NES = NesConfig(variant="snes", max_evaluations=300, target_cost=-1.0, tolerance=2e-3)
 
@@ -39,6 +46,73 @@ class TaskSpaceTest(unittest.TestCase):
         )
         self.assertEqual(space.dimension, 7)
         np.testing.assert_allclose(space(e), [4, 5, 6, 6, 0.3, 0.1, 3])
+
+    def test_angles_of_a_marker_direction(self):
+        # Marker 0 points along (cos 30, sin 30, 0) in the table plane, marker 1 straight up.
+        c, s = np.cos(np.radians(30)), np.sin(np.radians(30))
+        e = PoseEvaluation(
+            q=np.zeros(1),
+            marker_positions=np.zeros((2, 3)),
+            marker_directions=np.array([[c, s, 0.0], [0.0, 0.0, 1.0]]),
+            collision_pairs=(),
+        )
+        np.testing.assert_allclose(MarkerAngle(0, (1.0, 0.0, 0.0))(e), [np.radians(30)])
+        np.testing.assert_allclose(MarkerAngle(1, (0.0, 0.0, -1.0))(e), [np.pi])
+        # Heading about +z from +x: +30 degrees; about -z: -30; from +y: -60.
+        np.testing.assert_allclose(MarkerHeading(0, (0, 0, 1.0), (1.0, 0, 0))(e), [np.pi / 6])
+        np.testing.assert_allclose(MarkerHeading(0, (0, 0, -1.0), (1.0, 0, 0))(e), [-np.pi / 6])
+        np.testing.assert_allclose(MarkerHeading(0, (0, 0, 1.0), (0, 1.0, 0))(e), [-np.pi / 3])
+        # A component along the plane's normal does not change the heading.
+        e.marker_directions[0] = [c, s, 5.0]
+        np.testing.assert_allclose(MarkerHeading(0, (0, 0, 1.0), (1.0, 0, 0))(e), [np.pi / 6])
+
+    def test_opposed_directions(self):
+        from mobee_drake.ngik.costs import OpposedDirections
+
+        u = np.array([[0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0]])
+        e = PoseEvaluation(np.zeros(1), np.zeros((3, 3)), u, ())
+        self.assertAlmostEqual(OpposedDirections(0, 1)(e), 0.0)  # facing each other
+        self.assertAlmostEqual(OpposedDirections(0, 2, weight=2.0)(e), 2.0)  # at right angles
+        self.assertAlmostEqual(OpposedDirections(0, 0)(e), 2.0)  # the same direction
+
+
+class CatalogueTest(unittest.TestCase):
+    def test_every_example_starts_from_a_pose_meeting_its_terms(self):
+        from mobee_drake.trm.catalogue import EXAMPLES
+
+        for name, Make in EXAMPLES.items():
+            with self.subTest(name):
+                example = Make()
+                problem = example.problem
+                evaluation, _ = problem.Evaluate(problem.SearchVector(example.q_init))
+                if name in ("reach_into", "raise_a_glass"):
+                    continue  # (these start at home, as Alg. 4 does, and search from there)
+                self.assertTrue(problem.IsSolved(evaluation))
+                self.assertFalse(evaluation.collision_pairs)
+
+    def test_a_two_hand_roadmap_holds_its_object(self):
+        from mobee_drake.trm.bimanual import HOLD, BimanualTwist
+
+        example = BimanualTwist()
+        config = TrmConfig(
+            max_vertices=4, spacing=example.spacing, sigma=example.sigma, nes=FAST_NES
+        )
+        roadmap = BuildTrm(
+            example.problem, example.task_space, example.q_init, config, np.random.default_rng(0)
+        )
+        model = example.model
+        right, left = model.MarkerIndex("r_palm"), model.MarkerIndex("l_palm")
+        headings = []
+        for q in roadmap.q:
+            e = model.Evaluate(q)
+            apart = np.linalg.norm(e.marker_positions[right] - e.marker_positions[left])
+            self.assertAlmostEqual(apart, HOLD, delta=0.01)
+            self.assertLess(1.0 + e.marker_directions[right] @ e.marker_directions[left], 0.016)
+            headings.append(example.task_space(e)[0])
+        # The vertices are spread over the palms' heading, at least d apart.
+        gaps = np.diff(np.sort(headings))
+        self.assertEqual(roadmap.num_vertices, 4)
+        self.assertTrue(np.all(gaps >= example.spacing / 2), headings)
 
 
 class GraphStateSpaceTest(unittest.TestCase):

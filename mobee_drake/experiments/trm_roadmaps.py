@@ -6,21 +6,28 @@ the marker cloud, the edges and the robot moving along the path between the two 
 farthest apart in task space) and a report of what was measured: size, build speed, and how
 many edges are free of collisions when interpolated (TRM edges are not checked when built).
 
-Run: ``mobee-drake experiment trm --output DIR [--examples reach_into raise_a_glass]
-[--max-vertices N] [--seed S]``.
+Each example's task-space spacing ``d`` and NES spread are its own (:mod:`mobee_drake.trm.catalogue`
+lists the examples by the source's figures). ``--doc`` writes the table of every example built
+into a doc's generated block.
+
+Run: ``mobee-drake experiment trm --output DIR [--examples reach_into raise_a_glass ...]
+[--max-vertices N] [--seed S] [--doc docs/roadmaps.md]``.
 """
 
+import dataclasses as dc
 import pathlib
 
 import numpy as np
 
 from mobee_drake.atomic_files import WriteTextAtomically
 from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
+from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.plots import Figure, SaveFigure, plt
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.station.viewer import RecordingMeshcat
+from mobee_drake.trm.catalogue import EXAMPLES
 from mobee_drake.trm.display import MarkerCloud, PathMotion, RecordMotion, ShowRoadmap
-from mobee_drake.trm.examples import EXAMPLES, OpenBox, TrmExample
+from mobee_drake.trm.examples import OpenBox, TrmExample
 from mobee_drake.trm.roadmap import BuildTrm, TaskRelevantRoadmap, TrmConfig
 
 EDGE_SAMPLES = 10  # interpolated poses per edge for the collision check
@@ -74,9 +81,15 @@ def RoadmapFigure(
     return figure
 
 
-def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) -> str:
+DOC_TABLE = "trm-examples"
+
+
+def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) -> tuple[str, str]:
+    """Builds, saves, draws and records one example; returns its report section and its row of
+    the examples' table."""
     meshcat = RecordingMeshcat()
     example = EXAMPLES[name](meshcat)
+    config = dc.replace(config, spacing=example.spacing, sigma=example.sigma)
     roadmap = BuildTrm(
         example.problem, example.task_space, example.q_init, config, np.random.default_rng(seed)
     )
@@ -87,7 +100,7 @@ def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) ->
             points,
             roadmap,
             f"{name}: the right palm over a task-relevant roadmap of {roadmap.num_vertices} "
-            f"vertices\n(spacing d = {config.spacing} m, seed {seed}; cf. Fig. 3.1-3.3, 3.8)",
+            f"vertices\n(spacing d = {config.spacing}, seed {seed}; cf. Fig. 3.1-3.11)",
             boxes=name == "reach_into",
         ),
         output / f"{name}.png",
@@ -101,7 +114,8 @@ def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) ->
     colliding = EdgeCollisions(example, roadmap)
     seconds = roadmap.build_seconds
     extent = roadmap.y.max(axis=0) - roadmap.y.min(axis=0)
-    return "\n".join(
+    extent_text = np.round(extent, 3).tolist()
+    section = "\n".join(
         [
             f"## {name}",
             "",
@@ -110,7 +124,8 @@ def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) ->
             f"({roadmap.searches - roadmap.num_vertices} rejected)",
             f"- built in {seconds:.1f} s: {roadmap.num_vertices / seconds:.2f} vertices/s, "
             f"{roadmap.searches / seconds:.2f} searches/s",
-            f"- task-space extent {np.round(extent, 3).tolist()} m; spacing d = {config.spacing} m",
+            f"- task-space extent {extent_text}; spacing d = {config.spacing}, NES spread "
+            f"{config.sigma} rad",
             f"- edges colliding along their interpolation ({EDGE_SAMPLES} samples): {colliding} of "
             f"{len(roadmap.edges)}",
             f"- path shown: {len(path)} vertices from {start} to {goal}",
@@ -118,6 +133,19 @@ def RunExample(name: str, output: pathlib.Path, config: TrmConfig, seed: int) ->
             "",
         ]
     )
+    row = (
+        f"| {name} | {example.task_space.dimension} | {config.spacing:g} | {roadmap.num_vertices} "
+        f"| {len(roadmap.edges)} | {roadmap.searches} | {seconds:.0f} | {extent_text} | "
+        f"{colliding} of {len(roadmap.edges)} |"
+    )
+    return section, row
+
+
+TABLE_HEADER = [
+    "| roadmap | task dimensions | spacing d | vertices | edges | NGIK searches | build s | "
+    "task-space extent | edges colliding when interpolated |",
+    "|---|---:|---:|---:|---:|---:|---:|---|---|",
+]
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -142,15 +170,34 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--seed", type=NonNegativeInt, default=0, help="seed of the roadmap builder"
     )
+    parser.add_argument("--doc", help="a doc whose generated block to rewrite with the table")
+    parser.add_argument("--doc-table", default=DOC_TABLE, help="the name of --doc's block")
     args = parser.parse_args(argv)
+    if args.doc:
+        try:
+            GeneratedTable(args.doc, args.doc_table)
+        except (OSError, ValueError) as error:
+            parser.error(f"--doc: {error}")
     output = pathlib.Path(args.output)
     config = TrmConfig(max_vertices=args.max_vertices)
     # (Claimed like every folder a command writes: never a user's, one writer at a time.)
     with OwnedFolder(output, "trm roadmaps"):
-        sections = [RunExample(name, output, config, args.seed) for name in args.examples]
-        report = "# Task-relevant roadmaps\n\n" + "\n".join(sections)
+        built = [RunExample(name, output, config, args.seed) for name in args.examples]
+        table = "\n".join(TABLE_HEADER + [row for _, row in built])
+        report = (
+            "# Task-relevant roadmaps\n\n"
+            + table
+            + "\n\n"
+            + "\n".join(section for section, _ in built)
+        )
         WriteTextAtomically(output / "report.md", report)
     print(report)
+    if args.doc:
+        command = " ".join(
+            ["mobee-drake experiment trm --output", str(output), "--examples", *args.examples,
+             "--max-vertices", str(args.max_vertices), "--seed", str(args.seed)]
+        )  # fmt: skip
+        WriteGeneratedTable(args.doc, args.doc_table, f"{command} --doc {args.doc}", table)
 
 
 if __name__ == "__main__":

@@ -101,6 +101,22 @@ class TwoHandHoldCost:
 
 
 @dc.dataclass
+class OpposedDirections:
+    """h = w (1 + u_a . u_b): turn two markers' directions against each other (two palms facing
+    each other, as when holding an object between them), whatever their common direction."""
+
+    a: int
+    b: int
+    weight: float = 1.0
+    # 1 - cos(10 deg), as the orientation term.
+    tolerance: float = 1.0 - math.cos(math.radians(10.0))
+
+    def __call__(self, evaluation: PoseEvaluation) -> float:
+        u = evaluation.marker_directions
+        return self.weight * float(1.0 + u[self.a] @ u[self.b])
+
+
+@dc.dataclass
 class MarkerInBox:
     """A user-defined term: w times how far a marker is outside an axis-aligned box (m)."""
 

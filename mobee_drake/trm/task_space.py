@@ -7,7 +7,11 @@ R^n; it concatenates task functions, each giving one or more coordinates:
   workspace dimensions", or a plane of them);
 - :class:`MarkerAlong`: a marker's position along one direction ("move the hand back and forth",
   Table 3.2's ``x_1 + x_2 + x_3`` is the direction (1, 1, 1) unnormalised);
-- :class:`JointCoordinates`: some joint positions ("move in the null space of the cost").
+- :class:`JointCoordinates`: some joint positions ("move in the null space of the cost");
+- :class:`MarkerAngle`: the angle between a marker's direction and a fixed one ("turn the hand
+  with respect to the gaze", Fig. 3.5);
+- :class:`MarkerHeading`: the angle of a marker's direction in a plane, from a reference axis
+  ("rotate the palms in the up/down, left/right plane", Fig. 3.9-3.11).
 """
 
 import dataclasses as dc
@@ -55,7 +59,45 @@ class JointCoordinates:
         return evaluation.q[list(self.joints)]
 
 
-TaskFunction = MarkerCoordinates | MarkerAlong | JointCoordinates
+@dc.dataclass(frozen=True)
+class MarkerAngle:
+    """arccos(u . direction) (rad): how far a marker's direction is turned from ``direction``."""
+
+    marker: int
+    direction: tuple[float, float, float]  # unit, in world
+
+    @property
+    def size(self) -> int:
+        return 1
+
+    def __call__(self, evaluation: PoseEvaluation) -> np.ndarray:
+        cosine = evaluation.marker_directions[self.marker] @ np.asarray(self.direction)
+        return np.array([np.arccos(np.clip(cosine, -1.0, 1.0))])
+
+
+@dc.dataclass(frozen=True)
+class MarkerHeading:
+    """The angle (rad, in (-pi, pi]) of a marker's direction projected on the plane normal to
+    ``normal``, from ``reference`` (a unit vector in that plane), positive about ``normal``."""
+
+    marker: int
+    normal: tuple[float, float, float]  # unit, in world
+    reference: tuple[float, float, float]  # unit, normal to ``normal``
+
+    @property
+    def size(self) -> int:
+        return 1
+
+    def __call__(self, evaluation: PoseEvaluation) -> np.ndarray:
+        u, n, r = (
+            evaluation.marker_directions[self.marker],
+            np.asarray(self.normal),
+            np.asarray(self.reference),
+        )
+        return np.array([np.arctan2(np.cross(r, u) @ n, r @ u)])
+
+
+TaskFunction = MarkerCoordinates | MarkerAlong | JointCoordinates | MarkerAngle | MarkerHeading
 
 
 @dc.dataclass(frozen=True)
