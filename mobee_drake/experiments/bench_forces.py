@@ -3,9 +3,10 @@
 Like the scalability experiment of dissertation ch. 2.4: every controlled joint is driven through
 its range by its own oscillator, and for each new pose the whole MoBeE evaluation runs (forward
 kinematics, SceneGraph's signed-distance query, every force term and their total), against 0 to
-several hundred boxes in the robot's workspace: the iCub upper body (20 joints, 14 primitives) or
-the Katana of App. B (5 joints, 10 primitives). With ``--churn``, as in Alg. 1, objects are removed
-and inserted while the robot moves: before every evaluation one box is removed and a new one
+several hundred boxes in the robot's workspace: the iCub upper body (20 joints, 14 primitives),
+the same with 125 boxes fitted to its meshes (``icub_dense``, about the source's 129 primitives)
+or the Katana of App. B (5 joints, 10 primitives). With ``--churn``, as in Alg. 1, objects are
+removed and inserted while the robot moves: before every evaluation one box is removed and a new one
 inserted (our single-threaded stand-in for the source's sensory thread flooding the model).
 One process, one core.
 
@@ -21,6 +22,7 @@ Run: ``mobee-drake bench forces [--robot katana] [--churn] [--plot FILE.png]`` (
 
 import dataclasses as dc
 import resource
+import sys
 import time
 
 import numpy as np
@@ -33,6 +35,7 @@ from mobee_drake.experiments.arguments import (
     NonNegativeInt,
     PositiveInt,
 )
+from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.plots import Figure, SaveFigure, plt
 from mobee_drake.mobee.barrier import StepModel
 from mobee_drake.mobee.system import Mobee
@@ -50,7 +53,14 @@ BOX_REGIONS = {
     "icub": (np.array([-0.80, -0.60, -0.40]), np.array([-0.20, 0.60, 0.60])),
     "katana": (np.array([-0.50, -0.50, -0.20]), np.array([0.50, 0.50, 0.55])),
 }
-ROBOTS = {"icub": IcubConfig, "katana": ZeroPositionConfig}
+BOX_REGIONS["icub_dense"] = BOX_REGIONS["icub"]
+ROBOTS = {
+    "icub": IcubConfig,
+    # The iCub with boxes fitted to its meshes (models/icub_dense_overlay.yaml, 125 primitives,
+    # about the source's 129; issue 34).
+    "icub_dense": lambda: IcubConfig(overlay="icub_dense_overlay.yaml"),
+    "katana": ZeroPositionConfig,
+}
 
 
 @dc.dataclass
@@ -333,6 +343,10 @@ def _Parser() -> CommandParser:
         "robot runs it at that period (the poses are at rest)",
     )
     parser.add_argument(
+        "--doc", help="a doc whose generated block (--doc-table) to rewrite with the table"
+    )
+    parser.add_argument("--doc-table", default="forces", help="the name of --doc's block")
+    parser.add_argument(
         "--stages",
         action="store_true",
         help="instead, time each stage of one evaluation: " + ", ".join(STAGES),
@@ -345,6 +359,11 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     if args.plot and not CanWrite(args.plot):  # (checked before the work)
         parser.error(f"--plot {args.plot}: cannot be written (its folder is missing, read-only?)")
+    if args.doc:
+        try:
+            GeneratedTable(args.doc, args.doc_table)
+        except (OSError, ValueError) as error:
+            parser.error(f"--doc: {error}")
     if args.stages:
         print("| robot | boxes | " + " | ".join(f"{s} (us)" for s in STAGES) + " |")
         print("|---|---:|" + "---:|" * len(STAGES))
@@ -356,11 +375,12 @@ def main(argv=None) -> None:
                 cells = " | ".join(f"{stages[s]:.1f}" for s in STAGES)
                 print(f"| {robot} | {n} | {cells} |", flush=True)
         return
-    print(
+    lines = [
         "| robot | boxes | evaluations/s (best) | evaluations/s (median) | us/evaluation (best) "
-        "| floor us (best) | ratio | pairs inside fields (mean) | peak RSS (MiB) |"
-    )
-    print("|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+        "| floor us (best) | ratio | pairs inside fields (mean) | peak RSS (MiB) |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    print("\n".join(lines))
     curves = {}
     for robot in args.robot:
         for n in args.obstacles:
@@ -375,12 +395,15 @@ def main(argv=None) -> None:
                 period=args.barrier_period,
             )
             curves.setdefault(robot, []).append((n, r.best_per_second, r.median_per_second))
-            print(
+            lines.append(
                 f"| {robot} | {n} | {r.best_per_second:,.0f} | {r.median_per_second:,.0f} | "
                 f"{1e6 / r.best_per_second:.0f} | {r.floor_us:.0f} | {r.ratio:.2f} | "
-                f"{r.mean_pairs_in_fields:.2f} | {r.peak_rss_mib:.0f} |",
-                flush=True,
+                f"{r.mean_pairs_in_fields:.2f} | {r.peak_rss_mib:.0f} |"
             )
+            print(lines[-1], flush=True)
+    if args.doc:
+        command = "mobee-drake bench forces " + " ".join(sys.argv[1:] if argv is None else argv)
+        WriteGeneratedTable(args.doc, args.doc_table, command, "\n".join(lines))
     if args.plot:
         SaveFigure(ScalabilityFigure(curves, args.churn), args.plot, dpi=90)
         print(f"plot: {args.plot}")
