@@ -38,6 +38,12 @@ class AdaptiveRoadmapTest(unittest.TestCase):
         self.assertEqual(pairs, {(0, 1), (1, 0), (1, 4), (4, 1), (2, 1), (1, 2), (3, 2), (2, 3)})
         np.testing.assert_array_equal(roadmap.status, EdgeStatus.UNTRIED)
 
+    def test_k_nearest_out_only(self):
+        # The source's reading: each vertex commands its nearest; 3's nearest is 2, not back.
+        roadmap = AdaptiveRoadmap.KNearest(POSES, 1, both_ways=False)
+        pairs = {tuple(e) for e in roadmap.edges.tolist()}
+        self.assertEqual(pairs, {(0, 1), (1, 4), (2, 1), (3, 2), (4, 1)})
+
     def test_plans_around_infeasible_edges(self):
         roadmap = AdaptiveRoadmap(POSES, [(0, 1), (1, 2), (0, 4), (4, 2), (2, 3)])
         self.assertEqual(roadmap.Plan(0, 3), [0, 1, 2, 3])
@@ -93,6 +99,28 @@ class IcubDemosTest(unittest.TestCase):
         )
         self.assertEqual(result.reflexes, result.infeasible)
         self.assertGreater(result.feasible, 0)
+        self.assertEqual(result.forbidden_vertices, 0)  # (drawn free of MoBeE's fields)
+        # A dead end is a reachable vertex with no feasible edge out.
+        feasible_out = set(roadmap.edges[roadmap.status == EdgeStatus.FEASIBLE][:, 0].tolist())
+        self.assertEqual(
+            result.dead_ends, sum(1 for v in np.flatnonzero(reachable) if v not in feasible_out)
+        )
+
+    def test_the_sources_readings_leave_vertices_out_of_reach(self):
+        # Unchecked samples and one-way edges: some samples are forbidden poses, which no
+        # command reaches, and the explored graph is no larger than with checked samples.
+        result, roadmap = RoadmapFromScratch(
+            0, samples=6, k=3, vertex_sampling="uniform", edges="out"
+        )
+        self.assertEqual(result.edges, 7 * 3)
+        self.assertGreater(result.forbidden_vertices, 0)
+        self.assertGreaterEqual(result.unreachable_vertices, 1)
+        reachable = roadmap.Reachable(0)
+        self.assertFalse(
+            np.any((roadmap.status == EdgeStatus.UNTRIED) & reachable[roadmap.edges[:, 0]])
+        )
+        with self.assertRaisesRegex(ValueError, "unknown reading"):
+            RoadmapFromScratch(0, vertex_sampling="gaussian")
 
 
 if __name__ == "__main__":

@@ -1,19 +1,25 @@
 """The demonstrations of adaptive roadmap planning (dissertation ch. 4.3.1-4.3.2) in simulation.
 
 - **Roadmap from scratch**: the home pose and 20 random poses of the torso and right arm
-  (10 joints; the others at home), each joined both ways to its 10 nearest in joint space, no edge
+  (10 joints; the others at home), each joined to its 10 nearest in joint space, no edge
   checked; the robot, under MoBeE 1.0, explores until every edge out of every vertex it can reach
   is known (a table in front of it, as in the motor babbling scenario). We add the home pose as
-  the start vertex, since the robot has to begin somewhere, and draw the random poses among the
-  valid ones with nothing inside MoBeE's fields (a vertex the reflex forbids could never be
-  reached; checking 20 poses is cheap, it is the edges that go unchecked).
+  the start vertex, since the robot has to begin somewhere. Two readings of the source are
+  options (issue 34): ``vertex_sampling`` ``free`` (ours: the random poses are drawn among the
+  valid ones with nothing inside MoBeE's fields, since a vertex the reflex forbids could never be
+  reached) or ``uniform`` (the source's "20 random samples in the configuration space", checked
+  for nothing); ``edges`` ``both-ways`` (ours) or ``out`` (the source's "connected to their 10
+  nearest neighbors" read as each vertex's commands to its nearest). The source reports
+  unreachable vertices and edges (Fig. 4.6); each run counts them, and the dead ends (reachable
+  vertices with no feasible edge out).
 - **Adaptive re-planning**: a small graph built on purpose around a ball in front of the right
   hand: poses A and B put the palm on either side of the ball, D and E above A and B; the edge
   A-B is the short way (the hand passes through the ball), A-D-E-B the long way over it. With the
   ball a ghost the planner takes A -> B; then the ball is made solid, and the way back, B -> A,
   makes the reflex fire: the edge is removed and the planner goes around, B -> E -> D -> A.
 
-Run: ``mobee-drake experiment roadmaps [--seed S] [--meshcat]``.
+Run: ``mobee-drake experiment roadmaps [--seed S] [--meshcat]``; the readings' table over
+several seeds: ``mobee-drake experiment roadmaps --scratch-table --seeds 0 1 2 [--doc FILE]``.
 """
 
 import dataclasses as dc
@@ -23,6 +29,7 @@ import numpy as np
 from pydrake.geometry import StartMeshcat
 
 from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt
+from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.ngik.costs import CollisionCost, HomeCost, MarkerPositionCost
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.ngik.nes import NesConfig
@@ -64,6 +71,11 @@ def _ReflexRobot(objects: list[SceneObject], seed: int, meshcat) -> ReflexRobot:
     return ReflexRobot(BuildScenario(scenario, meshcat))
 
 
+DOC_TABLE = "roadmap-from-scratch"
+VERTEX_SAMPLINGS = ("free", "uniform")
+EDGE_READINGS = ("both-ways", "out")
+
+
 @dc.dataclass
 class ScratchResult:
     vertices: int
@@ -72,6 +84,10 @@ class ScratchResult:
     infeasible: int
     untried: int  # edges out of vertices the robot could never reach
     unreachable_vertices: int
+    # Vertices (home excluded) that are invalid, colliding or inside MoBeE's fields.
+    forbidden_vertices: int
+    # Reachable vertices with no feasible edge out.
+    dead_ends: int
     commands: int
     reflexes: int
     simulated_minutes: float
@@ -79,25 +95,39 @@ class ScratchResult:
 
 
 def RoadmapFromScratch(
-    seed: int = 0, *, samples: int = 20, k: int = 10, meshcat=None
+    seed: int = 0,
+    *,
+    samples: int = 20,
+    k: int = 10,
+    vertex_sampling: str = "free",
+    edges: str = "both-ways",
+    meshcat=None,
 ) -> tuple[ScratchResult, AdaptiveRoadmap]:
+    """Ch. 4.3.1 under the given readings (see the module's docstring)."""
+    if vertex_sampling not in VERTEX_SAMPLINGS or edges not in EDGE_READINGS:
+        raise ValueError(f"unknown reading: vertex_sampling {vertex_sampling!r}, edges {edges!r}")
     rng = np.random.default_rng(seed)
     robot = _ReflexRobot([TABLE], seed, meshcat)
     mobee = robot.station.mobee
     lower, upper = mobee.position_limits
     columns = [mobee.joint_index(j) for j in TORSO_JOINTS + RIGHT_ARM_JOINTS]
     model = KinematicModel(IcubConfig(), [TABLE], inside_fields=True)
+
+    def Free(q: np.ndarray) -> bool:
+        return model.IsValid(q) and not model.Evaluate(q).collision_pairs
+
     poses = [mobee.home]
     while len(poses) < samples + 1:
         q = mobee.home.copy()
         q[columns] = rng.uniform(lower[columns], upper[columns])
-        if model.IsValid(q) and not model.Evaluate(q).collision_pairs:
+        if vertex_sampling == "uniform" or Free(q):
             poses.append(q)
-    roadmap = AdaptiveRoadmap.KNearest(np.array(poses), k)
+    roadmap = AdaptiveRoadmap.KNearest(np.array(poses), k, both_ways=edges == "both-ways")
     began = time.perf_counter()
     record = ExploreRoadmap(roadmap, robot, 0, rng)
     wall = time.perf_counter() - began
     reachable = roadmap.Reachable(0)
+    feasible = roadmap.edges[roadmap.status == EdgeStatus.FEASIBLE]
     return ScratchResult(
         vertices=len(poses),
         edges=len(roadmap.edges),
@@ -105,6 +135,8 @@ def RoadmapFromScratch(
         infeasible=int(np.sum(roadmap.status == EdgeStatus.INFEASIBLE)),
         untried=int(np.sum(roadmap.status == EdgeStatus.UNTRIED)),
         unreachable_vertices=int(np.sum(~reachable)),
+        forbidden_vertices=sum(not Free(q) for q in poses[1:]),
+        dead_ends=int(np.sum(reachable & ~np.isin(np.arange(len(poses)), feasible[:, 0]))),
         commands=record.commands,
         reflexes=record.reflexes,
         simulated_minutes=robot.context.get_time() / 60,
@@ -190,7 +222,29 @@ def AdaptiveReplanning(seed: int = 0, *, meshcat=None) -> ReplanningResult:
     return ReplanningResult(ghost_path, ghost_arrived, first, direct, replanned, arrived, reflexes)
 
 
-def main(argv: list[str] | None = None) -> None:
+def ScratchTable(seeds: list[int]) -> list[str]:
+    """Markdown: ch. 4.3.1 under every reading, one row per reading and seed."""
+    lines = [
+        "| vertex sampling | edges | seed | directed edges | feasible | infeasible | never "
+        "reachable | forbidden vertices | unreachable vertices | dead ends | commands | simulated "
+        "min |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for sampling in VERTEX_SAMPLINGS:
+        for edges in EDGE_READINGS:
+            for seed in seeds:
+                r, _ = RoadmapFromScratch(seed, vertex_sampling=sampling, edges=edges)
+                lines.append(
+                    f"| {sampling} | {edges} | {seed} | {r.edges} | {r.feasible} | "
+                    f"{r.infeasible} | {r.untried} | {r.forbidden_vertices} | "
+                    f"{r.unreachable_vertices} | {r.dead_ends} | {r.commands} | "
+                    f"{r.simulated_minutes:.1f} |"
+                )
+                print(lines[-1], flush=True)
+    return lines
+
+
+def _Parser() -> CommandParser:
     parser = CommandParser(
         prog="mobee-drake experiment roadmaps",
         description=__doc__.split("\n")[0],
@@ -198,17 +252,64 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--seed", type=NonNegativeInt, default=0, help="seed of the roadmap and its exploration"
     )
+    parser.add_argument(
+        "--vertex-sampling",
+        choices=VERTEX_SAMPLINGS,
+        default="free",
+        help="ch. 4.3.1's vertices: free (valid, nothing inside MoBeE's fields) or uniform (the "
+        "source's random samples, unchecked)",
+    )
+    parser.add_argument(
+        "--edges",
+        choices=EDGE_READINGS,
+        default="both-ways",
+        help="ch. 4.3.1's edges to the 10 nearest: both ways, or out of each vertex only",
+    )
+    parser.add_argument(
+        "--scratch-table",
+        action="store_true",
+        help="instead, ch. 4.3.1 under every reading for each of --seeds, as a table",
+    )
+    parser.add_argument(
+        "--seeds", type=NonNegativeInt, nargs="+", default=[0, 1, 2], help="--scratch-table's"
+    )
+    parser.add_argument("--doc", help="a doc whose block 'roadmap-from-scratch' gets the table")
     parser.add_argument("--meshcat", action="store_true", help="watch the robot in Meshcat")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = _Parser()
     args = parser.parse_args(argv)
+    if args.doc and not args.scratch_table:
+        parser.error("--doc writes the table of --scratch-table")
+    if args.doc:
+        try:
+            GeneratedTable(args.doc, DOC_TABLE)
+        except (OSError, ValueError) as error:
+            parser.error(f"--doc: {error}")
+    if args.scratch_table:
+        lines = ScratchTable(args.seeds)
+        if args.doc:
+            command = "mobee-drake experiment roadmaps --scratch-table --seeds " + " ".join(
+                map(str, args.seeds)
+            )
+            WriteGeneratedTable(
+                args.doc, DOC_TABLE, f"{command} --doc {args.doc}", "\n".join(lines)
+            )
+        return
     meshcat = None
     if args.meshcat:
         meshcat = StartMeshcat()
-    scratch, _ = RoadmapFromScratch(args.seed, meshcat=meshcat)
+    scratch, _ = RoadmapFromScratch(
+        args.seed, vertex_sampling=args.vertex_sampling, edges=args.edges, meshcat=meshcat
+    )
     print("Roadmap from scratch (ch. 4.3.1):")
     print(
         f"  {scratch.vertices} vertices, {scratch.edges} directed edges: {scratch.feasible} "
         f"feasible, {scratch.infeasible} infeasible, {scratch.untried} never reachable "
-        f"({scratch.unreachable_vertices} vertices unreachable)"
+        f"({scratch.unreachable_vertices} vertices unreachable, {scratch.forbidden_vertices} "
+        f"forbidden, {scratch.dead_ends} dead ends)"
     )
     print(
         f"  {scratch.commands} commands, {scratch.reflexes} reflexes, "

@@ -53,15 +53,17 @@ class AdaptiveRoadmap:
             self.status = np.full(len(self.edges), EdgeStatus.UNTRIED)
 
     @staticmethod
-    def KNearest(poses: np.ndarray, k: int) -> "AdaptiveRoadmap":
-        """Each pose joined both ways to its ``k`` nearest in joint space (ch. 4.3.1)."""
+    def KNearest(poses: np.ndarray, k: int, both_ways: bool = True) -> "AdaptiveRoadmap":
+        """Each pose joined to its ``k`` nearest in joint space (ch. 4.3.1): both ways, or with
+        ``both_ways=False`` only from the pose to its nearest (the source's "connected to their
+        10 nearest neighbors", the edges read as the commands each vertex sends)."""
         poses = np.asarray(poses, dtype=float)
         distances = np.linalg.norm(poses[:, None] - poses[None], axis=2)
         np.fill_diagonal(distances, np.inf)
         pairs = set()
         for a, row in enumerate(distances):
             for b in np.argsort(row, kind="stable")[:k]:
-                pairs |= {(a, int(b)), (int(b), a)}
+                pairs |= {(a, int(b)), (int(b), a)} if both_ways else {(a, int(b))}
         return AdaptiveRoadmap(poses, np.array(sorted(pairs)))
 
     def Edge(self, a: int, b: int) -> int:
