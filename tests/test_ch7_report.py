@@ -42,9 +42,54 @@ class TestCh7Reports(unittest.TestCase):
             )
         ]
         lines = REPORTS["7.1"](self.output, runs)
-        # Mean tries 6, spread: the mean of std(4, 6) = 1 and std(5, 9) = 2, mean value 0.25.
-        self.assertEqual(_Cells(lines[2]), ["0.9", "2", "6.00", "1.50", "0.2500", "15.0"])
+        # Mean tries 6, spread: the mean of std(4, 6) = 1 and std(5, 9) = 2, mean value 0.25,
+        # times 1 - gamma: 0.025.
+        self.assertEqual(
+            _Cells(lines[2]), ["0.9", "2", "6.00", "1.50", "0.2500", "0.02500", "15.0"]
+        )
         self.assertTrue((self.output / "7.1_hypercube.png").is_file())
+
+    def test_coverage_counts_censored_runs_and_marks_the_ratio(self):
+        from mobee_drake.experiments.ch7_figures import COVERAGE_STATE_ACTIONS as ALL
+
+        def Run(strategy: str, run: int, covered_at: int | None, cap: int = 4000):
+            end = covered_at or cap
+            coverage = [[n, min(ALL, ALL * n // end) if covered_at else ALL - 5] for n in
+                        range(500, end + 1, 500)]  # fmt: skip
+            return _Run(labels=dict(strategy=strategy, run=run, cap=cap), coverage=coverage)
+
+        runs = [Run("curious", k, n) for k, n in enumerate((1000, 1500, 1000))]
+        runs += [Run("least_tried", k, n) for k, n in enumerate((2500, 2500, 2000))]
+        lines = REPORTS["7.2"](self.output, runs)
+        self.assertEqual(_Cells(lines[2]), ["curious", "0", "1000", str(ALL), "1000"])
+        # Means 1166.7 and 2333.3: a ratio of 0.50, every run finished.
+        self.assertRegex(lines[-1], r"least-tried.*: 0\.50 \[.*\(3 and 3 runs\).*\*\*reproduced")
+        runs[-1] = Run("least_tried", 2, None)  # stopped by the cap at 4000
+        lines = REPORTS["7.2"](self.output, runs)
+        self.assertIn("| least_tried | 2 | 4000 | " + str(ALL - 5) + " | > 4000 |", lines[7])
+        self.assertIn("an upper bound: 1 run(s) stopped by the cap", lines[-1])
+        self.assertIn("**not reproduced**", lines[-1])
+
+    def test_controls_compare_the_arms_correlation_with_and_without_the_table(self):
+        rng = np.random.default_rng(0)
+        shared = rng.poisson(5, 300)
+
+        def Arms(noise: float) -> list:
+            return [(shared + rng.poisson(noise, 300)).tolist() for _ in range(2)]
+
+        runs = [
+            _Run(labels={}, tries=Arms(0.5)),  # 7.4: the arms alike
+            _Run(labels=dict(control="no_table"), tries=Arms(20.0)),  # unlike without it
+            _Run(labels=dict(control="right_alone"), tries=Arms(0.5)[:1]),
+            _Run(labels=dict(control="left_alone"), tries=Arms(0.5)[:1]),
+        ]
+        lines = REPORTS["7.4c"](self.output, runs)
+        table, no_table = (np.corrcoef(r.tries[0], r.tries[1])[0, 1] for r in runs[:2])
+        self.assertEqual(_Cells(lines[2])[2], f"{table:.3f}")
+        self.assertEqual(_Cells(lines[3])[2], f"{no_table:.3f}")
+        self.assertIn("the table makes the arms more alike", lines[-1])
+        runs[1] = _Run(labels=dict(control="no_table"), tries=Arms(0.5))
+        self.assertIn("the table adds no similarity", REPORTS["7.4c"](self.output, runs)[-1])
 
     def test_initialization_lists_the_state_actions_that_miss_their_goal(self):
         tries = np.full(8, 4)

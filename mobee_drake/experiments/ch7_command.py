@@ -17,6 +17,7 @@ from mobee_drake.experiments.ch7_model_learning import (
     RunInitializations,
     RunRank4,
     RunThreeAgents,
+    RunThreeAgentsControls,
 )
 from mobee_drake.experiments.ch7_report import REPORTS
 from mobee_drake.owned_folders import ClaimFolder
@@ -30,7 +31,7 @@ def _Parser() -> CommandParser:
     )
     parser.add_argument(
         "--experiment",
-        choices=["7.1", "7.2", "7.2i", "7.3", "7.4", "7.4.1"],
+        choices=["7.1", "7.2", "7.2i", "7.3", "7.4", "7.4c", "7.4.1"],
         required=True,
         help="which experiment of ch. 7",
     )
@@ -42,8 +43,9 @@ def _Parser() -> CommandParser:
         "--transitions",
         type=PositiveInt,
         default=None,
-        help="7.2: per run (default 2500); 7.3: per lattice (default: the "
-        "source's 14,597 and 26,963); 7.4: in all (default 18,000)",
+        help="7.2: the cap per run, which stops once every state-action was tried (default "
+        "20,000); 7.3: per lattice (default: the source's 14,597 and 26,963); 7.4 and 7.4c: in "
+        "all (default 18,000)",
     )
     parser.add_argument(
         "--transition-noise",
@@ -68,13 +70,17 @@ def main(argv=None) -> None:
     if args.experiment == "7.1":
         results = RunHypercube(output, args.runs, backend, transition_noise=noise)
     elif args.experiment == "7.2":
-        results = RunCoverage(output, args.transitions or 2500, args.runs, backend, noise)
+        results = RunCoverage(output, args.transitions or 20000, args.runs, backend, noise)
     elif args.experiment == "7.2i":
         results = RunInitializations(output, args.runs, backend, transition_noise=noise)
     elif args.experiment == "7.3":
         results = RunRank4(output, args.transitions, backend, noise)
     elif args.experiment == "7.4":
         results = RunThreeAgents(output, args.transitions or 18000, backend, noise)
+    elif args.experiment == "7.4c":
+        transitions = args.transitions or 18000
+        results = [RunThreeAgents(output, transitions, backend, noise)]
+        results += RunThreeAgentsControls(output, transitions, backend, noise)
     else:
         results = RunDynamicPlanning(output, args.transitions or 1000, args.runs, backend)
     table = REPORTS[args.experiment](output, results)

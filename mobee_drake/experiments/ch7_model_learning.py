@@ -186,6 +186,8 @@ def RunCoverage(
     backend: Backend,
     transition_noise: float = 0.0,
 ) -> list[ExplorationRun]:
+    """Ch. 7.2's coverage race: each strategy until every one of the 1296 state-actions was
+    tried, or ``transitions`` (a cap; a run stopped by it is censored in the report)."""
     jobs = [
         Job(
             f"7.2_{strategy}_run{run}",
@@ -196,8 +198,8 @@ def RunCoverage(
                         [0.25, 0.5, 0.75], nearest=16, explorer=ExplorerConfig(strategy=strategy)
                     )
                 ],
-                stop=Stop(actions=transitions),
-                labels=dict(strategy=strategy, run=run),
+                stop=Stop(min_tries=1, actions=transitions),
+                labels=dict(strategy=strategy, run=run, cap=transitions),
                 random_seed=run,
             ),
             total=transitions,
@@ -269,20 +271,23 @@ def RunRank4(
     return _Run(jobs, output, backend, "7.3", transition_noise)
 
 
-def RunThreeAgents(
-    output: pathlib.Path, transitions: int, backend: Backend, transition_noise: float = 0.0
-) -> ExplorationRun:
+def _ThreeAgents() -> list[ExploringAgent]:
     rank_3 = [0.25, 0.5, 0.75]
-    agents = [
+    return [
         ExploringAgent(name="right_arm", joints=RIGHT_ARM, levels=rank_3, nearest=16),
         ExploringAgent(name="left_arm", joints=LEFT_ARM, levels=rank_3, nearest=16),
         ExploringAgent(name="torso", joints=TORSO, levels=rank_3, nearest=8),
     ]
+
+
+def RunThreeAgents(
+    output: pathlib.Path, transitions: int, backend: Backend, transition_noise: float = 0.0
+) -> ExplorationRun:
     job = Job(
         f"7.4_{transitions}",
         ExploreJob,
         dict(
-            agents=agents,
+            agents=_ThreeAgents(),
             stop=Stop(total_actions=transitions),
             labels={},
             objects=[TABLE],
@@ -293,6 +298,43 @@ def RunThreeAgents(
         total=transitions,
     )
     return _Run([job], output, backend, "7.4", transition_noise)[0]
+
+
+# Each arm's share of 7.4's transitions (5,420 and 5,428 of 18,000): an arm alone explores as
+# long as it did beside the others.
+ARM_SHARE = 0.3
+
+
+def RunThreeAgentsControls(
+    output: pathlib.Path, transitions: int, backend: Backend, transition_noise: float = 0.0
+) -> list[ExplorationRun]:
+    """Controls for 7.4's arm-to-arm correlation (issue 34): the three agents without the
+    table, and each arm alone by the table (the torso at home) for its share of the
+    transitions."""
+    agents = _ThreeAgents()
+    alone = round(ARM_SHARE * transitions)
+    settings = [
+        ("no_table", agents, [], Stop(total_actions=transitions), transitions),
+        ("right_alone", agents[:1], [TABLE], Stop(total_actions=alone), alone),
+        ("left_alone", agents[1:2], [TABLE], Stop(total_actions=alone), alone),
+    ]
+    jobs = [
+        Job(
+            f"7.4c_{name}_{budget}",
+            ExploreJob,
+            dict(
+                agents=chosen,
+                stop=stop,
+                labels=dict(control=name),
+                objects=objects,
+                random_seed=1,  # (as 7.4: the agents' seeds 1, 2, 3)
+                chunk=5.0,
+            ),
+            total=budget,
+        )
+        for name, chosen, objects, stop, budget in settings
+    ]
+    return _Run(jobs, output, backend, "7.4c", transition_noise)
 
 
 def _TableContacts(simulation, period: float = 0.1):

@@ -54,33 +54,80 @@ def _HypercubeReport(output: pathlib.Path, results: list[ExplorationRun]) -> lis
         lines.append(
             f"| {gamma} | {len(mine)} | {tries.mean():.2f} | "
             f"{tries.std(axis=1).mean():.2f} | {values.mean():.4f} | "
+            f"{values.mean() * (1 - gamma):.5f} | "
             f"{np.mean([r.wall_seconds for r in mine]):.1f} |"
         )
+    # A reward r repeated for ever is worth r / (1 - gamma): the values scale like 1 / (1 - gamma).
     header = [
         "| gamma | runs | mean tries per state-action after 320 actions | "
         "spread of tries (std over state-actions, mean over runs) | mean V(s, a) | "
-        "wall s per run |",
-        "|---:|---:|---:|---:|---:|---:|",
+        "mean V(s, a) x (1 - gamma) | wall s per run |",
+        "|---:|---:|---:|---:|---:|---:|---:|",
     ]
     return header + lines
 
 
+def _TransitionsToCover(run: ExplorationRun) -> tuple[int, bool]:
+    """The transitions until every state-action was tried, and whether the run got there (if
+    not, its last count: a lower bound)."""
+    coverage = np.array(run.coverage)
+    full = coverage[coverage[:, 1] >= COVERAGE_STATE_ACTIONS, 0]
+    return (int(full[0]), True) if len(full) else (int(coverage[-1, 0]), False)
+
+
+# "In about half the time" (ch. 7.2, Fig. 7.5): the curious agent's coverage time over least-tried.
+SOURCE_COVERAGE_RATIO = 0.5
+
+
+def CoverageRatio(results: list[ExplorationRun]) -> str:
+    """The source's "AC tries all state-actions in about half the time LT needs": the ratio of
+    the mean transitions to full coverage, curious over least-tried, with a 95 % bootstrap
+    interval over runs; a least-tried run stopped by the cap enters with its cap, so the ratio
+    is then an upper bound. Marked reproduced when every run finished and the interval holds
+    0.5 and lies below 1."""
+    counts = {
+        strategy: [_TransitionsToCover(r) for r in results if r.labels["strategy"] == strategy]
+        for strategy in ("curious", "least_tried")
+    }
+    if min(len(c) for c in counts.values()) < 2:
+        return "- curious over least-tried: not testable (fewer than 2 runs of each)"
+    curious, least = (np.array([n for n, _ in counts[s]], float) for s in counts)
+    censored = sum(not done for c in counts.values() for _, done in c)
+    rng = np.random.default_rng(0)
+    ratios = [
+        rng.choice(curious, curious.size).mean() / rng.choice(least, least.size).mean()
+        for _ in range(10_000)
+    ]
+    low, high = np.percentile(ratios, [2.5, 97.5])
+    ratio = curious.mean() / least.mean()
+    held = not censored and low <= SOURCE_COVERAGE_RATIO <= high and high < 1
+    bound = f", an upper bound: {censored} run(s) stopped by the cap" if censored else ""
+    return (
+        f"- curious over least-tried, mean transitions to try every state-action: {ratio:.2f} "
+        f"[{low:.2f}, {high:.2f}] ({curious.size} and {least.size} runs{bound}); the source: "
+        f"about {SOURCE_COVERAGE_RATIO}: **{'reproduced' if held else 'not reproduced'}**"
+    )
+
+
 def _CoverageReport(output: pathlib.Path, results: list[ExplorationRun]) -> list[str]:
-    """Coverage (ch. 7.2): transitions until every state-action was tried."""
+    """Coverage (ch. 7.2): transitions until every state-action was tried (or the cap)."""
     lines = []
     SaveFigure(CoverageFigure(results), output / "7.2_coverage.png")
     for strategy in ("curious", "random", "least_tried"):
         for r in [r for r in results if r.labels["strategy"] == strategy]:
             coverage = np.array(r.coverage)
-            full = coverage[coverage[:, 1] >= COVERAGE_STATE_ACTIONS, 0]
+            count, done = _TransitionsToCover(r)
             lines.append(
                 f"| {strategy} | {r.labels['run']} | {coverage[-1, 0]} | "
-                f"{coverage[-1, 1]} | {full[0] if len(full) else '-'} |"
+                f"{coverage[-1, 1]} | {count if done else f'> {count}'} |"
             )
     return [
         "| strategy | run | transitions | state-actions tried | transitions to try all |",
         "|---|---:|---:|---:|---:|",
-    ] + lines
+        *lines,
+        "",
+        CoverageRatio(results),
+    ]
 
 
 def _Rank4Report(output: pathlib.Path, results: list[ExplorationRun]) -> list[str]:
@@ -222,6 +269,57 @@ def _ThreeAgentsReport(output: pathlib.Path, results: ExplorationRun) -> list[st
     return lines
 
 
+def ArmCorrelation(a, b) -> float:
+    return float(np.corrcoef(np.asarray(a, float), np.asarray(b, float))[0, 1])
+
+
+def _CorrelationDifference(table: tuple, control: tuple) -> tuple[float, float, float]:
+    """r(table) - r(control) of the two arms' tries, with a 95 % bootstrap interval over the
+    state-actions (resampled together in both runs: the same lattice)."""
+    rng = np.random.default_rng(0)
+    table, control = (tuple(np.asarray(t, float) for t in pair) for pair in (table, control))
+    differences = []
+    for _ in range(2000):
+        pick = rng.integers(table[0].size, size=table[0].size)
+        differences.append(
+            ArmCorrelation(table[0][pick], table[1][pick])
+            - ArmCorrelation(control[0][pick], control[1][pick])
+        )
+    low, high = np.percentile(differences, [2.5, 97.5])
+    return ArmCorrelation(*table) - ArmCorrelation(*control), float(low), float(high)
+
+
+def _ControlsReport(output: pathlib.Path, results: list[ExplorationRun]) -> list[str]:
+    """7.4's arm-to-arm correlation against its controls (issue 34): is the arms' similarity
+    the table's doing? The runs: 7.4 itself (labels {}), its three agents without the table,
+    and each arm alone by the table."""
+    by = {r.labels.get("control", "table"): r for r in results}
+    pairs = {
+        "three agents, table (7.4)": by["table"].tries[:2],
+        "three agents, no table": by["no_table"].tries[:2],
+        "each arm alone, table": (by["right_alone"].tries[0], by["left_alone"].tries[0]),
+    }
+    lines = [
+        "| run | transitions per arm | correlation of the arms' tries per state-action | "
+        "7.4's minus this [95 % bootstrap over state-actions] |",
+        "|---|---|---:|---|",
+    ]
+    table = pairs["three agents, table (7.4)"]
+    for name, (right, left) in pairs.items():
+        difference = "-"
+        if name != "three agents, table (7.4)":
+            d, low, high = _CorrelationDifference(table, (right, left))
+            difference = f"{d:+.3f} [{low:+.3f}, {high:+.3f}]"
+        lines.append(
+            f"| {name} | {sum(right)}, {sum(left)} | {ArmCorrelation(right, left):.3f} | "
+            f"{difference} |"
+        )
+    d, low, high = _CorrelationDifference(table, pairs["three agents, no table"])
+    says = "the table makes the arms more alike" if low > 0 else "the table adds no similarity"
+    lines += ["", f"- without the table: {says} (difference {d:+.3f} [{low:+.3f}, {high:+.3f}])"]
+    return lines
+
+
 # Each experiment's figures, written into the output folder; each returns its report's lines.
 REPORTS = {
     "7.1": _HypercubeReport,
@@ -230,4 +328,5 @@ REPORTS = {
     "7.2i": _InitializationReport,
     "7.4.1": _MovingBoxReport,
     "7.4": _ThreeAgentsReport,
+    "7.4c": _ControlsReport,
 }
