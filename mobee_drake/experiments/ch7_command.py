@@ -20,6 +20,7 @@ from mobee_drake.experiments.ch7_model_learning import (
     RunThreeAgentsControls,
 )
 from mobee_drake.experiments.ch7_report import REPORTS
+from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.owned_folders import ClaimFolder
 
 
@@ -54,6 +55,9 @@ def _Parser() -> CommandParser:
         help="a stochastic robot (not for 7.4.1): the actuation noise's standard deviation "
         "per joint, a fraction of its range (runs named ..._noise<sd>)",
     )
+    parser.add_argument(
+        "--doc", help="a doc whose generated block 'ch7-<experiment>' gets the report's table"
+    )
     AddBackendArguments(parser)
     return parser
 
@@ -65,6 +69,12 @@ def main(argv=None) -> None:
     noise = args.transition_noise
     if noise and args.experiment == "7.4.1":
         parser.error("--transition-noise: 7.4.1 runs on the noise-free robot only")
+    block = f"ch7-{args.experiment}"
+    if args.doc:
+        try:
+            GeneratedTable(args.doc, block)
+        except (OSError, ValueError) as error:
+            parser.error(f"--doc: {error}")
     output = ClaimFolder(args.output, "battery")  # (a file or a user's folder refused)
     backend = BackendOf(args)
     if args.experiment == "7.1":
@@ -90,6 +100,9 @@ def main(argv=None) -> None:
     )
     WriteTextAtomically(output / f"report_{args.experiment}.md", text)
     print(text)
+    if args.doc:
+        command = f"mobee-drake experiment ch7 {' '.join(argv)}"
+        WriteGeneratedTable(args.doc, block, command, "\n".join(table))
 
 
 if __name__ == "__main__":
