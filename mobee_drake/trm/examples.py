@@ -125,7 +125,7 @@ def ReachInto(meshcat: Meshcat | None = None) -> TrmExample:
     inside = BOX_INSIDE / 2 - 0.03
     lower = np.array([*(BOX_CENTRE - inside), BOX_FLOOR + 0.03])
     upper = np.array([*(BOX_CENTRE + inside), BOX_RIM])
-    terms = [HomeBias(model), CollisionCost(), MarkerInBox(palm, lower, upper)]
+    terms = [HomeBias(model), CollisionCost(), MarkerInBox(palm, lower, upper, weight=10.0)]
     problem = IkProblem(model, terms, joints=JOINTS)
     return TrmExample(
         "reach_into", model, problem, TaskSpace((MarkerCoordinates(palm),)), model.home, palm
