@@ -211,7 +211,6 @@ def Run(problems: int, seed: int) -> list[dict]:
                     "evaluations": float(np.mean([s.evaluations for s in solutions])),
                     "solves_per_s": float(len(solutions) / seconds.sum()),
                     "evaluations_each": [s.evaluations for s in solutions],
-                    "solved_each": solved.tolist(),
                 }
             )
     return rows
