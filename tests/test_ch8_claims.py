@@ -112,6 +112,14 @@ class TestClaims(unittest.TestCase):
         row = next(line for line in table if line.startswith("| intrinsic motivation is the least"))
         self.assertTrue(row.endswith("| reproduced | not reproduced | unit0.03_force300 |"))
 
+    def test_one_pair_per_mdp_is_tested_without_separating_the_mdps(self):
+        # Seeds 0 and 1 on MDPs 0 and 1: no pair shares an MDP, so there is no error within
+        # them; the plain paired t-test is used, and the evidence says so.
+        few = [_Run(s, k) for s in REWARDS for k in range(2)]
+        verdict = claims.Verdicts(few)[0]
+        self.assertIn("(one pair per MDP, MDPs not separated)", verdict.evidence)
+        self.assertNotIn("over 2 MDPs", verdict.evidence)
+
     def test_a_claim_with_nothing_to_compare_is_not_testable(self):
         alone = [r for r in self.strict if r.strategy == "intrinsic"]
         marks = _Marks(alone)
