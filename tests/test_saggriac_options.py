@@ -391,6 +391,20 @@ class TestVariants(unittest.TestCase):
                 self.assertIn(text, report)
             for name in ("exp2_effects.png", "exp2_tips.png", "exp2_goals.png"):
                 self.assertGreater((output / name).stat().st_size, 1000, name)
+            # --doc writes the interest tables and marks into the doc's block, naming the command
+            # that rewrites it without running anything.
+            doc = output / "doc.md"
+            doc.write_text(
+                "<!-- generated: saggriac-interest, by x -->\nOLD\n"
+                "<!-- end generated: saggriac-interest -->\n"
+            )
+            with contextlib.redirect_stdout(io.StringIO()):
+                command.main([*argv, "--analyse-only", "--doc", str(doc)])
+            text = doc.read_text()
+            self.assertNotIn("OLD", text)
+            self.assertIn("--analyse-only --doc", text)
+            self.assertIn("| SAGG-RIAC | 2 |", text)
+            self.assertIn("The paper's gain (SAGG-RIAC over SAGG-Random): **not testable**", text)
 
 
 def _Run(method: str, seed: int, curve: list[dict], variant: str = "paper", **fields):
