@@ -133,62 +133,53 @@ def BimanualInspect(meshcat: Meshcat | None = None) -> TrmExample:
     )
 
 
-def PushForward(meshcat: Meshcat | None = None) -> TrmExample:
-    """Fig. 3.6: both palms facing forward (-x), 25 cm apart, in the height band
-    :data:`PUSH_HEIGHT`; the task space the right palm's forward/back position; spacing 2 cm."""
+def _Push(name: str, facing: tuple, along: tuple, meshcat: Meshcat | None) -> TrmExample:
+    """Both palms facing ``facing``, 25 cm apart, in the height band :data:`PUSH_HEIGHT`; the
+    task space the right palm's position along ``along``; spacing 2 cm."""
     return _TwoHandTask(
-        "push_forward",
+        name,
         lambda m, right, left: [
             TwoHandHoldCost(left, right, HOLD),
-            *_Facing(right, left, (-1.0, 0.0, 0.0)),
+            *_Facing(right, left, facing),
             HeightBand(right, *PUSH_HEIGHT),
             HeightBand(left, *PUSH_HEIGHT),
         ],
-        lambda m: (MarkerAlong(m.MarkerIndex("r_palm"), (-1.0, 0.0, 0.0)),),
+        lambda m: (MarkerAlong(m.MarkerIndex("r_palm"), along),),
         0.02,
         meshcat,
     )
 
 
+def PushForward(meshcat: Meshcat | None = None) -> TrmExample:
+    """Fig. 3.6: the palms face forward (-x) and move forward/back (:func:`_Push`)."""
+    return _Push("push_forward", (-1.0, 0.0, 0.0), (-1.0, 0.0, 0.0), meshcat)
+
+
 def PushOver(meshcat: Meshcat | None = None) -> TrmExample:
-    """Fig. 3.7: both palms facing left (-y), 25 cm apart, in the height band
-    :data:`PUSH_HEIGHT`; the task space the right palm's left/right position; spacing 2 cm."""
+    """Fig. 3.7: the palms face left (-y) and move left/right (:func:`_Push`)."""
+    return _Push("push_over", (0.0, -1.0, 0.0), (0.0, 1.0, 0.0), meshcat)
+
+
+def _HeldTurn(name: str, axis: tuple, meshcat: Meshcat | None) -> TrmExample:
+    """The hands hold an object; the task space the right palm normal's angle about ``axis``,
+    from -y; spacing 0.1 rad."""
     return _TwoHandTask(
-        "push_over",
-        lambda m, right, left: [
-            TwoHandHoldCost(left, right, HOLD),
-            *_Facing(right, left, (0.0, -1.0, 0.0)),
-            HeightBand(right, *PUSH_HEIGHT),
-            HeightBand(left, *PUSH_HEIGHT),
-        ],
-        lambda m: (MarkerAlong(m.MarkerIndex("r_palm"), (0.0, 1.0, 0.0)),),
-        0.02,
+        name,
+        _Hold,
+        lambda m: (MarkerHeading(m.MarkerIndex("r_palm"), axis, (0.0, -1.0, 0.0)),),
+        0.1,
         meshcat,
     )
 
 
 def BimanualRotate(meshcat: Meshcat | None = None) -> TrmExample:
-    """Fig. 3.9: the hands hold an object; the task space the right palm normal's angle in the
-    up/down, left/right plane (about the forward axis, from -y); spacing 0.1 rad."""
-    return _TwoHandTask(
-        "bimanual_rotate",
-        _Hold,
-        lambda m: (MarkerHeading(m.MarkerIndex("r_palm"), (1.0, 0.0, 0.0), (0.0, -1.0, 0.0)),),
-        0.1,
-        meshcat,
-    )
+    """Fig. 3.9: the held object turns in the up/down, left/right plane (about forward)."""
+    return _HeldTurn("bimanual_rotate", (1.0, 0.0, 0.0), meshcat)
 
 
 def BimanualTwist(meshcat: Meshcat | None = None) -> TrmExample:
-    """Fig. 3.10: the hands hold an object; the task space the right palm normal's angle in the
-    table plane (about the vertical, from -y); spacing 0.1 rad."""
-    return _TwoHandTask(
-        "bimanual_twist",
-        _Hold,
-        lambda m: (MarkerHeading(m.MarkerIndex("r_palm"), (0.0, 0.0, 1.0), (0.0, -1.0, 0.0)),),
-        0.1,
-        meshcat,
-    )
+    """Fig. 3.10: the held object turns in the table plane (about the vertical)."""
+    return _HeldTurn("bimanual_twist", (0.0, 0.0, 1.0), meshcat)
 
 
 def Unscrew(meshcat: Meshcat | None = None) -> TrmExample:
