@@ -27,7 +27,7 @@ HEADER = """\
 def DenseIcubOverlayText(slices: int = SLICES) -> str:
     """The dense overlay file's text."""
     base = LoadOverlay(ResolveModelFile("icub_overlay.yaml"))
-    overlay = DenseOverlay(base, PreparedIcubModel(DEFAULT_ICUB_MODEL), slices)
+    overlay = DenseOverlay(base, PreparedIcubModel(DEFAULT_ICUB_MODEL, "full"), slices)
     return HEADER.format(model=DEFAULT_ICUB_MODEL, slices=slices) + yaml_dump_typed(overlay)
 
 

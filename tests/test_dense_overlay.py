@@ -61,7 +61,7 @@ class DenseIcubOverlayTest(unittest.TestCase):
         self.assertEqual(script.DenseIcubOverlayText(), shipped)
 
     def test_boxes_hold_every_vertex_of_their_links_mesh(self):
-        urdf = PreparedIcubModel(DEFAULT_ICUB_MODEL)
+        urdf = PreparedIcubModel(DEFAULT_ICUB_MODEL, "full")
         links = {p.link for p in self.base.primitives}
         self.assertEqual({p.link for p in self.dense.primitives}, links)
         self.assertGreaterEqual(len(self.dense.primitives), 120)

@@ -630,12 +630,19 @@ class TestInteractive(unittest.TestCase):
         ball = _Palm(simulation, context) + 0.05 * normal
         simulation.world.Move(simulator.get_mutable_context(), "ball", ball)
         simulation.diagram.ForcedPublish(context)
-        self.assertTrue(meshcat.HasPath("/field_forces"))
+        self.assertTrue(_Visible(meshcat, "/field_forces/0"))
         # Without the ball nothing is inside a field, and no force is drawn.
         simulation.world.Remove(simulator.get_mutable_context(), "ball")
         simulation.world.Remove(simulator.get_mutable_context(), "table")
         simulation.diagram.ForcedPublish(context)
-        self.assertFalse(meshcat.HasPath("/field_forces"))
+        self.assertFalse(_Visible(meshcat, "/field_forces/0"))
+
+
+def _Visible(meshcat, path: str) -> bool:
+    """Whether Meshcat shows the object at ``path`` (its last "visible" property)."""
+    import msgpack
+
+    return msgpack.unpackb(meshcat._GetPackedProperty(path, "visible"))["value"]
 
 
 class BallSwitcher(LeafSystem):
@@ -744,7 +751,7 @@ class TestRunner(unittest.TestCase):
             "/drake/illustration/icub_iCubGazeboV2_5",
             "/drake/illustration/attractor",
             "/drake/world/ball/0",
-            "/trail",
+            "/trail/0",
         ):
             self.assertTrue(meshcat.HasPath(scene_path), scene_path)
         self.assertAlmostEqual(summary.simulated_time, 1.0)

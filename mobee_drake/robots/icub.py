@@ -68,8 +68,10 @@ def AddIcub(
     scene_graph: SceneGraph,
     config: IcubConfig | None = None,
     X_WRoot: RigidTransform | None = None,
+    meshes: str = "light",
 ) -> RobotOverlay:
-    """Adds the iCub with its collision overlay to an unfinalized ``plant``.
+    """Adds the iCub with its collision overlay to an unfinalized ``plant``, drawn with its
+    ``meshes`` ("light", decimated for viewers, or "full"; see ``model_cache``).
 
     The root link is welded to the world at ``X_WRoot`` (identity by default); joints that are not
     in ``config.controlled_joints`` are welded at their home angles.
@@ -82,7 +84,7 @@ def AddIcub(
     return AddRobotWithOverlay(
         plant,
         scene_graph,
-        model_file=PreparedIcubModel(config.model),
+        model_file=PreparedIcubModel(config.model, meshes),
         overlay_file=ResolveModelFile(config.overlay),
         controlled_joints=config.controlled_joints,
         home={name: math.radians(value) for name, value in config.home_deg.items()},

@@ -22,11 +22,14 @@ def AddScenarioRobot(
     *,
     X_WRoot: RigidTransform | None = None,
     model_name: str | None = None,
+    meshes: str = "light",
 ) -> tuple[RobotOverlay, list[str]]:
     """Adds the configured robot, its root at ``X_WRoot``, to an unfinalized plant; returns its
-    overlay and the joints MoBeE controls."""
+    overlay and the joints MoBeE controls. An iCub is drawn with its ``meshes`` (see
+    :func:`~mobee_drake.robots.icub.AddIcub`)."""
     if isinstance(config, IcubConfig):
-        return AddIcub(plant, scene_graph, config, X_WRoot), list(config.controlled_joints)
+        overlay = AddIcub(plant, scene_graph, config, X_WRoot, meshes)
+        return overlay, list(config.controlled_joints)
     robot = config.Load()
     joints = config.Joints(robot)
     return AddZeroPositionRobot(
@@ -34,11 +37,14 @@ def AddScenarioRobot(
     ), joints
 
 
-def RobotModelText(config: RobotConfig, alpha: float) -> tuple[str, str, str, dict[str, float]]:
-    """The robot's model drawn with opacity ``alpha`` (for the attractor's ghost robot): its text,
-    its format ("urdf" or "sdf"), its root link and its home angles (radians)."""
+def RobotModelText(
+    config: RobotConfig, alpha: float, meshes: str = "light"
+) -> tuple[str, str, str, dict[str, float]]:
+    """The robot's model drawn with opacity ``alpha`` (for the attractor's ghost robot) and,
+    for an iCub, its ``meshes``: its text, its format ("urdf" or "sdf"), its root link and its
+    home angles (radians)."""
     if isinstance(config, IcubConfig):
-        text = PreparedIcubModel(config.model).read_text()
+        text = PreparedIcubModel(config.model, meshes).read_text()
         text = re.sub(
             r'rgba="([\d.]+) ([\d.]+) ([\d.]+) [\d.]+"', rf'rgba="\1 \2 \3 {alpha}"', text
         )

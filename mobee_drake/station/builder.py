@@ -349,7 +349,8 @@ def _AddPlantAndWorld(builder: DiagramBuilder, config: StationConfig):
         scene_graph = builder.AddNamedSystem("scene_graph", SceneGraph())
         plant = MultibodyPlant(0.0)
         plant.RegisterAsSourceForSceneGraph(scene_graph)
-    robot = AddScenarioRobot(plant, scene_graph, config.robot)
+    meshes = config.visualization.meshes
+    robot = AddScenarioRobot(plant, scene_graph, config.robot, meshes=meshes)
     companions = [
         AddScenarioRobot(
             plant,
@@ -357,6 +358,7 @@ def _AddPlantAndWorld(builder: DiagramBuilder, config: StationConfig):
             c.robot,
             model_name=c.name,
             X_WRoot=ObjectPose(c.position, c.rpy_deg),
+            meshes=meshes,
         )
         for c in config.companions
     ]

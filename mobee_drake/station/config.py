@@ -26,6 +26,7 @@ from pydrake.multibody.plant import (
 from mobee_drake.mobee.params import Dissertation, MobeeParams
 from mobee_drake.mobee.reflex import ReflexParams
 from mobee_drake.robots.icub import IcubConfig
+from mobee_drake.robots.model_cache import MESH_RESOLUTIONS
 from mobee_drake.robots.zero_position import ZeroPositionConfig
 from mobee_drake.station.attractors import FixedAttractor, RandomAttractors
 from mobee_drake.world.objects import OBJECT_ROLES, Box, Cylinder, SceneObject, Sphere, WorldEvent
@@ -122,10 +123,14 @@ class Visualization:
     # (a longer run is recorded at a lower rate), which bounds its size.
     frame_rate: float = 30.0
     max_recorded_frames: int = 3600
-    # The default camera (world, m): in front of the iCub (which faces -x), a little to its
-    # right and above, looking at its hands' workspace.
-    camera_position: list[float] = dc.field(default_factory=lambda: [-1.4, -0.7, 0.5])
-    camera_target: list[float] = dc.field(default_factory=lambda: [-0.2, 0.0, 0.0])
+    # The camera (world, m), both given or both empty; empty: framed on the task when the run
+    # starts (the trail's marker and the world's objects, seen from in front of the iCub, which
+    # faces -x, a little to its right and above).
+    camera_position: list[float] = dc.field(default_factory=list)
+    camera_target: list[float] = dc.field(default_factory=list)
+    # The robot's visual meshes: "light" (decimated, a tenth of the triangles, for viewers and
+    # recordings) or "full" (icub-models' own).
+    meshes: str = "light"
 
 
 @dc.dataclass
@@ -222,11 +227,19 @@ def _TimingAndViewErrors(config: StationConfig) -> list[str]:
     shown, log = config.visualization, config.data_log
     if not (math.isfinite(shown.frame_rate) and shown.frame_rate > 0):
         errors.append(f"visualization frame_rate must be > 0, got {shown.frame_rate}")
-    if not (
-        len(shown.camera_position) == len(shown.camera_target) == 3
-        and _Finite(shown.camera_position + shown.camera_target)
+    camera = shown.camera_position + shown.camera_target
+    if camera and not (
+        len(shown.camera_position) == len(shown.camera_target) == 3 and _Finite(camera)
     ):
-        errors.append("visualization camera_position and camera_target need three finite numbers")
+        errors.append(
+            "visualization camera_position and camera_target need three finite numbers each "
+            "(or leave both out: the camera is then framed on the task)"
+        )
+    if shown.meshes not in MESH_RESOLUTIONS:
+        errors.append(
+            f"visualization meshes must be one of {', '.join(MESH_RESOLUTIONS)}, "
+            f"got '{shown.meshes}'"
+        )
     if shown.max_recorded_frames < 1:
         errors.append(
             f"visualization max_recorded_frames must be >= 1, got {shown.max_recorded_frames}"

@@ -19,6 +19,7 @@ from mobee_drake.station.checkpoint import (
 )
 from mobee_drake.station.data_log import CheckpointedLog, WriteTable
 from mobee_drake.station.outcome import RunOutcome
+from mobee_drake.station.recording import CompactRecording
 from mobee_drake.station.safety import CheckStart, SafetyReport
 from mobee_drake.station.world_events import MakeSimulator
 
@@ -222,7 +223,7 @@ def _SaveRecording(station: Station, record: str) -> str:
     station.meshcat.StopRecording()
     station.meshcat.PublishRecording()
     path = pathlib.Path(record)
-    WriteTextAtomically(path, station.meshcat.StaticHtml())
+    WriteTextAtomically(path, CompactRecording(station.meshcat.StaticHtml()))
     return str(path.resolve())
 
 

@@ -2,6 +2,7 @@
 and MoBeE's workspace forces: field forces at witness points, client forces at markers."""
 
 import logging
+import math
 
 import numpy as np
 from pydrake.common.value import AbstractValue
@@ -15,10 +16,10 @@ from pydrake.geometry import (
     Role,
     SceneGraph,
 )
-from pydrake.math import RigidTransform
+from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.systems.framework import BasicVector, DiagramBuilder, LeafSystem, OutputPort
+from pydrake.systems.framework import DiagramBuilder, LeafSystem, OutputPort
 from pydrake.systems.primitives import SharedPointerSystem
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 
@@ -36,6 +37,15 @@ MARKER_FORCE_COLOR = Rgba(0.85, 0.0, 0.85, 1.0)
 MARKER_ARROW_LENGTH_PER_FORCE = 0.01
 # Length of a drawn contact force per metre of field penetration (a full 3 cm field: 15 cm).
 ARROW_LENGTH_PER_PENETRATION = 5.0
+# The framed camera (see CameraFramer) looks from in front of the iCub (which faces -x), a little
+# to its right and above; Meshcat's camera sees 75 degrees vertically. It frames a sphere of at
+# least FRAMED_RADIUS (m) with a margin.
+CAMERA_DIRECTION = np.array([-1.0, -0.25, 0.45]) / np.linalg.norm([-1.0, -0.25, 0.45])
+CAMERA_FIELD_OF_VIEW = math.radians(75.0)
+FRAMED_RADIUS = 0.15
+# The objects framed are those whose centre lies this close to a framed marker (m).
+FRAMED_REACH = 0.15
+FRAMING_MARGIN = 1.3
 
 
 def RecordingMeshcat() -> Meshcat:
@@ -50,18 +60,63 @@ def RecordingMeshcat() -> Meshcat:
         drake_logger.setLevel(level)
 
 
+class _Arrows:
+    """A pool of arrows drawn at Meshcat paths ``{root}/{i}`` that sends only what changed.
+
+    Each arrow is a unit segment along its own z axis, placed by its transform and stretched by
+    its ``scale`` property: a frame with forces sends a transform and a scale per changed arrow,
+    never geometry. Arrows are created when more are needed than ever before, hidden in a
+    recording until they are first used, and hidden (not deleted) when not needed. The pool is
+    Meshcat's bookkeeping, as MeshcatVisualizer keeps its own: drawing changes nothing in the
+    simulation.
+    """
+
+    def __init__(self, meshcat: Meshcat, root: str, color: Rgba):
+        self._meshcat, self._root, self._color = meshcat, root, color
+        self._drawn: list[tuple | None] = []  # Per arrow: (start, vector) shown, or None.
+
+    def Draw(self, arrows: list[tuple[np.ndarray, np.ndarray]], time: float) -> None:
+        """Shows ``arrows`` (start, vector: world, m) at ``time`` and hides the rest."""
+        meshcat = self._meshcat
+        for i, (start, vector) in enumerate(arrows):
+            path = f"{self._root}/{i}"
+            if i == len(self._drawn):
+                meshcat.SetLineSegments(
+                    path, np.zeros((3, 1)), np.array([[0.0], [0.0], [1.0]]), 4.0, self._color
+                )
+                meshcat.SetProperty(path, "visible", False, 0.0)
+                self._drawn.append(None)
+            key = (tuple(start), tuple(vector))
+            if self._drawn[i] == key:
+                continue
+            length = float(np.linalg.norm(vector))
+            X = RigidTransform(RotationMatrix.MakeFromOneVector(vector / length, 2), start)
+            meshcat.SetTransform(path, X, time)
+            meshcat.SetProperty(path, "scale", [1.0, 1.0, length], time)
+            if self._drawn[i] is None:
+                meshcat.SetProperty(path, "visible", True, time)
+            self._drawn[i] = key
+        for i in range(len(arrows), len(self._drawn)):
+            if self._drawn[i] is not None:
+                meshcat.SetProperty(f"{self._root}/{i}", "visible", False, time)
+                self._drawn[i] = None
+
+
 class ForceDrawer(LeafSystem):
-    """Draws MoBeE's workspace forces as segments (publish only: it keeps no state).
+    """Draws MoBeE's workspace forces as arrows (publish only: it keeps no state).
 
     - Field forces: from each witness point on the robot along the force (the separating
       direction), the length proportional to the field penetration (orange, ``/field_forces``).
     - Client forces on markers (``marker_forces``, when given): from each loaded marker along its
       force, 1 cm per unit of force (magenta, ``/marker_forces``).
+
+    Arrows are updated in place (see :class:`_Arrows`), so a recording shows them over time.
     """
 
     def __init__(self, *, meshcat: Meshcat, num_markers: int, period: float):
         super().__init__()
-        self._meshcat = meshcat
+        self._fields = _Arrows(meshcat, "/field_forces", CONTACT_FORCE_COLOR)
+        self._markers = _Arrows(meshcat, "/marker_forces", MARKER_FORCE_COLOR)
         self._contacts_port = self.DeclareAbstractInputPort(
             "field_contacts", AbstractValue.Make([])
         )
@@ -70,39 +125,36 @@ class ForceDrawer(LeafSystem):
         self.DeclarePeriodicPublishEvent(period_sec=period, offset_sec=0.0, publish=self._Draw)
         self.DeclareForcedPublishEvent(self._Draw)
 
-    def _Segments(self, path: str, starts: list, ends: list, color: Rgba) -> None:
-        if starts:
-            self._meshcat.SetLineSegments(path, np.array(starts).T, np.array(ends).T, 4.0, color)
-        else:
-            self._meshcat.Delete(path)
-
     def _Draw(self, context) -> None:
-        contacts = self._contacts_port.Eval(context)
-        self._Segments(
-            "/field_forces",
-            [c.p_WCa for c in contacts],
-            [
-                c.p_WCa + ARROW_LENGTH_PER_PENETRATION * c.penetration * c.nhat_BA_W
-                for c in contacts
-            ],
-            CONTACT_FORCE_COLOR,
-        )
-        starts, ends = [], []
+        time = context.get_time()
+        fields = [
+            (c.p_WCa, ARROW_LENGTH_PER_PENETRATION * c.penetration * c.nhat_BA_W)
+            for c in self._contacts_port.Eval(context)
+            if c.penetration > 0
+        ]
+        self._fields.Draw(fields, time)
+        markers = []
         if self._forces_port.HasValue(context):
             points = self._positions_port.Eval(context).reshape(-1, 3)
             forces = self._forces_port.Eval(context).reshape(-1, 3)
-            for p, f in zip(points, forces):
-                if np.any(f != 0):
-                    starts.append(p)
-                    ends.append(p + MARKER_ARROW_LENGTH_PER_FORCE * f)
-        self._Segments("/marker_forces", starts, ends, MARKER_FORCE_COLOR)
+            markers = [
+                (p, MARKER_ARROW_LENGTH_PER_FORCE * f)
+                for p, f in zip(points, forces)
+                if np.any(f != 0)
+            ]
+        self._markers.Draw(markers, time)
 
 
 class TrailDrawer(LeafSystem):
-    """Draws the recent path of one marker as a line in Meshcat.
+    """Draws the whole path of one marker in Meshcat, as a line in pieces under ``path``.
 
-    The last ``capacity`` positions, sampled every ``period``, are kept in the discrete state (a
-    ring buffer and its count); a periodic publish sends them to Meshcat.
+    Every ``period`` the marker's position is kept if it lies ``resolution`` or more from the
+    last kept one (a still marker adds nothing). Kept points go into the open piece (the discrete
+    state: its points, their count, its start time and its number), which is closed after
+    ``piece_points`` points or ``piece_seconds`` seconds; the next piece starts at its last point.
+    A closed piece is never sent again, so the stream carries only the open piece, and only when
+    it grew; a long run's path is never cut to a tail. In a recording each piece is hidden until
+    its start, so the path grows as it was travelled (a piece at a time).
     """
 
     def __init__(
@@ -112,41 +164,86 @@ class TrailDrawer(LeafSystem):
         marker_index: int,
         num_markers: int,
         period: float,
-        capacity: int = 600,
+        resolution: float = 0.002,
+        piece_points: int = 100,
+        piece_seconds: float = 0.5,
         path: str = "/trail",
     ):
         super().__init__()
-        self._meshcat, self._path, self._capacity = meshcat, path, capacity
+        self._meshcat, self._path, self._resolution = meshcat, path, resolution
+        self._capacity, self._piece_seconds = piece_points, piece_seconds
         self._marker_index = marker_index
         self._positions_port = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
-        self._state = self.DeclareDiscreteState(BasicVector(np.zeros(3 * capacity + 1)))
+        self._points = self.DeclareDiscreteState(3 * piece_points)
+        # The open piece: [its point count, its start time, its number].
+        self._piece = self.DeclareDiscreteState(3)
+        self._drawn: tuple[int, int] | None = None  # (piece, count) last sent to Meshcat.
         self.DeclarePeriodicDiscreteUpdateEvent(
             period_sec=period, offset_sec=0.0, update=self._Append
         )
         self.DeclarePeriodicPublishEvent(period_sec=period, offset_sec=0.0, publish=self._Draw)
 
     def _Append(self, context, discrete_state) -> None:
-        x = context.get_discrete_state(self._state).value().copy()
-        count = int(x[-1])
+        points = context.get_discrete_state(self._points).value().reshape(-1, 3).copy()
+        count, start, piece = context.get_discrete_state(self._piece).value()
+        count, piece, time = int(count), int(piece), context.get_time()
         i = 3 * self._marker_index
         p = self._positions_port.Eval(context)[i : i + 3]
-        slot = count % self._capacity
-        x[3 * slot : 3 * slot + 3] = p
-        x[-1] = count + 1
-        discrete_state.get_mutable_vector(self._state).SetFromVector(x)
+        if count and np.linalg.norm(p - points[count - 1]) < self._resolution:
+            return
+        if count == self._capacity or (count > 1 and time - start >= self._piece_seconds):
+            points[0], count, piece = points[count - 1], 1, piece + 1  # The next piece.
+            start = time
+        if count == 0:
+            start = time
+        points[count] = p
+        discrete_state.get_mutable_vector(self._points).SetFromVector(points.ravel())
+        discrete_state.get_mutable_vector(self._piece).SetFromVector([count + 1, start, piece])
 
     def _Draw(self, context) -> None:
-        x = context.get_discrete_state(self._state).value()
-        count = int(x[-1])
-        if count < 2:
+        count, start, piece = context.get_discrete_state(self._piece).value()
+        count, piece = int(count), int(piece)
+        if count < 2 or self._drawn == (piece, count):
             return
-        points = x[:-1].reshape(self._capacity, 3)
-        if count > self._capacity:  # Oldest first.
-            start = count % self._capacity
-            points = np.vstack([points[start:], points[:start]])
-        else:
-            points = points[:count]
-        self._meshcat.SetLine(self._path, points.T, 3.0, TRAIL_COLOR)
+        points = context.get_discrete_state(self._points).value().reshape(-1, 3)[:count]
+        path = f"{self._path}/{piece}"
+        self._meshcat.SetLine(path, points.T, 3.0, TRAIL_COLOR)
+        if self._drawn is None or self._drawn[0] != piece:
+            self._meshcat.SetProperty(path, "visible", False, 0.0)
+            self._meshcat.SetProperty(path, "visible", True, start)
+        self._drawn = (piece, count)
+
+
+class CameraFramer(LeafSystem):
+    """Frames Meshcat's camera on the task when the simulation starts (an initialization
+    publish): the sphere around the trail's marker (every marker without a trail) and the
+    world's objects within ``FRAMED_REACH`` of it, seen from ``CAMERA_DIRECTION`` at the distance
+    that fits the sphere in the view."""
+
+    def __init__(
+        self, *, meshcat: Meshcat, world: LiveWorld, marker_index: int | None, num_markers: int
+    ):
+        super().__init__()
+        self._meshcat, self._world, self._marker_index = meshcat, world, marker_index
+        self._positions_port = self.DeclareVectorInputPort("marker_positions", 3 * num_markers)
+        self._query_port = self.DeclareAbstractInputPort(
+            "geometry_query", AbstractValue.Make(QueryObject())
+        )
+        self.DeclareInitializationPublishEvent(self._Frame)
+
+    def _Frame(self, context) -> None:
+        markers = self._positions_port.Eval(context).reshape(-1, 3)
+        if self._marker_index is not None:
+            markers = markers[self._marker_index : self._marker_index + 1]
+        objects = self._world.ObjectsSeenBy(self._query_port.Eval(context).inspector())
+        centres = [X_WO.translation() for *_, X_WO in objects.values()]
+        near = [c for c in centres if np.linalg.norm(markers - c, axis=1).min() <= FRAMED_REACH]
+        points = np.vstack([markers, *near])
+        low, high = points.min(axis=0), points.max(axis=0)
+        target = (low + high) / 2
+        radius = max(FRAMED_RADIUS, float(np.linalg.norm(high - low)) / 2) * FRAMING_MARGIN
+        distance = radius / math.sin(CAMERA_FIELD_OF_VIEW / 2)
+        self._meshcat.SetCameraPose(target + distance * CAMERA_DIRECTION, target)
 
 
 class WorldDrawer(LeafSystem):
@@ -202,8 +299,11 @@ def _AddAttractorRobot(
     mobee: Mobee,
     attractor: OutputPort,
 ) -> None:
-    """A second, translucent robot (illustration only) posed at the attractor."""
-    text, extension, root, home = RobotModelText(config.robot, ATTRACTOR_ALPHA)
+    """A second, translucent robot (illustration only) posed at the attractor: the bodies that
+    MoBeE's joints move."""
+    text, extension, root, home = RobotModelText(
+        config.robot, ATTRACTOR_ALPHA, config.visualization.meshes
+    )
     ghost = MultibodyPlant(0.0)
     ghost.RegisterAsSourceForSceneGraph(scene_graph)
     parser = Parser(ghost, "attractor")
@@ -214,6 +314,16 @@ def _AddAttractorRobot(
     moved = list(mobee.joints) + [c.follower for c in followers]
     FreezeJoints(ghost, instance, keep=moved, home=home, source="attractor robot")
     ghost.Finalize()
+    # Only the bodies MoBeE's joints move are drawn: the rest would hide in the robot itself.
+    moving = set(
+        ghost.GetBodiesKinematicallyAffectedBy(
+            [ghost.GetJointByName(name, instance).index() for name in moved]
+        )
+    )
+    for index in ghost.GetBodyIndices(instance):
+        if index not in moving:
+            for geometry in ghost.GetVisualGeometriesForBody(ghost.get_body(index)):
+                scene_graph.RemoveGeometry(ghost.get_source_id(), geometry)
     builder.AddNamedSystem("attractor_robot_owner", SharedPointerSystem(ghost))
     coupled = CoupledPositions.Of(ghost, instance, list(mobee.joints), followers)
     P, p0 = coupled.PositionMap(ghost.num_positions())
@@ -259,7 +369,25 @@ def AddViewer(
         "world_drawer", WorldDrawer(meshcat=meshcat, world=world, period=period)
     )
     builder.Connect(scene_graph.get_query_output_port(), world_drawer.get_input_port())
-    meshcat.SetCameraPose(settings.camera_position, settings.camera_target)
+    num_markers = len(mobee.marker_names)
+    if settings.camera_position:
+        meshcat.SetCameraPose(settings.camera_position, settings.camera_target)
+    else:
+        framer = builder.AddNamedSystem(
+            "camera_framer",
+            CameraFramer(
+                meshcat=meshcat,
+                world=world,
+                marker_index=(
+                    mobee.marker_index(settings.trail_marker) if settings.trail_marker else None
+                ),
+                num_markers=num_markers,
+            ),
+        )
+        builder.Connect(
+            mobee.GetOutputPort("marker_positions"), framer.GetInputPort("marker_positions")
+        )
+        builder.Connect(scene_graph.get_query_output_port(), framer.GetInputPort("geometry_query"))
     # MoBeE's primitives, hidden by default (toggle "collision" in Meshcat's controls).
     MeshcatVisualizer.AddToBuilder(
         builder,
@@ -277,7 +405,7 @@ def AddViewer(
         "force_drawer",
         ForceDrawer(
             meshcat=meshcat,
-            num_markers=len(mobee.marker_names),
+            num_markers=num_markers,
             period=max(config.time_step, 1 / 30),
         ),
     )
@@ -295,7 +423,7 @@ def AddViewer(
             TrailDrawer(
                 meshcat=meshcat,
                 marker_index=mobee.marker_index(settings.trail_marker),
-                num_markers=len(mobee.marker_names),
+                num_markers=num_markers,
                 period=max(config.time_step, 0.02),
             ),
         )

@@ -1,0 +1,279 @@
+"""The viewer's parts: drawers that send only what changed, a recording compacted without
+changing what it plays, a camera framed on the task, light meshes and a light attractor robot."""
+
+import base64
+import math
+import pathlib
+import re
+import tempfile
+import unittest
+
+import msgpack
+import numpy as np
+from pydrake.geometry import GeometryId, Meshcat
+from pydrake.systems.analysis import Simulator
+from pydrake.systems.framework import DiagramBuilder
+from pydrake.systems.primitives import TrajectorySource
+from pydrake.trajectories import PiecewisePolynomial
+import trimesh
+
+from mobee_drake.mobee.fields import FieldContact
+from mobee_drake.robots.icub import DEFAULT_ICUB_MODEL, RIGHT_ARM_JOINTS
+from mobee_drake.robots.model_cache import LIGHT_MESH_FLOOR, LIGHT_MESH_SHARE, PreparedIcubModel
+from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario
+from mobee_drake.station.recording import KEYFRAME_TOLERANCE, ThinKeyframes
+from mobee_drake.station.viewer import (
+    ARROW_LENGTH_PER_PENETRATION,
+    CAMERA_DIRECTION,
+    CAMERA_FIELD_OF_VIEW,
+    FRAMED_RADIUS,
+    FRAMING_MARGIN,
+    ForceDrawer,
+    TrailDrawer,
+)
+
+DIAGRAMS = pathlib.Path(__file__).resolve().parents[1] / "diagrams"
+REACH = DIAGRAMS / "reach_around_ball.yaml"
+
+
+class CountingMeshcat:
+    """Records what a drawer sends (method, path, time) and passes it on to a real Meshcat."""
+
+    def __init__(self):
+        self.meshcat, self.sent = Meshcat(), []
+
+    def __getattr__(self, name):
+        method = getattr(self.meshcat, name)
+
+        def Send(path, *args):
+            time = args[-1] if name in ("SetProperty", "SetTransform") else None
+            value = args[1] if name == "SetProperty" else None
+            self.sent.append((name, path, time, value))
+            return method(path, *args)
+
+        return Send
+
+    def Property(self, path: str, name: str):
+        return msgpack.unpackb(self.meshcat._GetPackedProperty(path, name))["value"]
+
+    def Transform(self, path: str) -> np.ndarray:
+        matrix = msgpack.unpackb(self.meshcat._GetPackedTransform(path))["matrix"]
+        return np.array(matrix).reshape(4, 4).T
+
+    def LinePoints(self, path: str) -> np.ndarray:
+        command = msgpack.unpackb(self.meshcat._GetPackedObject(path))
+        data = command["object"]["geometries"][0]["data"]["attributes"]["position"]["array"]
+        return np.frombuffer(data.data, dtype=np.float32).reshape(-1, 3)
+
+
+def _Marker(times, positions) -> TrajectorySource:
+    return TrajectorySource(PiecewisePolynomial.FirstOrderHold(times, np.array(positions).T))
+
+
+class TestTrailDrawer(unittest.TestCase):
+    def Run(self, times, positions, until):
+        builder = DiagramBuilder()
+        meshcat = CountingMeshcat()
+        trail = builder.AddSystem(
+            TrailDrawer(meshcat=meshcat, marker_index=0, num_markers=1, period=0.02)
+        )
+        source = builder.AddSystem(_Marker(times, positions))
+        builder.Connect(source.get_output_port(), trail.get_input_port())
+        simulator = Simulator(builder.Build())
+        simulator.AdvanceTo(until)
+        return meshcat
+
+    def test_the_whole_path_is_kept_in_pieces_sent_once(self):
+        # 10 cm/s along x for 3 s (30 cm), then still for 7 s.
+        start, end = np.array([0.1, 0.2, 0.3]), np.array([0.4, 0.2, 0.3])
+        meshcat = self.Run([0.0, 3.0, 10.0], [start, end, end], until=10.0)
+        pieces = sorted(
+            {p for name, p, *_ in meshcat.sent if name == "SetLine"},
+            key=lambda p: int(p.split("/")[-1]),
+        )
+        # A piece is closed after 0.5 s: six pieces for 3 s of motion, none while still.
+        self.assertEqual(len(pieces), 6)
+        points = np.vstack([meshcat.LinePoints(p) for p in pieces])
+        np.testing.assert_allclose(points[0], start, atol=1e-6)
+        np.testing.assert_allclose(points[-1], end, atol=0.002 + 1e-6)
+        # Consecutive pieces share their end points: the line is unbroken.
+        for a, b in zip(pieces, pieces[1:]):
+            np.testing.assert_allclose(meshcat.LinePoints(a)[-1], meshcat.LinePoints(b)[0])
+        # A closed piece is never sent again: the pieces sent never go back.
+        sends = [int(p.split("/")[-1]) for name, p, *_ in meshcat.sent if name == "SetLine"]
+        self.assertEqual(sends, sorted(sends))
+        # Nothing is sent while the marker stands still (after 3 s).
+        self.assertLessEqual(len(sends), 3.0 / 0.02 + 1)
+        # In a recording each piece is hidden from 0 and shown from its start, in order.
+        shown = [t for name, _, t, value in meshcat.sent if name == "SetProperty" and value]
+        hidden = [t for name, _, t, value in meshcat.sent if name == "SetProperty" and not value]
+        self.assertEqual((len(shown), hidden), (6, [0.0] * 6))
+        np.testing.assert_allclose(np.diff(shown), 0.5, atol=0.021)
+
+    def test_a_still_marker_draws_nothing(self):
+        p = np.array([0.0, 0.0, 1.0])
+        meshcat = self.Run([0.0, 1.0], [p, p], until=1.0)
+        self.assertEqual(meshcat.sent, [])
+
+
+def _Contact(point, normal, penetration, margin=0.03) -> FieldContact:
+    g = GeometryId.get_new_id()
+    return FieldContact(
+        g,
+        g,
+        "palm",
+        "ball",
+        margin - penetration,
+        margin,
+        np.array(point),
+        np.array(point),
+        np.array(normal) / np.linalg.norm(normal),
+    )
+
+
+class TestForceDrawer(unittest.TestCase):
+    def setUp(self):
+        self.meshcat = CountingMeshcat()
+        self.drawer = ForceDrawer(meshcat=self.meshcat, num_markers=1, period=0.1)
+        self.context = self.drawer.CreateDefaultContext()
+        self.drawer.GetInputPort("marker_positions").FixValue(self.context, [0.0, 0.0, 0.0])
+
+    def Draw(self, contacts, time=0.0):
+        self.context.SetTime(time)
+        self.drawer.GetInputPort("field_contacts").FixValue(self.context, contacts)
+        self.drawer.ForcedPublish(self.context)
+
+    def test_an_arrow_per_contact_along_its_normal_scaled_by_its_penetration(self):
+        contacts = [
+            _Contact([0.1, 0.2, 0.3], [0.0, 0.0, 1.0], 0.01),
+            _Contact([0.0, -0.1, 0.5], [1.0, 1.0, 0.0], 0.02),
+        ]
+        self.Draw(contacts)
+        for i, c in enumerate(contacts):
+            path = f"/field_forces/{i}"
+            X = self.meshcat.Transform(path)
+            np.testing.assert_allclose(X[:3, 3], c.p_WCa)
+            np.testing.assert_allclose(X[:3, 2], c.nhat_BA_W, atol=1e-12)  # The arrow's axis.
+            length = self.meshcat.Property(path, "scale")[2]
+            self.assertAlmostEqual(length, ARROW_LENGTH_PER_PENETRATION * c.penetration)
+            self.assertTrue(self.meshcat.Property(path, "visible"))
+        # An unchanged frame sends nothing; one contact fewer hides (not deletes) an arrow.
+        sent = len(self.meshcat.sent)
+        self.Draw(contacts, 0.1)
+        self.assertEqual(len(self.meshcat.sent), sent)
+        self.Draw(contacts[:1], 0.2)
+        self.assertEqual(self.meshcat.sent[sent:], [("SetProperty", "/field_forces/1", 0.2, False)])
+        self.assertFalse(self.meshcat.Property("/field_forces/1", "visible"))
+        # Geometry is sent once per arrow, ever.
+        lines = [s for s in self.meshcat.sent if s[0] == "SetLineSegments"]
+        self.assertEqual(len(lines), 2)
+
+    def test_marker_forces_are_drawn_when_given(self):
+        self.drawer.GetInputPort("marker_forces").FixValue(self.context, [0.0, 0.0, 10.0])
+        self.Draw([])
+        self.assertAlmostEqual(self.meshcat.Property("/marker_forces/0", "scale")[2], 0.1)
+
+
+class TestRecording(unittest.TestCase):
+    def test_thinning_keeps_every_frame_within_the_tolerance(self):
+        rng = np.random.default_rng(0)
+        still = [1.0, 2.0, 3.0]
+        values = [still] * 10 + [[1.0 + 0.01 * k, 2.0, 3.0] for k in range(10)] + [still] * 10
+        values = [list(np.add(v, rng.uniform(-1e-6, 1e-6, 3))) for v in values]
+        keys = [{"time": k, "value": v} for k, v in enumerate(values)]
+        kept = ThinKeyframes(keys)
+        self.assertLess(len(kept), 16)
+        frames = [k["time"] for k in kept]
+        for axis in range(3):
+            played = np.interp(range(len(keys)), frames, [k["value"][axis] for k in kept])
+            np.testing.assert_allclose(played, [v[axis] for v in values], atol=KEYFRAME_TOLERANCE)
+
+    def test_a_compacted_recording_plays_as_drake_recorded_it(self):
+        path = pathlib.Path(tempfile.mkdtemp()) / "run.html"
+        meshcat = Meshcat()
+        RunScenario(LoadScenario(REACH, "{duration: 3}"), meshcat=meshcat, record=str(path))
+        original, compact = _Animation(meshcat.StaticHtml()), _Animation(path.read_text())
+        self.assertLess(sum(map(len, (k for _, k in compact))), len(original) * 60)
+        for (name, keys), (other, kept) in zip(original, compact):
+            self.assertEqual(name, other)
+            if not isinstance(keys[0]["value"], list):
+                continue
+            frames = [k["time"] for k in kept]
+            for axis in range(len(keys[0]["value"])):
+                played = np.interp(
+                    [k["time"] for k in keys], frames, [k["value"][axis] for k in kept]
+                )
+                np.testing.assert_allclose(
+                    played, [k["value"][axis] for k in keys], atol=KEYFRAME_TOLERANCE
+                )
+
+
+def _Animation(html: str) -> list[tuple[str, list[dict]]]:
+    """The tracks of a recording's animation: (path and property, keyframes)."""
+    for blob in re.findall(r'octet-binary;base64,([A-Za-z0-9+/=]*)"', html):
+        command = msgpack.unpackb(base64.b64decode(blob), strict_map_key=False)
+        if command["type"] == "set_animation":
+            return [
+                (a["path"] + t["name"], t["keys"])
+                for a in command["animations"]
+                for t in a["clip"]["tracks"]
+            ]
+    raise AssertionError("no animation in the recording")
+
+
+class TestCameraAndScene(unittest.TestCase):
+    def test_the_camera_is_framed_on_the_palm_and_the_ball(self):
+        meshcat = Meshcat()
+        station = BuildScenario(LoadScenario(REACH), meshcat)
+        context = station.diagram.CreateDefaultContext()
+        station.diagram.ExecuteInitializationEvents(context)
+        camera = msgpack.unpackb(
+            meshcat._GetPackedProperty("/Cameras/default/rotated/<object>", "position")
+        )["value"]
+        x, z, minus_y = camera  # Meshcat's camera is y-up.
+        position = np.array([x, -minus_y, z])
+        mobee = station.mobee
+        palm = mobee.GetOutputPort("marker_positions").Eval(mobee.GetMyContextFromRoot(context))
+        palm = palm[3 * mobee.marker_index("r_palm") :][:3]
+        ball = np.array(LoadScenario(REACH).objects[1].position)
+        target = (palm + ball) / 2
+        radius = max(FRAMED_RADIUS, np.linalg.norm(palm - ball) / 2) * FRAMING_MARGIN
+        distance = radius / math.sin(CAMERA_FIELD_OF_VIEW / 2)
+        np.testing.assert_allclose(position, target + distance * CAMERA_DIRECTION)
+
+    def test_the_attractor_robot_draws_only_what_moves(self):
+        meshcat = Meshcat()
+        scenario = LoadScenario(
+            REACH, f"{{robot: {{controlled_joints: {list(RIGHT_ARM_JOINTS)}}}}}"
+        )
+        station = BuildScenario(scenario, meshcat)
+        station.diagram.ForcedPublish(station.diagram.CreateDefaultContext())
+        ghost = "/drake/illustration/attractor"
+        self.assertTrue(meshcat.HasPath(f"{ghost}/r_forearm"))
+        for body in ("chest", "l_forearm", "head", "root_link"):
+            self.assertFalse(meshcat.HasPath(f"{ghost}/{body}"), body)
+            self.assertTrue(meshcat.HasPath(f"/drake/illustration/icub_iCubGazeboV2_5/iCub/{body}"))
+
+
+class TestLightMeshes(unittest.TestCase):
+    def test_each_light_mesh_keeps_a_tenth_of_its_triangles_or_is_small(self):
+        light, full = (PreparedIcubModel(DEFAULT_ICUB_MODEL, m) for m in ("light", "full"))
+        light_meshes = re.findall(r'filename="([^"]+)"', light.read_text())
+        full_meshes = re.findall(r'filename="([^"]+)"', full.read_text())
+        self.assertEqual(len(light_meshes), len(full_meshes))
+        for a, b in zip(light_meshes, full_meshes):
+            n_light = len(trimesh.load(a, force="mesh").faces)
+            n_full = len(trimesh.load(b, force="mesh").faces)
+            if n_full <= LIGHT_MESH_FLOOR:
+                self.assertEqual(n_light, n_full, a)
+            else:
+                self.assertLessEqual(n_light, max(LIGHT_MESH_SHARE * n_full, LIGHT_MESH_FLOOR))
+                self.assertGreater(n_light, 0.5 * LIGHT_MESH_SHARE * n_full)
+
+    def test_an_unknown_resolution_is_refused_by_name(self):
+        with self.assertRaisesRegex(ValueError, "meshes: 'medium' is not one of"):
+            PreparedIcubModel(DEFAULT_ICUB_MODEL, "medium")
+
+
+if __name__ == "__main__":
+    unittest.main()
