@@ -3,6 +3,7 @@
 import argparse
 import importlib
 import logging
+import math
 import pathlib
 import sys
 
@@ -21,6 +22,7 @@ from mobee_drake.resources import ScenarioNames
 from mobee_drake.robots.icub import AddIcub, IcubConfig
 from mobee_drake.robots.model_cache import IcubModelNames
 from mobee_drake.scenario import BuildScenario, LoadScenario, ResumableConfiguration
+from mobee_drake.station.attractors import SliderAttractor
 from mobee_drake.station.checkpoint import CheckpointError
 from mobee_drake.station.runner import RunStation
 from mobee_drake.station.safety import StartsInPenetrationError
@@ -126,6 +128,25 @@ def _RunOutputs(known) -> tuple[str | None, str | None, pathlib.Path]:
     return record, data_log, summary_file
 
 
+def _ServesUntilCtrlC(known, scenario) -> bool:
+    """Whether ``run`` serves a scenario moved by hand (sliders) until Ctrl-C: with --meshcat and
+    no --duration. Such a scenario is refused without --meshcat (no one could move it)."""
+    if not isinstance(scenario.attractor, SliderAttractor):
+        return False
+    if not known.meshcat or known.no_meshcat:
+        raise ValueError(
+            f"{known.scenario}: its attractor is moved by hand in the browser; run it with "
+            "--meshcat"
+        )
+    if known.duration is None and known.record:
+        raise ValueError("--record needs --duration here: the live view runs until Ctrl-C")
+    return known.duration is None
+
+
+def _Announce(meshcat) -> None:
+    print(f"serving the live view at {meshcat.web_url()} until Ctrl-C", flush=True)
+
+
 def _Run(args: list[str]) -> None:
     """Runs a scenario and prints its summary."""
     parser = _RunParser()
@@ -146,6 +167,9 @@ def _Run(args: list[str]) -> None:
     # bugs, and keep their traceback.
     try:
         scenario = LoadScenario(known.scenario, overrides)
+        serve = _ServesUntilCtrlC(known, scenario)
+        if serve:  # (Its data log is still sized by the scenario's duration.)
+            record = None
         station = BuildScenario(scenario, meshcat)
     except ValueError as e:  # YamlFileError included
         _Fail(str(e))
@@ -154,7 +178,7 @@ def _Run(args: list[str]) -> None:
     try:
         summary = RunStation(
             station,
-            scenario.duration,
+            math.inf if serve else scenario.duration,
             record=record,
             simulator_config=scenario.simulator_config,
             realtime_rate=1.0 if meshcat is not None and known.meshcat else None,
@@ -162,6 +186,7 @@ def _Run(args: list[str]) -> None:
             checkpoint=known.checkpoint,
             configuration=ResumableConfiguration(scenario),
             data_log=data_log,
+            on_start=(lambda: _Announce(meshcat)) if serve else None,
         )
     except (FolderError, CheckpointError, StartsInPenetrationError) as e:  # Before any step.
         _Fail(str(e))

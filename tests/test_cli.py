@@ -7,6 +7,7 @@ import logging
 import pathlib
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -268,6 +269,38 @@ class TestHeadlessRun(unittest.TestCase):
             self.assertIn(name, done.stdout)
             self.assertGreater((folder / "results" / name).stat().st_size, 0)
         self.assertTrue((folder / "results" / "reach_around_ball.summary.json").exists())
+
+
+class TestLiveRun(unittest.TestCase):
+    def test_a_scenario_moved_by_hand_needs_the_live_view(self):
+        code, _, err = _Call("run", "interactive", "--no-log")
+        self.assertEqual(code, 2)
+        self.assertIn("moved by hand in the browser; run it with --meshcat", err)
+        code, _, err = _Call("run", "interactive", "--meshcat", "--record", "x.html")
+        self.assertEqual((code, err.count("\n")), (2, 1))
+        self.assertIn("--record needs --duration", err)
+
+    def test_the_live_view_is_served_until_ctrl_c(self):
+        folder = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, folder)
+        live = subprocess.Popen(
+            [sys.executable, "-m", "mobee_drake.cli", "run", "interactive", "--meshcat"],
+            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=folder,
+        )  # fmt: skip
+        self.addCleanup(live.kill)
+        lines = []
+        while not any("until Ctrl-C" in line for line in lines):
+            lines.append(live.stdout.readline())
+            self.assertNotEqual(lines[-1], "", "the run ended before serving")
+        # The address comes first; the run goes on until it is interrupted.
+        self.assertRegex(lines[0] + lines[-1], r"http://localhost:\d+")
+        self.assertIsNone(live.poll())
+        live.send_signal(signal.SIGINT)
+        out, _ = live.communicate(timeout=60)
+        self.assertEqual(live.returncode, 0)
+        self.assertRegex(out, r"simulated \d+\.\d+ s")
+        self.assertNotIn("Traceback", out)
+        self.assertFalse((folder / "results" / "interactive.html").exists())  # no recording
 
 
 if __name__ == "__main__":

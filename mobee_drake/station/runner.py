@@ -2,6 +2,7 @@
 
 import contextlib
 import dataclasses as dc
+import math
 import pathlib
 import time
 
@@ -95,13 +96,18 @@ def Advance(
     progress: bool = False,
     after_chunk=None,
 ) -> None:
-    """Advances to ``until`` in at most 500 chunks.
+    """Advances to ``until`` in at most 500 chunks; an infinite ``until`` advances a second at a
+    time until Ctrl-C (a live run, served until the user ends it).
 
     ``after_chunk(context)``, if given, is called after each: the progress bar's and the
     checkpoints' occasions. World events are applied by the simulator's monitor (see
     :func:`~mobee_drake.station.world_events.MakeSimulator`).
     """
     context = simulator.get_mutable_context()
+    while math.isinf(until):  # (Ended by the KeyboardInterrupt of Ctrl-C.)
+        simulator.AdvanceTo(context.get_time() + 1.0)
+        if after_chunk is not None:
+            after_chunk(context)
     start = context.get_time()
     chunks = max(1, min(500, int(round((until - start) / station.config.time_step))))
     bar = None
@@ -150,13 +156,16 @@ def RunStation(
     checkpoint: str | None = None,
     configuration: str = "",
     data_log: str | None = None,
+    on_start=None,
 ) -> RunSummary:
-    """Runs ``station`` until ``duration`` with Drake's ``simulator_config`` (``realtime_rate``,
+    """Runs ``station`` until ``duration`` (``math.inf``: until Ctrl-C, for a live view; nothing
+    is recorded then) with Drake's ``simulator_config`` (``realtime_rate``,
     if given, overrides its target real-time rate); with ``record`` saves its Meshcat recording
     (HTML; the station must have been built with Meshcat) at the viewer's frame rate, or at the
     lower rate that keeps it within ``max_recorded_frames``; with ``data_log`` (a Parquet file)
     writes the station's data log (see :mod:`mobee_drake.station.data_log`; with a checkpoint
     it is saved with every checkpoint, and a resumed run's log is the uninterrupted run's).
+    ``on_start()``, if given, is called when the simulation starts.
 
     With ``checkpoint`` (a folder: new, empty or one of our checkpoints, and held by this run
     alone; see :mod:`mobee_drake.owned_folders`), a run resumes from the checkpoint there if
@@ -188,8 +197,7 @@ def RunStation(
             CheckStart(station.diagram, context)
         if record:  # (Before the initialization's drawing, which the recording keeps.)
             _StartRecording(station, duration - (resumed or 0.0))
-        simulator.Initialize(InitializeParams(suppress_initialization_events=resumed is not None))
-        saved = [CompletedActions(station, context)]
+        saved = [0]
 
         def Save(context) -> None:
             segments = log.Save(context) if log is not None else 0
@@ -202,7 +210,17 @@ def RunStation(
                 saved[0] = done
 
         start = time.perf_counter()
-        Advance(station, simulator, duration, progress=progress, after_chunk=AfterChunk)
+        # A live run served until Ctrl-C ends normally on it, whenever it comes.
+        serving = math.isinf(duration)
+        with contextlib.suppress(KeyboardInterrupt) if serving else contextlib.nullcontext():
+            simulator.Initialize(
+                InitializeParams(suppress_initialization_events=resumed is not None)
+            )
+            saved[0] = CompletedActions(station, context)
+            if on_start is not None:
+                on_start()
+            start = time.perf_counter()
+            Advance(station, simulator, duration, progress=progress, after_chunk=AfterChunk)
         if checkpoint:
             Save(context)
         wall = time.perf_counter() - start
