@@ -1,10 +1,14 @@
 """The example notebook runs from start to end (so it cannot rot)."""
 
+import base64
+import html
 import os
 import pathlib
+import re
 import unittest
 from unittest import mock
 
+import msgpack
 import nbclient
 import nbformat
 
@@ -27,6 +31,19 @@ class TestNotebook(unittest.TestCase):
         self.assertIn("rows: 601", text)  # 6 s at 10 ms, both ends
         images = [o for o in outputs if "image/png" in o.get("data", {})]
         self.assertEqual(len(images), 1)  # the plot
+        # The run's recording is in the notebook itself (it replays without a server).
+        (frame,) = [o["data"]["text/html"] for o in outputs if "text/html" in o.get("data", {})]
+        recording = html.unescape(re.fullmatch(r'<iframe srcdoc="([^"]*)".*', frame)[1])
+        commands = [
+            msgpack.unpackb(base64.b64decode(blob), strict_map_key=False)
+            for blob in re.findall(r'octet-binary;base64,([A-Za-z0-9+/=]*)"', recording)
+        ]
+        kinds = {c["type"] for c in commands}
+        self.assertLessEqual({"set_object", "set_animation"}, kinds)
+        paths = {c.get("path", "") for c in commands}
+        self.assertTrue(any(p.startswith("/drake/illustration/icub") for p in paths))
+        (animation,) = [c for c in commands if c["type"] == "set_animation"]
+        self.assertGreater(len(animation["animations"]), 10)  # the robot moves in it
 
 
 if __name__ == "__main__":

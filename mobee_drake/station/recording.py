@@ -11,6 +11,7 @@ base64 data URI; the animation is the one ``set_animation`` command.
 """
 
 import base64
+import html
 import re
 
 import msgpack
@@ -55,3 +56,12 @@ def _Compact(match: re.Match, tolerance: float) -> str:
 def CompactRecording(html: str, tolerance: float = KEYFRAME_TOLERANCE) -> str:
     """``html`` (a Meshcat recording) with its animation's still keyframes dropped."""
     return _COMMAND.sub(lambda m: _Compact(m, tolerance), html)
+
+
+def NotebookFrame(recording: str, width: int = 800, height: int = 450) -> str:
+    """An ``<iframe>`` that holds ``recording`` (a Meshcat recording's HTML) itself, for a
+    notebook's output: it replays once the notebook is saved and its Meshcat server is gone."""
+    return (
+        f'<iframe srcdoc="{html.escape(recording)}" width="{width}" height="{height}" '
+        'style="border: none"></iframe>'
+    )
