@@ -226,6 +226,7 @@ def _Bench(args: list[str]) -> None:
             "reactive": "mobee_drake.experiments.bench_reactive",
             "safety": "mobee_drake.experiments.bench_safety",
             "simulation": "mobee_drake.experiments.bench_simulation",
+            "viewer": "mobee_drake.experiments.bench_viewer",
         },
     )
 

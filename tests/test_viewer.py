@@ -10,7 +10,19 @@ import unittest
 
 import msgpack
 import numpy as np
-from pydrake.geometry import GeometryId, Meshcat
+from pydrake.common.value import AbstractValue
+from pydrake.geometry import (
+    FramePoseVector,
+    GeometryFrame,
+    GeometryId,
+    GeometryInstance,
+    IllustrationProperties,
+    Meshcat,
+    Role,
+    SceneGraph,
+    Sphere,
+)
+from pydrake.math import RigidTransform
 from pydrake.systems.analysis import Simulator
 from pydrake.systems.framework import DiagramBuilder
 from pydrake.systems.primitives import TrajectorySource
@@ -29,8 +41,10 @@ from mobee_drake.station.viewer import (
     FRAMED_RADIUS,
     FRAMING_MARGIN,
     ForceDrawer,
+    PoseStreamer,
     TrailDrawer,
 )
+from mobee_drake.station.world_events import MakeSimulator
 
 DIAGRAMS = pathlib.Path(__file__).resolve().parents[1] / "diagrams"
 REACH = DIAGRAMS / "reach_around_ball.yaml"
@@ -129,6 +143,54 @@ def _Contact(point, normal, penetration, margin=0.03) -> FieldContact:
         np.array(point),
         np.array(normal) / np.linalg.norm(normal),
     )
+
+
+class TestPoseStreamer(unittest.TestCase):
+    """Two bodies' frames in a SceneGraph, their poses fixed at the diagram's input."""
+
+    def setUp(self):
+        builder = DiagramBuilder()
+        scene_graph = builder.AddSystem(SceneGraph())
+        self.source = scene_graph.RegisterSource("bodies")
+        self.frames = {}
+        for name in ("a", "b"):
+            frame = scene_graph.RegisterFrame(self.source, GeometryFrame(name))
+            geometry = scene_graph.RegisterGeometry(
+                self.source, frame, GeometryInstance(RigidTransform(), Sphere(0.1), name)
+            )
+            scene_graph.AssignRole(self.source, geometry, IllustrationProperties())
+            self.frames[name] = frame
+        self.meshcat = CountingMeshcat()
+        streamer = builder.AddSystem(
+            PoseStreamer(meshcat=self.meshcat, role=Role.kIllustration, prefix="test", period=0.1)
+        )
+        builder.Connect(scene_graph.get_query_output_port(), streamer.get_input_port())
+        builder.ExportInput(scene_graph.get_source_pose_port(self.source), "poses")
+        self.diagram = builder.Build()
+        self.context = self.diagram.CreateDefaultContext()
+
+    def Publish(self, time: float, a: list, b: list) -> list:
+        poses = FramePoseVector()
+        poses.set_value(self.frames["a"], RigidTransform(a))
+        poses.set_value(self.frames["b"], RigidTransform(b))
+        self.diagram.get_input_port().FixValue(self.context, AbstractValue.Make(poses))
+        self.context.SetTime(time)
+        before = len(self.meshcat.sent)
+        self.diagram.ForcedPublish(self.context)
+        return [(path, t) for _, path, t, _ in self.meshcat.sent[before:]]
+
+    def test_only_what_moved_is_sent_and_a_restart_keeps_its_still_pose(self):
+        origin, moved = [0.0, 0.0, 0.0], [0.0, 0.0, 0.5]
+        sent = self.Publish(0.0, origin, origin)
+        self.assertEqual(sent, [("/drake/test/a", 0.0), ("/drake/test/b", 0.0)])
+        self.assertEqual(self.Publish(0.1, origin, [0.0, 0.0, 5e-5]), [])  # within tolerance
+        # a stood still from 0 to 0.1: its still pose at 0.1, then the new one at 0.2.
+        sent = self.Publish(0.2, moved, origin)
+        self.assertEqual(sent, [("/drake/test/a", 0.1), ("/drake/test/a", 0.2)])
+        # And again from 0.2 to 0.5.
+        sent = self.Publish(0.6, origin, origin)
+        self.assertEqual(sent, [("/drake/test/a", 0.5), ("/drake/test/a", 0.6)])
+        np.testing.assert_allclose(self.meshcat.Transform("/drake/test/a")[:3, 3], origin)
 
 
 class TestForceDrawer(unittest.TestCase):
@@ -240,6 +302,30 @@ class TestCameraAndScene(unittest.TestCase):
         radius = max(FRAMED_RADIUS, np.linalg.norm(palm - ball) / 2) * FRAMING_MARGIN
         distance = radius / math.sin(CAMERA_FIELD_OF_VIEW / 2)
         np.testing.assert_allclose(position, target + distance * CAMERA_DIRECTION)
+
+    def test_the_drawn_robot_follows_the_plant(self):
+        """The streamer's paths are the visualizer's: the drawn hand is where the plant's is."""
+        meshcat = Meshcat()
+        station = BuildScenario(LoadScenario(REACH), meshcat)
+        simulator = MakeSimulator(station)
+        context = simulator.get_context()
+        scene_graph = station.scene_graph
+        hand = station.plant.GetBodyFrameIdOrThrow(station.plant.GetBodyByName("r_hand").index())
+
+        def Hand():
+            query = scene_graph.get_query_output_port().Eval(
+                scene_graph.GetMyContextFromRoot(context)
+            )
+            return RigidTransform(query.GetPoseInWorld(hand))
+
+        start = Hand()
+        simulator.AdvanceTo(2.0)
+        X_WH = Hand()
+        path = "/drake/illustration/icub_iCubGazeboV2_5/iCub/r_hand"
+        matrix = msgpack.unpackb(meshcat._GetPackedTransform(path))["matrix"]
+        drawn = np.array(matrix).reshape(4, 4).T
+        self.assertGreater(np.linalg.norm(X_WH.translation() - start.translation()), 0.01)
+        np.testing.assert_allclose(drawn, X_WH.GetAsMatrix4(), atol=2e-4)
 
     def test_the_attractor_robot_draws_only_what_moves(self):
         meshcat = Meshcat()

@@ -46,6 +46,9 @@ FRAMED_RADIUS = 0.15
 # The objects framed are those whose centre lies this close to a framed marker (m).
 FRAMED_REACH = 0.15
 FRAMING_MARGIN = 1.3
+# The smallest motion of a body the viewer sends (m, or in its rotation matrix's entries, about
+# 0.006 degrees): far below a pixel (see PoseStreamer).
+POSE_TOLERANCE = 1e-4
 
 
 def RecordingMeshcat() -> Meshcat:
@@ -58,6 +61,82 @@ def RecordingMeshcat() -> Meshcat:
         return Meshcat(MeshcatParams(host="localhost"))
     finally:
         drake_logger.setLevel(level)
+
+
+class PoseStreamer(LeafSystem):
+    """Keeps Meshcat's bodies where they are, sending only what moved.
+
+    Drake's ``MeshcatVisualizer`` draws the geometry of ``role`` under ``/drake/{prefix}`` and
+    sends every frame's pose at every publish, also for bodies that stand still (the legs, the
+    resting arm). Its visualizer is added here to draw only when the simulation starts; this
+    system then sends, every ``period``, the pose of each frame that moved more than
+    ``POSE_TOLERANCE`` since the pose last sent. In a recording a frame that starts moving after
+    standing still first gets its still pose at the previous period, so the animation does not
+    spread the motion over the time it stood. Which frames there are and what was sent is
+    Meshcat's bookkeeping (as in MeshcatVisualizer): drawing changes nothing in the simulation.
+    """
+
+    def __init__(self, *, meshcat: Meshcat, role: Role, prefix: str, period: float):
+        super().__init__()
+        self._meshcat, self._role, self._prefix, self._period = meshcat, role, prefix, period
+        self._query_port = self.DeclareAbstractInputPort(
+            "geometry_query", AbstractValue.Make(QueryObject())
+        )
+        self._paths: dict | None = None  # frame -> its Meshcat path (on the first publish)
+        self._sent: dict = {}  # frame -> (the pose sent, its time)
+        self.DeclarePeriodicPublishEvent(period_sec=period, offset_sec=0.0, publish=self._Send)
+        self.DeclareForcedPublishEvent(self._Send)
+
+    def _Paths(self, inspector) -> dict:
+        return {
+            frame: f"/drake/{self._prefix}/" + inspector.GetName(frame).replace("::", "/")
+            for frame in inspector.GetAllFrameIds()
+            if frame != inspector.world_frame_id()
+            and inspector.NumGeometriesForFrameWithRole(frame, self._role) > 0
+        }
+
+    def _Send(self, context) -> None:
+        query = self._query_port.Eval(context)
+        if self._paths is None:
+            self._paths = self._Paths(query.inspector())
+        time = context.get_time()
+        for frame, path in self._paths.items():
+            X = RigidTransform(query.GetPoseInWorld(frame))  # (A copy: the query's is live.)
+            sent = self._sent.get(frame)
+            if sent is not None:
+                if _Near(sent[0], X):
+                    continue
+                if sent[1] < time - 1.5 * self._period:  # It stood still until now.
+                    self._meshcat.SetTransform(path, sent[0], time - self._period)
+            self._meshcat.SetTransform(path, X, time)
+            self._sent[frame] = (X, time)
+
+
+def _Near(X: RigidTransform, Y: RigidTransform) -> bool:
+    """Whether two poses differ by at most POSE_TOLERANCE (m, or in a rotation's entries)."""
+    return bool(
+        np.abs(X.translation() - Y.translation()).max() <= POSE_TOLERANCE
+        and np.abs(X.rotation().matrix() - Y.rotation().matrix()).max() <= POSE_TOLERANCE
+    )
+
+
+def _AddGeometryLayer(
+    builder: DiagramBuilder,
+    scene_graph: SceneGraph,
+    meshcat: Meshcat,
+    params: MeshcatVisualizerParams,
+    period: float,
+) -> MeshcatVisualizer:
+    """Drake's visualizer of ``params`` (drawing when the simulation starts) and a
+    :class:`PoseStreamer` that moves what it drew."""
+    name = f"{params.prefix}_poses"
+    params.publish_period = math.inf
+    visualizer = MeshcatVisualizer.AddToBuilder(builder, scene_graph, meshcat, params)
+    streamer = builder.AddNamedSystem(
+        name, PoseStreamer(meshcat=meshcat, role=params.role, prefix=params.prefix, period=period)
+    )
+    builder.Connect(scene_graph.get_query_output_port(), streamer.get_input_port())
+    return visualizer
 
 
 class _Arrows:
@@ -357,13 +436,12 @@ def AddViewer(
     if settings.show_attractor:
         _AddAttractorRobot(builder, config, scene_graph, mobee, attractor)
     period = 1.0 / settings.frame_rate
-    visualizer = MeshcatVisualizer.AddToBuilder(
+    visualizer = _AddGeometryLayer(
         builder,
         scene_graph,
         meshcat,
-        MeshcatVisualizerParams(
-            publish_period=period, role=Role.kIllustration, prefix="illustration"
-        ),
+        MeshcatVisualizerParams(role=Role.kIllustration, prefix="illustration"),
+        period,
     )
     world_drawer = builder.AddNamedSystem(
         "world_drawer", WorldDrawer(meshcat=meshcat, world=world, period=period)
@@ -389,17 +467,17 @@ def AddViewer(
         )
         builder.Connect(scene_graph.get_query_output_port(), framer.GetInputPort("geometry_query"))
     # MoBeE's primitives, hidden by default (toggle "collision" in Meshcat's controls).
-    MeshcatVisualizer.AddToBuilder(
+    _AddGeometryLayer(
         builder,
         scene_graph,
         meshcat,
         MeshcatVisualizerParams(
-            publish_period=period,
             role=Role.kProximity,
             prefix="collision",
             default_color=Rgba(0.2, 0.5, 0.9, 0.4),
             visible_by_default=False,
         ),
+        period,
     )
     forces = builder.AddNamedSystem(
         "force_drawer",
