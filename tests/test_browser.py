@@ -102,8 +102,8 @@ class TestMainJobRecording(unittest.TestCase):
         self.assertGreater(np.linalg.norm(end - start), NEAR)
 
     def _Trail(self, seconds: float) -> list[np.ndarray]:
-        """The trail's lines (it may be drawn in pieces, each a Line under /trail)."""
-        return [np.array(e.points) for e in self._Shown(seconds, "/trail", kind="Line")]
+        """The trail's pieces (each a chain of Points under /trail)."""
+        return [np.array(e.points) for e in self._Shown(seconds, "/trail", kind="Points")]
 
     def test_the_trail_is_drawn(self):
         for seconds in SEEK_TIMES:

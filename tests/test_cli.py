@@ -31,6 +31,7 @@ COMMANDS = [
     ["bench", "babbling"],
     ["bench", "safety"],
     ["bench", "objects"],
+    ["bench", "viewer"],
 ]
 
 

@@ -762,7 +762,7 @@ class TestRunner(unittest.TestCase):
         from pydrake.geometry import Meshcat
 
         folder = pathlib.Path(tempfile.mkdtemp())
-        for duration, max_frames, rate in ((1.0, 3600, 30.0), (2.0, 10, 5.0)):
+        for duration, max_frames, rate in ((1.0, 3600, 24.0), (2.0, 10, 5.0)):
             meshcat = Meshcat()
             scenario = LoadScenario(
                 REACH,

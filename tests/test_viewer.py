@@ -74,7 +74,7 @@ class CountingMeshcat:
         matrix = msgpack.unpackb(self.meshcat._GetPackedTransform(path))["matrix"]
         return np.array(matrix).reshape(4, 4).T
 
-    def LinePoints(self, path: str) -> np.ndarray:
+    def Points(self, path: str) -> np.ndarray:
         command = msgpack.unpackb(self.meshcat._GetPackedObject(path))
         data = command["object"]["geometries"][0]["data"]["attributes"]["position"]["array"]
         return np.frombuffer(data.data, dtype=np.float32).reshape(-1, 3)
@@ -102,19 +102,19 @@ class TestTrailDrawer(unittest.TestCase):
         start, end = np.array([0.1, 0.2, 0.3]), np.array([0.4, 0.2, 0.3])
         meshcat = self.Run([0.0, 3.0, 10.0], [start, end, end], until=10.0)
         pieces = sorted(
-            {p for name, p, *_ in meshcat.sent if name == "SetLine"},
+            {p for name, p, *_ in meshcat.sent if name == "SetObject"},
             key=lambda p: int(p.split("/")[-1]),
         )
         # A piece is closed after 0.5 s: six pieces for 3 s of motion, none while still.
         self.assertEqual(len(pieces), 6)
-        points = np.vstack([meshcat.LinePoints(p) for p in pieces])
+        points = np.vstack([meshcat.Points(p) for p in pieces])
         np.testing.assert_allclose(points[0], start, atol=1e-6)
         np.testing.assert_allclose(points[-1], end, atol=0.002 + 1e-6)
         # Consecutive pieces share their end points: the line is unbroken.
         for a, b in zip(pieces, pieces[1:]):
-            np.testing.assert_allclose(meshcat.LinePoints(a)[-1], meshcat.LinePoints(b)[0])
+            np.testing.assert_allclose(meshcat.Points(a)[-1], meshcat.Points(b)[0])
         # A closed piece is never sent again: the pieces sent never go back.
-        sends = [int(p.split("/")[-1]) for name, p, *_ in meshcat.sent if name == "SetLine"]
+        sends = [int(p.split("/")[-1]) for name, p, *_ in meshcat.sent if name == "SetObject"]
         self.assertEqual(sends, sorted(sends))
         # Nothing is sent while the marker stands still (after 3 s).
         self.assertLessEqual(len(sends), 3.0 / 0.02 + 1)

@@ -1,6 +1,6 @@
-"""Benchmark: Meshcat a person can use (issue 35). A headless Chromium (Playwright, WebGL in
-software; see :mod:`mobee_drake.experiments.browser_probe`) looks at the main job's recording
-and at a live interactive run as a person would.
+"""Benchmark: Meshcat as a person gets it. A headless Chromium (Playwright driving the system's
+chromium, WebGL in software; see mobee_drake/experiments/browser_probe.py) looks at the main
+job's recording and at a live interactive run as a person would.
 
 It measures, in the page:
 
@@ -89,18 +89,20 @@ class ViewerResult:
     draw: bool  # whether the page drew while timed
     recording_mb: float
     recording_playable_s: float
-    live_complete_s: float
-    live_complete_mb: float
-    stream_kb_per_s: float
-    stream_messages_per_s: float
+    # The live view's figures: None where it could not be measured (``live_failure`` says why).
+    live_complete_s: float | None
+    live_complete_mb: float | None
+    stream_kb_per_s: float | None
+    stream_messages_per_s: float | None
     slider_latency_median_s: float | None  # None: the hand never moved
     slider_latency_max_s: float | None
     slider_latencies_s: list[float | None]
-    live_paths: int  # paths that received an object by the scene's completion
+    live_paths: int | None  # paths that received an object by the scene's completion
     slider: str
     hand_node: str
     # The stream's commands/s by type and path (its first 3 parts), largest first.
     stream_by_kind_per_s: dict[str, float] = dc.field(default_factory=dict)
+    live_failure: str = ""
 
     def Save(self, path: pathlib.Path) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -123,6 +125,11 @@ class LiveFigures:
     latencies_s: list[float | None]
     hand_node: str
     by_kind_per_s: dict[str, float]
+    failure: str = ""  # why the figures are missing, if they are
+
+    @staticmethod
+    def Failed(why: str) -> "LiveFigures":
+        return LiveFigures(None, None, None, None, None, [], "", {}, why)
 
 
 # The folder this package was imported from: the runs it starts import the same package (``python
@@ -331,9 +338,13 @@ def RunBenchmark(args) -> ViewerResult:
             with LiveServer(pathlib.Path(folder), seconds=args.live_seconds) as server:
                 url = server.WaitForUrl(args.timeout)
                 print(f"live view: {Shown(server.command)} at {url}", flush=True)
-                live = MeasureLive(
-                    session, url, draw=args.draw, timeout=args.timeout, drags=args.drags
-                )
+                try:
+                    live = MeasureLive(
+                        session, url, draw=args.draw, timeout=args.timeout, drags=args.drags
+                    )
+                except (RuntimeError, TimeoutError, ValueError) as error:  # Kept, with why.
+                    print(f"the live view could not be measured: {error}", flush=True)
+                    live = LiveFigures.Failed(str(error))
     moved = [s for s in live.latencies_s if s is not None]
     return ViewerResult(
         label=args.label,
@@ -346,13 +357,17 @@ def RunBenchmark(args) -> ViewerResult:
         stream_kb_per_s=live.stream_kb_per_s,
         stream_messages_per_s=live.stream_messages_per_s,
         slider_latency_median_s=statistics.median(moved) if moved else None,
-        slider_latency_max_s=None if len(moved) < len(live.latencies_s) else max(moved),
+        slider_latency_max_s=max(moved) if moved and len(moved) == len(live.latencies_s) else None,
         slider_latencies_s=live.latencies_s,
         live_paths=live.paths,
         stream_by_kind_per_s=live.by_kind_per_s,
         slider=SLIDER,
         hand_node=live.hand_node,
+        live_failure=live.failure,
     )
+
+
+_RECORDING_FIELDS = ("recording_mb", "recording_playable_s")
 
 
 def _Figure(value: float | None) -> str:
@@ -362,19 +377,28 @@ def _Figure(value: float | None) -> str:
 
 
 def Table(results: list[ViewerResult]) -> str:
-    """A markdown table: one row per figure, its target, and one column per result."""
+    """A markdown table: one row per figure, its target, and one column per result (a live
+    figure that could not be measured reads "failed", and a note below says why)."""
     header = "| | target | " + " | ".join(r.label for r in results) + " |"
     lines = [header, "|---|---:|" + "---:|" * len(results)]
     for field, what, target in TARGETS:
-        cells = " | ".join(_Figure(getattr(r, field)) for r in results)
+        cells = " | ".join(
+            "failed" if r.live_failure and field not in _RECORDING_FIELDS
+            else _Figure(getattr(r, field))
+            for r in results
+        )  # fmt: skip
         lines.append(f"| {what} | <= {target:g} | {cells} |")
-    return "\n".join(lines)
+    notes = [
+        f"- {r.label}: the live view failed: {r.live_failure}" for r in results if r.live_failure
+    ]
+    return "\n".join(lines + ([""] + notes if notes else []))
 
 
 def StoredResults(folder: pathlib.Path) -> list[ViewerResult]:
-    """The results stored in ``folder``: ``before``, ``after``, then the other labels."""
+    """The results stored in ``folder``: ``before``, ``after``, ``before-drawn``,
+    ``after-drawn``, then the other labels."""
     results = [ViewerResult.Load(p) for p in sorted(folder.glob("bench_viewer_*.json"))]
-    order = {"before": 0, "after": 1}
+    order = {"before": 0, "after": 1, "before-drawn": 2, "after-drawn": 3}
     return sorted(results, key=lambda r: (order.get(r.label, 2), r.label))
 
 
@@ -439,8 +463,9 @@ def main(argv=None) -> None:
         print(f"result: {path}")
     if args.doc:
         stored = StoredResults(folder)
-        labels = "|".join(r.label for r in stored)
-        command = f"mobee-drake bench viewer --label {labels} --doc {args.doc}"
+        command = f"mobee-drake bench viewer --report-only --doc {args.doc}"
+        if args.results != _Parser().get_default("results"):
+            command += f" --results {args.results}"
         WriteGeneratedTable(args.doc, DOC_BLOCK, command, Table(stored))
         print(f"{args.doc}: block '{DOC_BLOCK}' rewritten ({len(stored)} results)")
 

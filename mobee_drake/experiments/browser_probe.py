@@ -143,7 +143,8 @@ _CENSUS = r"""
     object.getWorldPosition(p).applyMatrix4(toMeshcat);
     const visible = shown && object.visible;
     let points = null;
-    if (object.isLine && object.geometry && object.geometry.attributes.position) {
+    if ((object.isLine || object.isPoints) && object.geometry
+        && object.geometry.attributes.position) {
       const a = object.geometry.attributes.position, v = new THREE.Vector3();
       const n = object.geometry.drawRange.count === Infinity ? a.count
         : Math.min(a.count, object.geometry.drawRange.count);

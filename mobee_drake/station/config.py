@@ -119,9 +119,10 @@ class Visualization:
     trail_marker: str = "r_palm"
     # Draw the attractor as a translucent second robot.
     show_attractor: bool = True
-    # Frames per second of the viewer and of a recording, and the most frames a recording keeps
-    # (a longer run is recorded at a lower rate), which bounds its size.
-    frame_rate: float = 30.0
+    # Frames per second of the viewer and of a recording (film's rate: with the robot moving,
+    # the live stream stays within about 100 kB/s; see `mobee-drake bench viewer`), and the most
+    # frames a recording keeps (a longer run is recorded at a lower rate), which bounds its size.
+    frame_rate: float = 24.0
     max_recorded_frames: int = 3600
     # The camera (world, m), both given or both empty; empty: framed on the task when the run
     # starts (the trail's marker and the world's objects, seen from in front of the iCub, which

@@ -19,6 +19,7 @@ from pydrake.geometry import (
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
+from pydrake.perception import PointCloud
 from pydrake.systems.framework import DiagramBuilder, LeafSystem, OutputPort
 from pydrake.systems.primitives import SharedPointerSystem
 from pydrake.systems.rendering import MultibodyPositionToGeometryPose
@@ -32,6 +33,7 @@ from mobee_drake.world.live_world import ROLE_COLORS, LiveWorld
 
 ATTRACTOR_ALPHA = 0.25
 TRAIL_COLOR = Rgba(0.9, 0.2, 0.2, 1.0)
+TRAIL_WIDTH = 0.004  # m (the trail's points are kept 2 mm apart)
 CONTACT_FORCE_COLOR = Rgba(1.0, 0.55, 0.0, 1.0)
 MARKER_FORCE_COLOR = Rgba(0.85, 0.0, 0.85, 1.0)
 MARKER_ARROW_LENGTH_PER_FORCE = 0.01
@@ -46,6 +48,8 @@ FRAMED_RADIUS = 0.15
 # The objects framed are those whose centre lies this close to a framed marker (m).
 FRAMED_REACH = 0.15
 FRAMING_MARGIN = 1.3
+# MoBeE's primitives (the "collision" layer, hidden by default) move every this many frames.
+COLLISION_LAYER_FRAMES = 4
 # The smallest motion of a body the viewer sends (m, or in its rotation matrix's entries, about
 # 0.006 degrees): far below a pixel (see PoseStreamer).
 POSE_TOLERANCE = 1e-4
@@ -232,8 +236,10 @@ class TrailDrawer(LeafSystem):
     state: its points, their count, its start time and its number), which is closed after
     ``piece_points`` points or ``piece_seconds`` seconds; the next piece starts at its last point.
     A closed piece is never sent again, so the stream carries only the open piece, and only when
-    it grew; a long run's path is never cut to a tail. In a recording each piece is hidden until
-    its start, so the path grows as it was travelled (a piece at a time).
+    it grew; a long run's path is never cut to a tail. The path is drawn as points of
+    ``TRAIL_WIDTH`` (browsers draw lines one pixel wide whatever their width, which hides the
+    path behind the hand), closer than their width, so they read as a line. In a recording each
+    piece is hidden until its start, so the path grows as it was travelled (a piece at a time).
     """
 
     def __init__(
@@ -284,9 +290,12 @@ class TrailDrawer(LeafSystem):
         count, piece = int(count), int(piece)
         if count < 2 or self._drawn == (piece, count):
             return
-        points = context.get_discrete_state(self._points).value().reshape(-1, 3)[:count]
+        cloud = PointCloud(count)
+        cloud.mutable_xyzs()[:] = (
+            context.get_discrete_state(self._points).value()[: 3 * count].reshape(-1, 3).T
+        )
         path = f"{self._path}/{piece}"
-        self._meshcat.SetLine(path, points.T, 3.0, TRAIL_COLOR)
+        self._meshcat.SetObject(path, cloud, TRAIL_WIDTH, TRAIL_COLOR)
         if self._drawn is None or self._drawn[0] != piece:
             self._meshcat.SetProperty(path, "visible", False, 0.0)
             self._meshcat.SetProperty(path, "visible", True, start)
@@ -477,7 +486,7 @@ def AddViewer(
             default_color=Rgba(0.2, 0.5, 0.9, 0.4),
             visible_by_default=False,
         ),
-        period,
+        COLLISION_LAYER_FRAMES * period,
     )
     forces = builder.AddNamedSystem(
         "force_drawer",
