@@ -56,7 +56,7 @@ def CoverageFigure(results: list[ExplorationRun]) -> Figure:
     axis.set(
         xlabel="transitions [count]",
         ylabel=f"state-actions tried [count, of {COVERAGE_STATE_ACTIONS}]",
-        title=f"7.2, coverage of the rank-3 lattice (16 nearest neighbours), {runs} runs "
+        title=f"7.2, coverage of the rank-3 lattice (16 nearest neighbours),\n{runs} runs "
         "per strategy (cf. Fig. 7.5)",
     )
     Legend(axis, title="strategy (one line per run)")
