@@ -1,6 +1,7 @@
 """The ``mobee-drake`` command: one subcommand per job a user runs."""
 
 import argparse
+import difflib
 import importlib
 import logging
 import math
@@ -70,23 +71,25 @@ def _RunParser() -> CommandParser:
     parser.add_argument(
         "--duration", type=PositiveFloat, help="seconds to simulate instead of the scenario's"
     )
-    parser.add_argument(
+    # Each flag and its opposite exclude each other (one line names both).
+    record, log, view = (parser.add_mutually_exclusive_group() for _ in range(3))
+    record.add_argument(
         "--record", type=NonEmpty, help="save a replayable Meshcat recording to this HTML file"
     )
-    parser.add_argument(
+    record.add_argument(
         "--no-record", action="store_true", help="do not save a recording (opens no port)"
     )
-    parser.add_argument(
+    log.add_argument(
         "--log",
         type=NonEmpty,
         help="write the data log (Parquet) to this file instead of beside the summary; "
         "full force vectors with --set '{data_log: {full_forces: true}}'",
     )
-    parser.add_argument("--no-log", action="store_true", help="keep no data log")
-    parser.add_argument(
+    log.add_argument("--no-log", action="store_true", help="keep no data log")
+    view.add_argument(
         "--meshcat", action="store_true", help="serve the live view in Meshcat and run in real time"
     )
-    parser.add_argument(
+    view.add_argument(
         "--no-meshcat", action="store_true", help="no viewer at all (fastest; implies --no-record)"
     )
     parser.add_argument(
@@ -201,54 +204,67 @@ def _Run(args: list[str]) -> None:
         print(f"summary: {summary_file.resolve()}")
 
 
-def _Dispatch(prog: str, args: list[str], modules: dict[str, str]) -> None:
-    """Runs ``main(rest)`` of the module named by the first argument (its own --help included)."""
-    if not args or args[0] not in modules:
-        parser = CommandParser(prog=prog)
-        parser.add_argument("which", choices=sorted(modules), help="which one (its own --help)")
-        parser.parse_args(args[:1])
+def _Listing(title: str, entries: dict[str, str]) -> str:
+    """``entries`` (name: what it is) as help lines under ``title``."""
+    width = max(map(len, entries)) + 2
+    return f"{title}:\n" + "\n".join(f"  {n:{width}s}{what}" for n, what in entries.items())
+
+
+def _Dispatch(prog: str, args: list[str], modules: dict[str, tuple[str, str]]) -> None:
+    """Runs ``main(rest)`` of the module (``modules``: name -> (module, what it does)) named by
+    the first argument, its own --help included; without one, or with --help, lists them."""
+    if not args or args[0] in ("-h", "--help"):
+        print(f"usage: {prog} {{{','.join(sorted(modules))}}} ...  (each has --help)\n")
+        print(_Listing("one of", {n: what for n, (_, what) in sorted(modules.items())}))
+        sys.exit(0 if args else 2)
+    if args[0] not in modules:
+        close = difflib.get_close_matches(args[0], modules, n=1)
+        hint = f"; did you mean '{close[0]}'?" if close else ""
+        _Fail(f"{prog}: no '{args[0]}' (one of {', '.join(sorted(modules))}){hint}")
     try:
-        importlib.import_module(modules[args[0]]).main(args[1:])
+        importlib.import_module(modules[args[0]][0]).main(args[1:])
     except (FolderError, BatteryRefused) as e:  # Raised before anything runs.
         _Fail(str(e))
 
 
+_BENCHMARKS = {
+    "babbling": (
+        "bench_babbling",
+        "MoBeE 1.0's rewinding reflex against MoBeE 2.0 on motor babbling",
+    ),
+    "forces": ("bench_forces", "MoBeE's force evaluations per second among boxes (Fig. 2.4)"),
+    "objects": ("bench_objects", "what a scenario's number of objects costs to build"),
+    "ik": ("bench_ik", "NGIK (xNES, SNES) against CMA-ES and Drake's IK (ch. 3.1-3.2)"),
+    "reactive": ("bench_reactive", "MoBeE 2.0 against Drake's differential IK as reactive control"),
+    "safety": ("bench_safety", "whether a client can push the robot through an obstacle"),
+    "simulation": ("bench_simulation", "real-time factor and safety, kinematic and dynamic robot"),
+    "viewer": ("bench_viewer", "Meshcat in a real browser: sizes, stream, slider latency"),
+}
+_EXPERIMENTS = {
+    "ch7": ("ch7_command", "the model-learning experiments of ch. 7 (the curious agent)"),
+    "ch8": ("ch8_command", "learning to reach, ch. 8: strategies, readings, claims"),
+    "ch8-discounting": (
+        "ch8_discounting",
+        "when ch. 8's greedy reach planner moves, in closed form",
+    ),
+    "saggriac": ("saggriac_command", "SAGG-RIAC goal babbling on the 15-joint arm"),
+    "roadmaps": ("ch4_roadmaps", "adaptive roadmap planning on MoBeE 1.0 (ch. 4.3)"),
+    "trm": ("trm_roadmaps", "the task-relevant roadmaps of ch. 3.4"),
+}
+
+
+def _Modules(table: dict[str, tuple[str, str]]) -> dict[str, tuple[str, str]]:
+    return {n: (f"mobee_drake.experiments.{m}", what) for n, (m, what) in table.items()}
+
+
 def _Bench(args: list[str]) -> None:
     """Benchmarks that print their figures."""
-    _Dispatch(
-        "mobee-drake bench",
-        args,
-        {
-            "babbling": "mobee_drake.experiments.bench_babbling",
-            "forces": "mobee_drake.experiments.bench_forces",
-            "objects": "mobee_drake.experiments.bench_objects",
-            "ik": "mobee_drake.experiments.bench_ik",
-            "reactive": "mobee_drake.experiments.bench_reactive",
-            "safety": "mobee_drake.experiments.bench_safety",
-            "simulation": "mobee_drake.experiments.bench_simulation",
-            "viewer": "mobee_drake.experiments.bench_viewer",
-        },
-    )
+    _Dispatch("mobee-drake bench", args, _Modules(_BENCHMARKS))
 
 
 def _Experiment(args: list[str]) -> None:
-    """Batteries of experiments that write data, plots and a report: ch7 (the model-learning
-    experiments of the dissertation's ch. 7), ch8 (learning to reach, ch. 8; ch8-discounting: when
-    its greedy reach planner moves, closed form against value iteration), saggriac (SAGG-RIAC
-    on the 15-joint arm), trm (task-relevant roadmaps, ch. 3), roadmaps (adaptive roadmap
-    planning on MoBeE 1.0, ch. 4.3)."""
-    _Dispatch(
-        "mobee-drake experiment",
-        args,
-        {
-            "ch7": "mobee_drake.experiments.ch7_command",
-            "ch8": "mobee_drake.experiments.ch8_command",
-            "ch8-discounting": "mobee_drake.experiments.ch8_discounting",
-            "saggriac": "mobee_drake.experiments.saggriac_command",
-            "roadmaps": "mobee_drake.experiments.ch4_roadmaps",
-            "trm": "mobee_drake.experiments.trm_roadmaps",
-        },
-    )
+    """Batteries of experiments that write data, plots and a report."""
+    _Dispatch("mobee-drake experiment", args, _Modules(_EXPERIMENTS))
 
 
 def _Info(args: list[str]) -> None:
@@ -287,7 +303,11 @@ def main(argv: list[str] | None = None) -> None:
     argv = sys.argv[1:] if argv is None else argv
     parser = CommandParser(
         prog="mobee-drake",
-        description="MoBeE 2.0 on Drake for the iCub.",
+        description="MoBeE 2.0 on Drake for the iCub.\n\n"
+        + _Listing(
+            "commands",
+            {n: (f.__doc__ or "").split("\n")[0].rstrip(".") for n, f in COMMANDS.items()},
+        ),
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     parser.add_argument(
@@ -295,8 +315,11 @@ def main(argv: list[str] | None = None) -> None:
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log details (DEBUG)")
     parser.add_argument("-q", "--quiet", action="store_true", help="log warnings and errors only")
-    parser.add_argument("command", choices=sorted(COMMANDS), help="what to do")
-    parser.add_argument("args", nargs=argparse.REMAINDER, help="the command's own arguments")
+    parser.add_argument("command", choices=sorted(COMMANDS), help="what to do (each has --help)")
+    parser.add_argument("args", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+    if not argv:
+        parser.print_help()
+        sys.exit(2)
     known = parser.parse_args(argv)
     global _debug
     _debug = known.debug

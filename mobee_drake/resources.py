@@ -9,6 +9,7 @@ folders), so both are found through :mod:`importlib.resources` wherever the pack
 A scenario is a file path or the name of a shipped one (``reach_around_ball``).
 """
 
+import difflib
 import functools
 import importlib.resources
 import pathlib
@@ -54,11 +55,24 @@ def ScenarioNames() -> list[str]:
 
 def ResolveScenarioFile(name: str | pathlib.Path) -> pathlib.Path:
     """A scenario file: ``name`` if it is an existing file, else the shipped scenario of that name
-    (with or without ``.yaml``); an unknown name is returned as given, for the loader to report."""
+    (with or without ``.yaml``); an unknown path is returned as given, for the loader to report.
+
+    Raises:
+        ValueError: for a bare name that is neither a file here nor a shipped scenario, naming
+            the shipped ones and the closest.
+    """
     path = pathlib.Path(name)
     if path.is_file():
         return path
     shipped = ScenariosDirectory() / (path.stem + ".yaml")
-    if path.parent == pathlib.Path(".") and shipped.is_file():
+    if path.parent != pathlib.Path("."):
+        return path
+    if shipped.is_file():
         return shipped
-    return path
+    if path.exists():  # (A folder, say: the loader says what it is.)
+        return path
+    close = difflib.get_close_matches(path.stem, ScenarioNames(), n=1)
+    raise ValueError(
+        f"{name}: no such file, nor a shipped scenario (shipped: {', '.join(ScenarioNames())})"
+        + (f"; did you mean '{close[0]}'?" if close else "")
+    )

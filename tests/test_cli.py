@@ -14,6 +14,8 @@ import tempfile
 import unittest
 from unittest import mock
 
+from battery_jobs import DefaultSigint
+
 from mobee_drake import cli
 from mobee_drake.experiments.battery import BatteryError
 
@@ -54,11 +56,25 @@ class TestHelp(unittest.TestCase):
                 self.assertEqual(code, 0)
                 options = re.findall(r"^  (--[a-z-]+)", text, flags=re.MULTILINE)
                 self.assertTrue(options)
-                # Each option's entry (up to the next one) says its default.
-                entries = re.split(r"\n  (?=--)", text.split("options:")[1])[1:]
-                for entry in entries:
-                    if not entry.startswith("--help"):
-                        self.assertIn("(default:", entry, entry.split()[0])
+                # An option's default is said where it is worth reading: never "None", a flag
+                # that is off or an empty list; and the help is the user's, not the code's.
+                for noise in ("(default: None)", "(default: False)", "(default: [])"):
+                    self.assertNotIn(noise, text)
+                for code_only in (":mod:", ":class:", ":func:", "``", "(issue "):
+                    self.assertNotIn(code_only, text)
+                self.assertNotIn("args", re.findall(r"^  (\w+)", text, flags=re.MULTILINE))
+
+    def test_bare_commands_list_what_they_offer(self):
+        code, text, _ = _Call()
+        self.assertEqual(code, 2)
+        for command in ("bench", "experiment", "info", "run"):
+            self.assertRegex(text, rf"\n  {command} +[A-Z]")  # each with what it does
+        for group, member in (("bench", "viewer"), ("experiment", "ch8")):
+            code, text, _ = _Call(group)
+            self.assertEqual(code, 2)
+            self.assertRegex(text, rf"\n  {member} +\S")
+            code, _, _ = _Call(group, "--help")
+            self.assertEqual(code, 0)
 
     def test_version(self):
         code, text, _ = _Call("--version")
@@ -238,6 +254,26 @@ class TestMistakes(unittest.TestCase):
         logging.getLogger("drake").setLevel(logging.INFO)
 
 
+class TestGuidance(unittest.TestCase):
+    def test_a_misspelt_name_is_met_with_the_closest(self):
+        for args, message in (
+            (["bench", "viwer"], "no 'viwer' (one of babbling, "),
+            (["run", "reach_arund_ball"], "nor a shipped scenario (shipped: explore_hypercube"),
+        ):
+            with self.subTest(args=args):
+                code, _, err = _Call(*args)
+                self.assertEqual((code, err.count("\n")), (2, 1))
+                self.assertIn(message, err)
+                self.assertIn("did you mean", err)
+
+    def test_a_flag_and_its_opposite_are_refused_together(self):
+        for pair in (("--meshcat", "--no-meshcat"), ("--record", "x.html", "--no-record")):
+            with self.subTest(pair=pair):
+                code, _, err = _Call("run", "reach_around_ball", *pair)
+                self.assertEqual((code, err.count("\n")), (2, 1))
+                self.assertIn("not allowed with argument", err)
+
+
 class TestProgressInLogs(unittest.TestCase):
     def test_a_log_file_gets_plain_lines_not_bars(self):
         done = subprocess.run(
@@ -287,6 +323,7 @@ class TestLiveRun(unittest.TestCase):
         live = subprocess.Popen(
             [sys.executable, "-m", "mobee_drake.cli", "run", "interactive", "--meshcat"],
             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, cwd=folder,
+            preexec_fn=DefaultSigint,  # (Ctrl-C as in a terminal, also in a background job.)
         )  # fmt: skip
         self.addCleanup(live.kill)
         lines = []

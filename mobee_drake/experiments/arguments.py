@@ -3,6 +3,7 @@ error naming the flag and the value, what no run could use."""
 
 import argparse
 import math
+import re
 
 
 def _Checked(text: str, convert, accept, what: str):
@@ -55,15 +56,35 @@ def NonEmpty(text: str) -> str:
     return _Checked(text, str, bool, "a non-empty path")
 
 
+def PlainHelp(text: str | None) -> str | None:
+    """A docstring made user help: Sphinx roles and doubled backquotes read as plain code, and
+    the developers' issue numbers left out."""
+    if text is None:
+        return None
+    text = re.sub(r":(?:mod|class|func|meth|attr|data|obj):`~?([^`]+)`", r"`\1`", text)
+    text = text.replace("``", "`")
+    return re.sub(r" ?\(issues? \d+(?:, \d+)*\)", "", text)
+
+
 class HelpFormatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
-    """Every command's help: its description as written, each option with its default."""
+    """Every command's help: its description as written, each option with its default where it
+    has one worth reading (not for a flag that is off, an option that is unset, or help that
+    already says it)."""
+
+    def _get_help_string(self, action) -> str:
+        text = PlainHelp(action.help or "")
+        if "default" in text or action.default in (None, False, [], argparse.SUPPRESS):
+            return text
+        return PlainHelp(super()._get_help_string(action))
 
 
 class CommandParser(argparse.ArgumentParser):
-    """A command's parser: help with defaults, and a mistake in one line (no usage dump)."""
+    """A command's parser: help with defaults, a description in plain words, and a mistake in
+    one line (no usage dump)."""
 
     def __init__(self, **kwargs):
         kwargs.setdefault("formatter_class", HelpFormatter)
+        kwargs["description"] = PlainHelp(kwargs.get("description"))
         super().__init__(**kwargs)
 
     def error(self, message: str):
