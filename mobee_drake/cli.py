@@ -2,6 +2,7 @@
 
 import argparse
 import difflib
+import hashlib
 import importlib
 import logging
 import math
@@ -61,11 +62,12 @@ def _RunParser() -> CommandParser:
         prog="mobee-drake run",
         description="Simulate a scenario: a file, or the name of a shipped one ("
         + ", ".join(ScenarioNames())
-        + "). Headless by default: the run is recorded to results/<scenario>.html unless "
+        + "). Headless by default: the run is recorded to results/<name>.html unless "
         "--record or --no-record says otherwise (Drake's Meshcat records through its server: "
         "that one listens on localhost only, silently), its data log written to "
-        "results/<scenario>.log.parquet and its summary to results/<scenario>.summary.json; "
-        "--meshcat serves the live view.",
+        "results/<name>.log.parquet and its summary to results/<name>.summary.json, where "
+        "<name> is the scenario's, followed by a hash of --set and --duration when they are "
+        "given (variants never overwrite each other); --meshcat serves the live view.",
     )
     parser.add_argument("scenario", help="a scenario file or a shipped scenario's name")
     parser.add_argument(
@@ -109,13 +111,31 @@ def _RunParser() -> CommandParser:
     parser.add_argument(
         "--graphviz", type=NonEmpty, help="write the diagram's Graphviz (dot) text to this file"
     )
+    parser.add_argument(
+        "--output",
+        type=NonEmpty,
+        default="results",
+        help="the folder of the recording, data log and summary (named after the scenario, "
+        "and for a run with --set or --duration the first 8 hex digits of their hash)",
+    )
     return parser
+
+
+def RunName(scenario: str, changes: list[str]) -> str:
+    """The name of a run's outputs: its scenario's, and for a variant (``changes``: its --set
+    overrides and --duration, in order) the first 8 hex digits of their SHA-256, so that
+    variants never overwrite each other."""
+    name = pathlib.Path(scenario).stem
+    if not changes:
+        return name
+    return f"{name}-{hashlib.sha256(chr(10).join(changes).encode()).hexdigest()[:8]}"
 
 
 def _RunOutputs(known) -> tuple[str | None, str | None, pathlib.Path]:
     """Where ``run`` writes its recording, data log and summary (the summary and the log beside
     the recording, or where it would be), each checked before the run."""
-    default_record = pathlib.Path("results") / (pathlib.Path(known.scenario).stem + ".html")
+    changes = list(known.set) + ([f"duration: {known.duration}"] if known.duration else [])
+    default_record = pathlib.Path(known.output) / (RunName(known.scenario, changes) + ".html")
     record = None
     if not (known.no_record or known.no_meshcat):
         record = known.record or str(default_record)

@@ -55,24 +55,22 @@ def ScenarioNames() -> list[str]:
 
 def ResolveScenarioFile(name: str | pathlib.Path) -> pathlib.Path:
     """A scenario file: ``name`` if it is an existing file, else the shipped scenario of that name
-    (with or without ``.yaml``); an unknown path is returned as given, for the loader to report.
-
-    Raises:
-        ValueError: for a bare name that is neither a file here nor a shipped scenario, naming
-            the shipped ones and the closest.
-    """
+    (with or without ``.yaml``); an unknown name is returned as given, for the loader to report
+    (see :func:`UnknownScenario`)."""
     path = pathlib.Path(name)
     if path.is_file():
         return path
     shipped = ScenariosDirectory() / (path.stem + ".yaml")
-    if path.parent != pathlib.Path("."):
-        return path
-    if shipped.is_file():
+    if path.parent == pathlib.Path(".") and shipped.is_file():
         return shipped
-    if path.exists():  # (A folder, say: the loader says what it is.)
-        return path
-    close = difflib.get_close_matches(path.stem, ScenarioNames(), n=1)
-    raise ValueError(
+    return path
+
+
+def UnknownScenario(name: str | pathlib.Path) -> str:
+    """What to say of a scenario ``name`` that is neither a file nor a shipped scenario: the
+    shipped ones, and the closest."""
+    close = difflib.get_close_matches(pathlib.Path(name).stem, ScenarioNames(), n=1)
+    return (
         f"{name}: no such file, nor a shipped scenario (shipped: {', '.join(ScenarioNames())})"
         + (f"; did you mean '{close[0]}'?" if close else "")
     )

@@ -24,7 +24,7 @@ import yaml
 
 from mobee_drake import __version__
 from mobee_drake.planning.supervisor import ExploreAttractor
-from mobee_drake.resources import ResolveScenarioFile
+from mobee_drake.resources import ResolveScenarioFile, UnknownScenario
 from mobee_drake.station.attractors import FixedAttractor, RandomAttractors, SliderAttractor
 from mobee_drake.station.builder import MakeMobeeStation, Station
 from mobee_drake.station.config import DataLog, StationConfig, StationConfigErrors, Visualization
@@ -111,6 +111,8 @@ def LoadScenario(
     top-level key of the file), then applies ``overrides``: YAML texts with the same keys, in
     order (e.g. ``{mover: !Dynamic {control: force}}``)."""
     filename = ResolveScenarioFile(filename)
+    if filename.parent == pathlib.Path(".") and not filename.exists():
+        raise YamlFileError(UnknownScenario(filename))
     scenario = LoadYamlFile(schema=Scenario, filename=filename, child_name=scenario_name)
     ValidateScenario(scenario, str(filename))
     for text in [overrides] if isinstance(overrides, str) else overrides or []:

@@ -302,10 +302,30 @@ class TestHeadlessRun(unittest.TestCase):
         for stream in (done.stdout, done.stderr):
             self.assertNotIn("Meshcat", stream)
             self.assertNotIn("http", stream)
-        for name in ("reach_around_ball.html", "reach_around_ball.log.parquet"):
-            self.assertIn(name, done.stdout)
-            self.assertGreater((folder / "results" / name).stat().st_size, 0)
-        self.assertTrue((folder / "results" / "reach_around_ball.summary.json").exists())
+        name = cli.RunName("reach_around_ball", ["duration: 0.5"])
+        for file in (f"{name}.html", f"{name}.log.parquet"):
+            self.assertIn(file, done.stdout)
+            self.assertGreater((folder / "results" / file).stat().st_size, 0)
+        self.assertTrue((folder / "results" / f"{name}.summary.json").exists())
+
+    def test_variants_never_overwrite_each_other(self):
+        folder = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, folder)
+        variants = (
+            [],
+            ["--duration", "0.2"],
+            ["--duration", "0.2", "--set", "{objects: []}"],
+            ["--set", "{objects: []}", "--duration", "0.2"],  # (the same changes)
+        )
+        with contextlib.chdir(folder):
+            for variant in variants:
+                code, _, _ = _Call("run", "reach_around_ball", "--no-record", *variant)
+                self.assertEqual(code, 0)
+            _Call("run", "reach_around_ball", "--no-record", "--output", "elsewhere")
+        summaries = sorted(p.name for p in (folder / "results").glob("*.summary.json"))
+        self.assertEqual(len(summaries), 3, summaries)
+        self.assertIn("reach_around_ball.summary.json", summaries)
+        self.assertTrue((folder / "elsewhere" / "reach_around_ball.summary.json").exists())
 
 
 class TestLiveRun(unittest.TestCase):

@@ -73,7 +73,8 @@ class HelpFormatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefau
 
     def _get_help_string(self, action) -> str:
         text = PlainHelp(action.help or "")
-        if "default" in text or action.default in (None, False, [], argparse.SUPPRESS):
+        unset = action.default is None or action.default is False or action.default in ([], "")
+        if "default" in text or unset or action.default is argparse.SUPPRESS:
             return text
         return PlainHelp(super()._get_help_string(action))
 
