@@ -4,9 +4,11 @@ import argparse
 import difflib
 import hashlib
 import importlib
+import itertools
 import logging
 import math
 import pathlib
+import re
 import sys
 
 import numpy as np
@@ -20,7 +22,7 @@ from mobee_drake.experiments.arguments import CommandParser, NonEmpty, PositiveF
 from mobee_drake.experiments.battery import BatteryError, BatteryRefused, TerminationInterrupts
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.owned_folders import CanWrite, FolderError
-from mobee_drake.resources import ScenarioNames
+from mobee_drake.resources import ResolveScenarioFile, ScenarioNames, UnknownScenario
 from mobee_drake.robots.icub import AddIcub, IcubConfig
 from mobee_drake.robots.model_cache import IcubModelNames
 from mobee_drake.scenario import BuildScenario, LoadScenario, ResumableConfiguration
@@ -316,7 +318,39 @@ def _Info(args: list[str]) -> None:
     print("constraint clauses: " + ", ".join(mobee.clauses.names))
 
 
-COMMANDS = {"bench": _Bench, "experiment": _Experiment, "info": _Info, "run": _Run}
+def _Scenarios(args: list[str]) -> None:
+    """Lists the shipped scenarios, or prints one to copy and change."""
+    parser = CommandParser(
+        prog="mobee-drake scenarios",
+        description="Without a name, lists the shipped scenarios with what each does; with one, "
+        "prints that scenario's file, e.g. `mobee-drake scenarios reach_around_ball > mine.yaml`, "
+        "then `mobee-drake run mine.yaml`.",
+    )
+    parser.add_argument("name", nargs="?", help="a shipped scenario's name")
+    known = parser.parse_args(args)
+    if known.name is None:
+        print(_Listing("shipped scenarios", {n: _Purpose(n) for n in ScenarioNames()}))
+        return
+    if known.name not in ScenarioNames():
+        _Fail(UnknownScenario(known.name))
+    print(ResolveScenarioFile(known.name).read_text(), end="")
+
+
+def _Purpose(name: str) -> str:
+    """The opening clause of a shipped scenario's first comment."""
+    lines = ResolveScenarioFile(name).read_text().splitlines()
+    comment = " ".join(line.lstrip("# ") for line in itertools.takewhile(
+        lambda line: line.startswith("#"), lines))  # fmt: skip
+    return re.split(r";|: | \(|\. ", comment)[0].rstrip(".")
+
+
+COMMANDS = {
+    "bench": _Bench,
+    "experiment": _Experiment,
+    "info": _Info,
+    "run": _Run,
+    "scenarios": _Scenarios,
+}
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -274,6 +274,25 @@ class TestGuidance(unittest.TestCase):
                 self.assertIn("not allowed with argument", err)
 
 
+class TestScenarios(unittest.TestCase):
+    def test_the_shipped_scenarios_are_listed_and_printed_to_copy(self):
+        code, text, _ = _Call("scenarios")
+        self.assertEqual(code, 0)
+        self.assertIn("  interactive", text)
+        self.assertIn("Move the attractor by hand", text)
+        folder = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, folder)
+        code, text, _ = _Call("scenarios", "reach_around_ball")
+        (folder / "mine.yaml").write_text(text)
+        with contextlib.chdir(folder):
+            code, out, _ = _Call("run", "mine.yaml", "--duration", "0.2", "--no-record")
+        self.assertEqual(code, 0)
+        self.assertIn("simulated 0.20 s", out)
+        code, _, err = _Call("scenarios", "reach_arund")
+        self.assertEqual((code, err.count("\n")), (2, 1))
+        self.assertIn("did you mean 'reach_around_ball'", err)
+
+
 class TestProgressInLogs(unittest.TestCase):
     def test_a_log_file_gets_plain_lines_not_bars(self):
         done = subprocess.run(
