@@ -25,7 +25,12 @@ from mobee_drake.owned_folders import CanWrite, FolderError
 from mobee_drake.resources import ResolveScenarioFile, ScenarioNames, UnknownScenario
 from mobee_drake.robots.icub import AddIcub, IcubConfig
 from mobee_drake.robots.model_cache import IcubModelNames
-from mobee_drake.scenario import BuildScenario, LoadScenario, ResumableConfiguration
+from mobee_drake.scenario import (
+    BuildScenario,
+    LoadScenario,
+    ResumableConfiguration,
+    ScenarioDoubts,
+)
 from mobee_drake.station.attractors import SliderAttractor
 from mobee_drake.station.checkpoint import CheckpointError
 from mobee_drake.station.runner import RunStation
@@ -40,13 +45,13 @@ _debug = False
 MAX_ERROR_LINE = 1000
 
 
-def _PrintError(message: str) -> None:
-    """``error: message`` on stderr, on one line of at most about :data:`MAX_ERROR_LINE`."""
+def _PrintError(message: str, kind: str = "error") -> None:
+    """``kind: message`` on stderr, on one line of at most about :data:`MAX_ERROR_LINE`."""
     message = message.replace("\n", " ")
     if len(message) > MAX_ERROR_LINE:
         cut = len(message) - MAX_ERROR_LINE
         message = f"{message[: MAX_ERROR_LINE - 200]} [... {cut:,} characters ...] {message[-200:]}"
-    print(f"error: {message}", file=sys.stderr)
+    print(f"{kind}: {message}", file=sys.stderr)
 
 
 def _Fail(message: str) -> None:
@@ -112,6 +117,12 @@ def _RunParser() -> CommandParser:
     )
     parser.add_argument(
         "--graphviz", type=NonEmpty, help="write the diagram's Graphviz (dot) text to this file"
+    )
+    parser.add_argument(
+        "--no-warnings",
+        action="store_true",
+        help="do not warn of values that look like unit mistakes (a 3.5 m ball, an object 330 m "
+        "away, attractor angles that look like radians, world events after the run's end)",
     )
     parser.add_argument(
         "--output",
@@ -192,6 +203,9 @@ def _Run(args: list[str]) -> None:
     # bugs, and keep their traceback.
     try:
         scenario = LoadScenario(known.scenario, overrides)
+        if not known.no_warnings:
+            for doubt in ScenarioDoubts(scenario):
+                _PrintError(doubt, "warning")
         serve = _ServesUntilCtrlC(known, scenario)
         if serve:  # (Its data log is still sized by the scenario's duration.)
             record = None

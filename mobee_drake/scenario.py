@@ -16,6 +16,7 @@ import dataclasses as dc
 import math
 import pathlib
 
+import numpy as np
 from pydrake.common.yaml import yaml_dump_typed
 from pydrake.geometry import Meshcat
 from pydrake.systems.analysis import ApplySimulatorConfig, Simulator, SimulatorConfig
@@ -31,6 +32,7 @@ from mobee_drake.station.config import DataLog, StationConfig, StationConfigErro
 from mobee_drake.station.executor import StateActionAttractor
 from mobee_drake.station.runner import RunStation, RunSummary
 from mobee_drake.station.viewer import RecordingMeshcat
+from mobee_drake.world.objects import Box, Cylinder
 from mobee_drake.yaml_io import (
     CheckYamlStructure,
     InvalidYaml,
@@ -92,6 +94,57 @@ def ScenarioErrors(scenario: Scenario) -> list[str]:
     except ValueError as e:
         errors.append(str(e))
     return errors
+
+
+# Beyond these a value is more likely a unit mistake (centimetres, millimetres, radians) than
+# meant: the largest object size (m) and distance from the world's origin (m).
+DOUBTFUL_SIZE = 3.0
+DOUBTFUL_DISTANCE = 5.0
+
+
+def _ObjectDoubts(scenario: Scenario) -> list[str]:
+    doubts = []
+    for o in scenario.objects:
+        shape = o.shape
+        if isinstance(shape, Box):
+            values = [("size", max(shape.size), DOUBTFUL_SIZE)]
+        else:
+            values = [("radius", shape.radius, DOUBTFUL_SIZE / 2)]
+            if isinstance(shape, Cylinder):
+                values.append(("length", shape.length, DOUBTFUL_SIZE))
+        for what, value, limit in values:
+            if value > limit:
+                doubts.append(
+                    f"objects '{o.name}': {what} {value:g} m; sizes are in metres ({value:g} cm "
+                    f"would be {value / 100:g})"
+                )
+        distance = float(np.linalg.norm(o.position))
+        if distance > DOUBTFUL_DISTANCE:
+            doubts.append(
+                f"objects '{o.name}': {distance:g} m from the world's origin, out of any reach; "
+                "positions are in metres"
+            )
+    return doubts
+
+
+def ScenarioDoubts(scenario: Scenario) -> list[str]:
+    """What in ``scenario`` looks like a mistake though it is allowed: sizes or distances far
+    beyond a robot's world (a unit slip), world events after the run's end (they never happen),
+    joint attractors below pi with fractions (radians in a field of degrees)."""
+    doubts = _ObjectDoubts(scenario)
+    for event in scenario.world_events:
+        if event.time >= scenario.duration:
+            doubts.append(
+                f"world_events: '{event.object}' at {event.time:g} s, at or after the run's end "
+                f"({scenario.duration:g} s): it never happens"
+            )
+    for name, value in getattr(scenario.attractor, "joints_deg", {}).items():
+        if 0 < abs(value) <= math.pi and value != round(value):
+            doubts.append(
+                f"attractor joints_deg: {name}: {value:g} looks like radians; the angles are in "
+                f"degrees ({value:g} rad would be {math.degrees(value):.1f})"
+            )
+    return doubts
 
 
 def ValidateScenario(scenario: Scenario, source: str = "scenario") -> None:

@@ -274,6 +274,41 @@ class TestGuidance(unittest.TestCase):
                 self.assertIn("not allowed with argument", err)
 
 
+class TestDoubts(unittest.TestCase):
+    ODD = (
+        "{objects: [{name: ball, shape: !Sphere {radius: 3.5}, position: [330, 0, 0]}], "
+        "world_events: [{time: 20, object: ball, role: ghost}], "
+        "attractor: !FixedAttractor {joints_deg: {r_shoulder_pitch: -0.5, r_shoulder_roll: 0.3}}}"
+    )
+
+    def Run(self, *extra: str) -> tuple[int, str]:
+        folder = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, folder)
+        with contextlib.chdir(folder):
+            code, _, err = _Call(
+                "run", "reach_around_ball", "--duration", "0.1", "--no-record", "--no-log",
+                "--set", self.ODD, *extra,
+            )  # fmt: skip
+        return code, err
+
+    def test_values_that_look_like_unit_mistakes_are_warned_of_and_run(self):
+        code, err = self.Run()
+        self.assertEqual(code, 0)
+        warnings = [line for line in err.splitlines() if line.startswith("warning: ")]
+        for expected in (
+            "radius 3.5 m; sizes are in metres (3.5 cm would be 0.035)",
+            "330 m from the world's origin",
+            "'ball' at 20 s, at or after the run's end (0.1 s): it never happens",
+            "r_shoulder_pitch: -0.5 looks like radians; the angles are in degrees (-0.5 rad "
+            "would be -28.6)",
+            "r_shoulder_roll: 0.3 looks like radians",
+        ):
+            self.assertEqual(sum(expected in w for w in warnings), 1, expected)
+        self.assertEqual(len(warnings), 5)
+        code, err = self.Run("--no-warnings")
+        self.assertEqual((code, err.count("warning")), (0, 0))
+
+
 class TestScenarios(unittest.TestCase):
     def test_the_shipped_scenarios_are_listed_and_printed_to_copy(self):
         code, text, _ = _Call("scenarios")
