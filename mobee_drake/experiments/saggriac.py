@@ -329,6 +329,18 @@ def Diagnostics(learner, evaluator: Evaluator) -> dict:
     return result
 
 
+class _ReportingEvaluator:
+    """The run's evaluator, telling the battery's display at each checkpoint how many
+    micro-actions are done."""
+
+    def __init__(self, evaluator: Evaluator, run: RunFolder):
+        self._evaluator, self._run = evaluator, run
+
+    def __call__(self, memory, rest_position) -> dict:
+        self._run.Progress(memory.size)
+        return self._evaluator(memory, rest_position)
+
+
 def RunOne(run: RunFolder, spec: dict) -> dict:
     """Runs one learner (a battery job; ``spec`` a :class:`RunSpec` as a dict) and returns its
     :class:`BabblingRun` as written."""
@@ -336,7 +348,7 @@ def RunOne(run: RunFolder, spec: dict) -> dict:
     config = MakeConfig(spec)
     evaluator = Evaluator(config)
     started = time.perf_counter()
-    learner = METHODS[spec.method](config, evaluator).Run()
+    learner = METHODS[spec.method](config, _ReportingEvaluator(evaluator, run)).Run()
     stride = max(1, learner.memory.size // TIP_SAMPLES)
     result = BabblingRun(
         spec=spec,
@@ -362,7 +374,10 @@ def RunOne(run: RunFolder, spec: dict) -> dict:
 def RunAll(specs: list[RunSpec], output: pathlib.Path, backend: Backend) -> list[BabblingRun]:
     """Runs the missing runs on ``backend`` (see :mod:`mobee_drake.experiments.battery`) and
     returns every run's result."""
-    jobs = [Job(spec.Name(), RunOne, {"spec": dataclasses.asdict(spec)}) for spec in specs]
+    jobs = [
+        Job(spec.Name(), RunOne, {"spec": dataclasses.asdict(spec)}, total=spec.budget)
+        for spec in specs
+    ]
     results = RunBattery(jobs, output, backend=backend, description="SAGG-RIAC")
     return [BabblingRun.FromJson(result) for result in results.values()]
 
