@@ -31,6 +31,7 @@ from mobee_drake.scenario import (
     ResumableConfiguration,
     ScenarioDoubts,
 )
+from mobee_drake.scenario_reference import ScenarioReference
 from mobee_drake.station.attractors import SliderAttractor
 from mobee_drake.station.checkpoint import CheckpointError
 from mobee_drake.station.runner import RunStation
@@ -341,7 +342,15 @@ def _Scenarios(args: list[str]) -> None:
         "then `mobee-drake run mine.yaml`.",
     )
     parser.add_argument("name", nargs="?", help="a shipped scenario's name")
+    parser.add_argument(
+        "--reference",
+        action="store_true",
+        help="print the reference of every key a scenario file may hold (markdown)",
+    )
     known = parser.parse_args(args)
+    if known.reference:
+        print(ScenarioReference(), end="")
+        return
     if known.name is None:
         print(_Listing("shipped scenarios", {n: _Purpose(n) for n in ScenarioNames()}))
         return

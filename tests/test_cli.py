@@ -328,6 +328,25 @@ class TestScenarios(unittest.TestCase):
         self.assertIn("did you mean 'reach_around_ball'", err)
 
 
+class TestScenarioReference(unittest.TestCase):
+    def test_the_reference_is_the_config_and_up_to_date(self):
+        code, text, _ = _Call("scenarios", "--reference")
+        self.assertEqual(code, 0)
+        doc = pathlib.Path(__file__).parents[1] / "docs" / "scenario_reference.md"
+        self.assertEqual(
+            doc.read_text(), text, "run: mobee-drake scenarios --reference > " + str(doc)
+        )
+        # Each key with its type, default and the comment above it in the source.
+        self.assertIn("| `duration` | float | `10.0` | Seconds to simulate. |", text)
+        self.assertRegex(text, r"\| `mover` \| one of `!Kinematic`, `!Dynamic`, `!Reflex` \|")
+        # Every key the shipped scenarios use is in it.
+        for name in ("reach_around_ball", "interactive", "three_agents_table", "katana"):
+            _, scenario, _ = _Call("scenarios", name)
+            for key in re.findall(r"^\s*(\w+):", scenario, flags=re.MULTILINE):
+                with self.subTest(scenario=name, key=key):
+                    self.assertIn(f"| `{key}` |", text)
+
+
 class TestProgressInLogs(unittest.TestCase):
     def test_a_log_file_gets_plain_lines_not_bars(self):
         done = subprocess.run(
