@@ -64,6 +64,14 @@ class TestHelp(unittest.TestCase):
                     self.assertNotIn(code_only, text)
                 self.assertNotIn("args", re.findall(r"^  (\w+)", text, flags=re.MULTILINE))
 
+    def test_required_options_are_listed_as_required(self):
+        for command, option in ((["experiment", "ch7"], "--experiment"),
+                                (["experiment", "ch8-discounting"], "--model")):  # fmt: skip
+            _, text, _ = _Call(*command, "--help")
+            required = text.split("required options:")[1]
+            self.assertIn(f"  {option}", required)
+            self.assertNotIn(f"  {option}", text.split("options:")[1].split("required")[0])
+
     def test_bare_commands_list_what_they_offer(self):
         code, text, _ = _Call()
         self.assertEqual(code, 2)

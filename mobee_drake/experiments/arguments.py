@@ -87,6 +87,16 @@ class CommandParser(argparse.ArgumentParser):
         kwargs.setdefault("formatter_class", HelpFormatter)
         kwargs["description"] = PlainHelp(kwargs.get("description"))
         super().__init__(**kwargs)
+        self._required_options = None
+
+    def add_argument(self, *args, **kwargs):
+        """As argparse's; a required option is listed under "required options", not among the
+        optional ones."""
+        if kwargs.get("required") and args and args[0].startswith("-"):
+            if self._required_options is None:
+                self._required_options = self.add_argument_group("required options")
+            return self._required_options.add_argument(*args, **kwargs)
+        return super().add_argument(*args, **kwargs)
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message}\n")

@@ -79,7 +79,7 @@ def _Parser() -> CommandParser:
     parser.add_argument(
         "--output",
         type=pathlib.Path,
-        default=pathlib.Path("saggriac_results"),
+        default=pathlib.Path("results/saggriac"),
         help="the battery folder (runs, curves, report)",
     )
     parser.add_argument(

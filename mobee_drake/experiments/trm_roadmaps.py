@@ -153,7 +153,9 @@ def main(argv: list[str] | None = None) -> None:
         prog="mobee-drake experiment trm",
         description=__doc__.split("\n")[0],
     )
-    parser.add_argument("--output", required=True, help="where the roadmaps, figures and report go")
+    parser.add_argument(
+        "--output", default="results/trm", help="where the roadmaps, figures and report go"
+    )
     parser.add_argument(
         "--examples",
         nargs="+",
