@@ -4,6 +4,7 @@
 import contextlib
 import io
 import logging
+import math
 import pathlib
 import re
 import shutil
@@ -417,6 +418,15 @@ class TestLiveRun(unittest.TestCase):
         code, _, err = _Call("run", "interactive", "--meshcat", "--record", "x.html")
         self.assertEqual((code, err.count("\n")), (2, 1))
         self.assertIn("--record needs --duration", err)
+
+    def test_a_run_until_ctrl_c_is_not_recorded(self):
+        from mobee_drake.scenario import BuildScenario, LoadScenario
+        from mobee_drake.station.runner import RunStation
+        from mobee_drake.station.viewer import RecordingMeshcat
+
+        station = BuildScenario(LoadScenario("reach_around_ball"), RecordingMeshcat())
+        with self.assertRaisesRegex(ValueError, "cannot be recorded; give it a duration"):
+            RunStation(station, math.inf, record="x.html")
 
     def test_the_live_view_is_served_until_ctrl_c(self):
         folder = pathlib.Path(tempfile.mkdtemp())

@@ -158,8 +158,8 @@ def RunStation(
     data_log: str | None = None,
     on_start=None,
 ) -> RunSummary:
-    """Runs ``station`` until ``duration`` (``math.inf``: until Ctrl-C, for a live view; nothing
-    is recorded then) with Drake's ``simulator_config`` (``realtime_rate``,
+    """Runs ``station`` until ``duration`` (``math.inf``: until Ctrl-C, for a live view, which
+    cannot be recorded) with Drake's ``simulator_config`` (``realtime_rate``,
     if given, overrides its target real-time rate); with ``record`` saves its Meshcat recording
     (HTML; the station must have been built with Meshcat) at the viewer's frame rate, or at the
     lower rate that keeps it within ``max_recorded_frames``; with ``data_log`` (a Parquet file)
@@ -175,6 +175,8 @@ def RunStation(
     flight. A run whose checkpoint is at or past ``duration`` has nothing left to do: it
     simulates nothing and says so (``RunSummary.finished_before``).
     """
+    if record and math.isinf(duration):
+        raise ValueError("a run served until Ctrl-C cannot be recorded; give it a duration")
     with OwnedFolder(checkpoint, "checkpoint") if checkpoint else contextlib.nullcontext():
         simulator = MakeSimulator(station, simulator_config)
         if realtime_rate is not None:
