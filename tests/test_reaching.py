@@ -4,6 +4,7 @@ import contextlib
 import dataclasses
 import io
 import itertools
+import json
 import pathlib
 import tempfile
 import unittest
@@ -274,6 +275,25 @@ class TestReachLearner(unittest.TestCase):
                 _Learner("random" if strategy != "random" else "greedy", seed=3)[1].LoadArrays(
                     arrays, data
                 )
+
+    def test_a_save_older_than_an_option_resumes_at_its_default(self):
+        """A checkpoint written before an option existed resumes when the option is at its
+        default, and is refused when it is not (a different configuration)."""
+        space, first = _Learner("intrinsic", seed=3)
+        robot = FakeRobot(space, PALMS, blocked={(0, 2)}, obstacles={(1, 3)})
+        for _ in range(3):
+            first.Explore(robot)
+        arrays, data = first.ToArrays()
+        older = json.loads(json.dumps(data))
+        del older["config"]["goals"]["interest"]["region_measure"]  # (added by issue 34)
+        del older["config"]["plateau_rule"]
+        _, resumed = _Learner("intrinsic", seed=3)
+        resumed.LoadArrays(arrays, older)
+        self.assertEqual(resumed.log, first.log)
+        _, other = _Learner("intrinsic", seed=3)
+        other.config.plateau_rule = "arrival"
+        with self.assertRaisesRegex(ValueError, "configuration"):
+            other.LoadArrays(arrays, older)
 
     def test_learned_mdp_tells_model_updates_from_penalties(self):
         # Ch. 9.4.1: from state 0, the edge to 1 is blocked by the robot's own body (a model

@@ -193,6 +193,18 @@ LOG_COLUMNS = (
 )
 
 
+def _WithDefaults(saved: dict, defaults: dict) -> dict:
+    """``saved`` (a configuration as JSON data) with every key it lacks taken from
+    ``defaults`` (the same configuration's defaults), nested mappings included."""
+    filled = dict(saved)
+    for key, value in defaults.items():
+        if key not in filled:
+            filled[key] = value
+        elif isinstance(value, dict) and isinstance(filled[key], dict):
+            filled[key] = _WithDefaults(filled[key], value)
+    return filled
+
+
 class ReachLearner:
     """Learns which pre-reach states suit which targets (ch. 8)."""
 
@@ -429,6 +441,9 @@ class ReachLearner:
         if self.log:
             raise ValueError("load a saved state into a fresh learner only")
         saved, mine = (json.loads(json.dumps(c)) for c in (data["config"], dc.asdict(self.config)))
+        # A key added after the save (a new option) counts at its default value.
+        defaults = json.loads(json.dumps(dc.asdict(ReachLearningConfig())))
+        saved = _WithDefaults(saved, defaults)
         if saved != mine:
             raise ValueError(f"the saved learner's configuration {saved} is not this one's {mine}")
         for row in np.asarray(arrays["log"]):
