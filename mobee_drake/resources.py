@@ -32,9 +32,11 @@ def ScenariosDirectory() -> pathlib.Path:
 
 @functools.cache
 def MobeePackageMap() -> PackageMap:
-    """A package map that resolves ``package://mobee_drake/...``."""
+    """A package map that resolves ``package://mobee_drake/...`` and the packages on
+    ``ROS_PACKAGE_PATH`` (a user's own models)."""
     package_map = PackageMap.MakeEmpty()
     package_map.AddPackageXml(str(ModelsDirectory() / "package.xml"))
+    package_map.PopulateFromRosPackagePath()
     return package_map
 
 
@@ -46,6 +48,28 @@ def ResolveModelFile(name: str | pathlib.Path) -> pathlib.Path:
         return pathlib.Path(MobeePackageMap().ResolveUrl(text))
     path = pathlib.Path(text)
     return path if path.is_absolute() else ModelsDirectory() / path
+
+
+def ResolveModelPath(name: str) -> pathlib.Path:
+    """The existing file a ``package://`` URI or a path (relative to the current folder) names.
+
+    Raises:
+        ValueError: naming the URI's unknown package, or the missing file.
+    """
+    if name.startswith("package://"):
+        package = name[len("package://") :].split("/", 1)[0]
+        if not MobeePackageMap().Contains(package):
+            raise ValueError(
+                f"{name}: unknown package '{package}' (known: "
+                + ", ".join(sorted(MobeePackageMap().GetPackageNames()))
+                + "; add yours to ROS_PACKAGE_PATH)"
+            )
+        path = pathlib.Path(MobeePackageMap().ResolveUrl(name))
+    else:
+        path = pathlib.Path(name)
+    if not path.is_file():
+        raise ValueError(f"{name}: no such file")
+    return path
 
 
 def ScenarioNames() -> list[str]:

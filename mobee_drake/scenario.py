@@ -26,13 +26,15 @@ import yaml
 from mobee_drake import __version__
 from mobee_drake.planning.supervisor import ExploreAttractor
 from mobee_drake.resources import ResolveScenarioFile, UnknownScenario
+from mobee_drake.robots.model_file import ModelFileConfig
 from mobee_drake.station.attractors import FixedAttractor, RandomAttractors, SliderAttractor
 from mobee_drake.station.builder import MakeMobeeStation, Station
 from mobee_drake.station.config import DataLog, StationConfig, StationConfigErrors, Visualization
 from mobee_drake.station.executor import StateActionAttractor
 from mobee_drake.station.runner import RunStation, RunSummary
 from mobee_drake.station.viewer import RecordingMeshcat
-from mobee_drake.world.objects import Box, Cylinder
+from mobee_drake.world.live_world import MakeShape
+from mobee_drake.world.objects import Box, Cylinder, Mesh, SceneObject
 from mobee_drake.yaml_io import (
     CheckYamlStructure,
     InvalidYaml,
@@ -102,21 +104,29 @@ DOUBTFUL_SIZE = 3.0
 DOUBTFUL_DISTANCE = 5.0
 
 
+def _Sizes(shape) -> list[tuple[str, float, float]]:
+    """(what, value in m, the largest plausible value) of an object's shape."""
+    if isinstance(shape, Box):
+        return [("size", max(shape.size), DOUBTFUL_SIZE)]
+    if isinstance(shape, Mesh):
+        hull = MakeShape(shape).GetConvexHull()
+        points = np.array([hull.vertex(i) for i in range(hull.num_vertices())])
+        return [("extent", float((points.max(axis=0) - points.min(axis=0)).max()), DOUBTFUL_SIZE)]
+    sizes = [("radius", shape.radius, DOUBTFUL_SIZE / 2)]
+    if isinstance(shape, Cylinder):
+        sizes.append(("length", shape.length, DOUBTFUL_SIZE))
+    return sizes
+
+
 def _ObjectDoubts(scenario: Scenario) -> list[str]:
     doubts = []
     for o in scenario.objects:
-        shape = o.shape
-        if isinstance(shape, Box):
-            values = [("size", max(shape.size), DOUBTFUL_SIZE)]
-        else:
-            values = [("radius", shape.radius, DOUBTFUL_SIZE / 2)]
-            if isinstance(shape, Cylinder):
-                values.append(("length", shape.length, DOUBTFUL_SIZE))
-        for what, value, limit in values:
+        for what, value, limit in _Sizes(o.shape):
             if value > limit:
                 doubts.append(
                     f"objects '{o.name}': {what} {value:g} m; sizes are in metres ({value:g} cm "
                     f"would be {value / 100:g})"
+                    + ("; a mesh's scale takes its units to metres" if what == "extent" else "")
                 )
         distance = float(np.linalg.norm(o.position))
         if distance > DOUBTFUL_DISTANCE:
@@ -167,6 +177,7 @@ def LoadScenario(
     if filename.parent == pathlib.Path(".") and not filename.exists():
         raise YamlFileError(UnknownScenario(filename))
     scenario = LoadYamlFile(schema=Scenario, filename=filename, child_name=scenario_name)
+    scenario = _FilesBeside(scenario, filename.resolve().parent)
     ValidateScenario(scenario, str(filename))
     for text in [overrides] if isinstance(overrides, str) else overrides or []:
         source = f"overrides '{_OneLine(text)}'"
@@ -185,6 +196,32 @@ def LoadScenario(
             raise YamlFileError(f"{source}: {e}") from e
         ValidateScenario(scenario, source)
     return scenario
+
+
+def _FilesBeside(scenario: Scenario, folder: pathlib.Path) -> Scenario:
+    """``scenario`` with the relative paths of its model files (a robot's model and overlay, an
+    object's mesh) made absolute in ``folder``, the scenario file's."""
+
+    def Beside(name: str) -> str:
+        relative = name and "://" not in name and not pathlib.Path(name).is_absolute()
+        return str(folder / name) if relative else name
+
+    def Robot(robot):
+        if not isinstance(robot, ModelFileConfig):
+            return robot
+        return dc.replace(robot, file=Beside(robot.file), overlay=Beside(robot.overlay))
+
+    def Object(o: SceneObject) -> SceneObject:
+        if not isinstance(o.shape, Mesh):
+            return o
+        return dc.replace(o, shape=dc.replace(o.shape, file=Beside(o.shape.file)))
+
+    return dc.replace(
+        scenario,
+        robot=Robot(scenario.robot),
+        companions=[dc.replace(c, robot=Robot(c.robot)) for c in scenario.companions],
+        objects=[Object(o) for o in scenario.objects],
+    )
 
 
 def _OneLine(text: str, limit: int = 80) -> str:

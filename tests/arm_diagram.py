@@ -13,7 +13,7 @@ from mobee_drake.robots.assembly import AddRobotWithOverlay
 from mobee_drake.world.live_world import LiveWorld
 from mobee_drake.world.objects import Box, SceneObject
 
-MODELS = pathlib.Path(__file__).parent / "models"
+MODELS = pathlib.Path(__file__).resolve().parents[1] / "models"
 JOINTS = ["joint1", "joint2", "joint3"]
 
 

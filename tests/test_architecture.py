@@ -2,19 +2,13 @@
 backend, and a release that ships what a run needs."""
 
 import ast
-import contextlib
-import io
-import os
 import pathlib
-import subprocess
-import sys
 import tempfile
 import unittest
 import zipfile
 
 import grimp
-
-from mobee_drake import cli
+from installed_wheel import CodeBlocks, InstalledWheel, RunCommandLine, RunPython
 
 PACKAGE = pathlib.Path(__file__).resolve().parents[1] / "mobee_drake"
 ROOT = PACKAGE.parent
@@ -114,21 +108,18 @@ class TestReadme(unittest.TestCase):
     def _Example(containing: str) -> str:
         """The README's Python example that contains ``containing`` (unindented)."""
         text = (ROOT / "README.md").read_text()
-        blocks = [block.split("```", 1)[0] for block in text.split("```python\n")[1:]]
-        (code,) = [block for block in blocks if containing in block]
-        return "\n".join(line[2:] if line.startswith("  ") else line for line in code.splitlines())
+        (code,) = [c for kind, c in CodeBlocks(text) if kind == "python" and containing in c]
+        return code
 
     def test_the_client_example_runs(self):
-        printed = io.StringIO()
-        with contextlib.redirect_stdout(printed):
-            exec(compile(self._Example("class BendElbow"), "README.md", "exec"), {})
-        self.assertIn("[", printed.getvalue())  # the robot's state
+        """In an empty folder, with the wheel installed (as every README example below)."""
+        printed = RunPython(self._Example("class BendElbow"), pathlib.Path(tempfile.mkdtemp()))
+        self.assertIn("[", printed)  # the robot's state
 
     def test_the_data_log_example_plots_the_main_job(self):
         folder = pathlib.Path(tempfile.mkdtemp())
-        with contextlib.chdir(folder), contextlib.redirect_stdout(io.StringIO()):
-            cli.main(["run", "reach_around_ball", "--no-record"])
-            exec(compile(self._Example("read_parquet"), "README.md", "exec"), {})
+        RunCommandLine("mobee-drake run reach_around_ball --no-record", folder)
+        RunPython(self._Example("read_parquet"), folder)
         self.assertGreater((folder / "results" / "palm_to_ball.png").stat().st_size, 10_000)
 
 
@@ -138,22 +129,8 @@ class TestRelease(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
-        cls.temporary = tempfile.TemporaryDirectory()
-        cls.addClassCleanup(cls.temporary.cleanup)
-        folder = pathlib.Path(cls.temporary.name)
-        subprocess.run(
-            [sys.executable, "-m", "pip", "wheel", "--no-deps", "-q",
-             "-w", str(folder / "dist"), str(ROOT)],
-            check=True,
-        )  # fmt: skip
-        (cls.wheel,) = (folder / "dist").glob("mobee_drake-*.whl")
-        cls.site = folder / "site"
-        subprocess.run(
-            [sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target",
-             str(cls.site), str(cls.wheel)],
-            check=True,
-        )  # fmt: skip
-        cls.folder = folder
+        cls.wheel, cls.site = InstalledWheel()
+        cls.folder = pathlib.Path(tempfile.mkdtemp())
 
     def test_the_wheel_ships_models_scenarios_and_license(self):
         names = set(zipfile.ZipFile(self.wheel).namelist())
@@ -162,41 +139,27 @@ class TestRelease(unittest.TestCase):
             "mobee_drake/models/icub_overlay.yaml",
             "mobee_drake/models/katana.xml",
             "mobee_drake/models/reach_targets.yaml",
+            "mobee_drake/models/three_link_arm.urdf",
+            "mobee_drake/models/three_link_arm_overlay.yaml",
+            "mobee_drake/models/pillar.obj",
             "mobee_drake/diagrams/reach_around_ball.yaml",
+            "mobee_drake/diagrams/three_link_arm.yaml",
             "mobee_drake/station/builder.py",
         ):
             self.assertIn(shipped, names)
         self.assertTrue(any(name.endswith("LICENSE") for name in names))
 
-    def _RunInstalled(self, *args: str) -> subprocess.CompletedProcess:
-        elsewhere = self.folder / "elsewhere"
-        elsewhere.mkdir(exist_ok=True)
-        return subprocess.run(
-            [sys.executable, "-m", "mobee_drake.cli", *args],
-            cwd=elsewhere,
-            env={**os.environ, "PYTHONPATH": str(self.site)},
-            capture_output=True,
-            text=True,
-            timeout=300,
-        )
-
     def test_the_installed_main_job_runs_from_another_directory(self):
-        where = self._RunInstalled("--version")
-        self.assertEqual(where.returncode, 0, where.stderr)
-        self.assertRegex(where.stdout, r"^mobee-drake \d+\.\d+\.\d+")
-        run = self._RunInstalled("run", "reach_around_ball", "--duration", "0.2", "--no-meshcat")
-        self.assertEqual(run.returncode, 0, run.stderr)
-        self.assertIn("simulated 0.20 s", run.stdout)
-        # The package imported is the installed copy, not the repository's.
-        probe = subprocess.run(
-            [sys.executable, "-c", "import mobee_drake; print(mobee_drake.__file__)"],
-            cwd=self.folder,
-            env={"PYTHONPATH": str(self.site)},
-            capture_output=True,
-            text=True,
-            check=True,
+        self.assertRegex(
+            RunCommandLine("mobee-drake --version", self.folder), r"^mobee-drake \d+\.\d+\.\d+"
         )
-        self.assertTrue(probe.stdout.startswith(str(self.site)), probe.stdout)
+        run = RunCommandLine(
+            "mobee-drake run reach_around_ball --duration 0.2 --no-meshcat", self.folder
+        )
+        self.assertIn("simulated 0.20 s", run)
+        # The package imported is the installed copy, not the repository's.
+        probe = RunPython("import mobee_drake; print(mobee_drake.__file__)", self.folder)
+        self.assertTrue(probe.startswith(str(self.site)), probe)
 
 
 if __name__ == "__main__":

@@ -17,7 +17,7 @@ from mobee_drake.robots.zero_position import (
 from mobee_drake.scenario import LoadScenario
 from mobee_drake.yaml_io import MAX_YAML_DEPTH, YamlFileError
 
-MODELS = pathlib.Path(__file__).resolve().parent / "models"
+MODELS = pathlib.Path(__file__).resolve().parents[1] / "models"
 HEADER = '<?xml version="1.0"?>\n<ZeroPositionKinematicTree version="1.0" robotName="r">\n'
 
 # (s) What a refused file may take: a guard against a hang (an alias bomb walked for hours), not

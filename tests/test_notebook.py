@@ -1,13 +1,16 @@
-"""The example notebook runs from start to end (so it cannot rot)."""
+"""The example notebook runs from start to end (so it cannot rot), in an empty folder with the
+wheel installed (tests/installed_wheel.py)."""
 
 import base64
 import html
 import os
 import pathlib
 import re
+import tempfile
 import unittest
 from unittest import mock
 
+from installed_wheel import Environment, InstalledWheel
 import msgpack
 import nbclient
 import nbformat
@@ -18,12 +21,16 @@ NOTEBOOK = pathlib.Path(__file__).parents[1] / "examples" / "first_steps.ipynb"
 class TestNotebook(unittest.TestCase):
     def test_first_steps_runs_and_plots(self):
         notebook = nbformat.read(NOTEBOOK, as_version=4)
+        probe = nbformat.v4.new_code_cell("import mobee_drake; print(mobee_drake.__file__)")
+        notebook.cells.append(probe)
         # The kernel draws inline, as in Jupyter (the suite's MPLBACKEND=Agg would hide plots).
-        with mock.patch.dict(os.environ):
+        with mock.patch.dict(os.environ, Environment()):
             os.environ.pop("MPLBACKEND", None)
             nbclient.NotebookClient(notebook, timeout=300, kernel_name="python3").execute(
-                cwd=str(NOTEBOOK.parent)
+                cwd=tempfile.mkdtemp()
             )
+        (where,) = [o["text"] for o in probe.outputs]
+        self.assertTrue(where.startswith(str(InstalledWheel()[1])), where)  # the installed copy
         outputs = [o for cell in notebook.cells for o in cell.get("outputs", [])]
         self.assertFalse([o for o in outputs if o.output_type == "error"])
         text = "".join(o.get("text", "") for o in outputs if o.output_type == "stream")

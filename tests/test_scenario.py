@@ -134,6 +134,14 @@ class TestShippedScenarios(unittest.TestCase):
     def test_katana(self):
         self.assertGreater(self._Travel(*self._Run("katana", 6.0)), 20.0)
 
+    def test_three_link_arm(self):
+        """The arm of one's own babbles, and MoBeE holds it off the ball it swings into."""
+        station, context, start = self._Run("three_link_arm", 6.0)
+        self.assertGreater(self._Travel(station, context, start), 20.0)
+        report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
+        self.assertGreater(report.closest_approach["ball"], 0.0)
+        self.assertEqual(report.penetrating_steps, 0)
+
     def test_icub_and_katana(self):
         """Both robots move: the iCub's arms and its companion Katana."""
         station, context, start = self._Run("icub_and_katana", 6.0)

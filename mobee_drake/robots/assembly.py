@@ -8,7 +8,7 @@ import numpy as np
 from pydrake.common.eigen_geometry import AngleAxis
 from pydrake.geometry import SceneGraph
 from pydrake.math import RigidTransform
-from pydrake.multibody.parsing import Parser
+from pydrake.multibody.parsing import PackageMap, Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex, RevoluteJoint
 
@@ -34,13 +34,16 @@ def AddRobotWithOverlay(
     model_name: str | None = None,
     couplings: tuple[JointCoupling, ...] = (),
     model_source: str | None = None,
+    package_map: PackageMap | None = None,
 ) -> RobotOverlay:
     """Adds the robot of ``model_file`` (URDF or SDFormat) with its MoBeE overlay to ``plant``.
 
     The overlay's ``reference_link`` is the robot's root: unless the model already fixes it, it is
     welded to the world at ``X_WRoot``. Joints not in ``controlled_joints`` are welded at their
     ``home`` angle (radians, zero by default), but for those that follow a controlled joint by
-    ``couplings`` (one motor driving several joints). Must be called before ``plant.Finalize()``.
+    ``couplings`` (one motor driving several joints). The parser resolves the model's
+    ``package://`` URIs with ``package_map`` besides its own. Must be called before
+    ``plant.Finalize()``.
 
     Raises:
         ValueError: naming the file (or ``model_source``: what the user named, where the file is
@@ -48,10 +51,17 @@ def AddRobotWithOverlay(
             limits, or a malformed overlay.
     """
     model_file = str(model_file)
+
+    def add_model(p: MultibodyPlant) -> ModelInstanceIndex:
+        parser = Parser(p, model_name)
+        if package_map is not None:
+            parser.package_map().AddMap(package_map)
+        return parser.AddModels(model_file)[0]
+
     return AddModelWithOverlay(
         plant,
         scene_graph,
-        add_model=lambda p: Parser(p, model_name).AddModels(model_file)[0],
+        add_model=add_model,
         overlay=LoadOverlay(overlay_file),
         controlled_joints=controlled_joints,
         home=home,
@@ -84,12 +94,7 @@ def AddModelWithOverlay(
             f"{overlay_source}: reference_link '{overlay.reference_link}' is not a "
             f"link of {model_source}"
         )
-    root = plant.GetBodyByName(overlay.reference_link, instance)
-    if not any(
-        plant.get_joint(j).child_body().index() == root.index()
-        for j in plant.GetJointIndices(instance)
-    ):
-        plant.WeldFrames(plant.world_frame(), root.body_frame(), X_WRoot or RigidTransform())
+    WeldRootUnlessFixed(plant, instance, overlay.reference_link, X_WRoot or RigidTransform())
     reference = ZeroConfigurationPoses(add_model, overlay.reference_link)
     controlled_joints = list(controlled_joints)
     followers = Followers(couplings, controlled_joints, model_source)
@@ -110,6 +115,19 @@ def AddModelWithOverlay(
         source=overlay_source,
     )
     return dc.replace(robot, couplings=tuple(followers))
+
+
+def WeldRootUnlessFixed(
+    plant: MultibodyPlant, instance: ModelInstanceIndex, root: str, X_WRoot: RigidTransform
+) -> None:
+    """Welds the body ``root`` of ``instance`` to the world at ``X_WRoot``, unless the model
+    already attaches it by a joint of its own."""
+    body = plant.GetBodyByName(root, instance)
+    if not any(
+        plant.get_joint(j).child_body().index() == body.index()
+        for j in plant.GetJointIndices(instance)
+    ):
+        plant.WeldFrames(plant.world_frame(), body.body_frame(), X_WRoot)
 
 
 def FreezeJoints(

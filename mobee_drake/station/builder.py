@@ -50,7 +50,14 @@ from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.couplings import LinearMapSystem
 from mobee_drake.robots.overlay import RobotOverlay
 from mobee_drake.robots.scenario_robot import AddScenarioRobot
-from mobee_drake.station.config import Dynamic, Kinematic, Mover, Reflex, StationConfig
+from mobee_drake.station.config import (
+    Dynamic,
+    Kinematic,
+    Mover,
+    Reflex,
+    StationConfig,
+    Visualization,
+)
 from mobee_drake.station.data_log import AddDataLog, DataLogger
 from mobee_drake.station.parts import (
     CheckClientPorts,
@@ -488,8 +495,14 @@ def MakeMobeeStation(
     attractor, marker_forces = _ConnectClient(
         builder, client, mobee, mover, isinstance(mover_config, Reflex)
     )
-    if config.visualization.trail_marker:
-        mobee.marker_index(config.visualization.trail_marker)  # Checked with or without a viewer.
+    if config.visualization.trail_marker:  # Checked with or without a viewer.
+        try:
+            mobee.marker_index(config.visualization.trail_marker)
+        except ValueError as e:
+            raise ValueError(
+                f"visualization trail_marker: {e} (the default, "
+                f"{Visualization.trail_marker}, is the iCub's; '' draws no trail)"
+            ) from None
     visualizer = None
     if meshcat is not None:
         visualizer = AddViewer(

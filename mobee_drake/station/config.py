@@ -25,11 +25,21 @@ from pydrake.multibody.plant import (
 
 from mobee_drake.mobee.params import Dissertation, MobeeParams
 from mobee_drake.mobee.reflex import ReflexParams
+from mobee_drake.resources import ResolveModelPath
 from mobee_drake.robots.icub import IcubConfig
 from mobee_drake.robots.model_cache import MESH_RESOLUTIONS
+from mobee_drake.robots.model_file import ModelFileConfig
 from mobee_drake.robots.zero_position import ZeroPositionConfig
 from mobee_drake.station.attractors import FixedAttractor, RandomAttractors
-from mobee_drake.world.objects import OBJECT_ROLES, Box, Cylinder, SceneObject, Sphere, WorldEvent
+from mobee_drake.world.objects import (
+    OBJECT_ROLES,
+    Box,
+    Cylinder,
+    Mesh,
+    SceneObject,
+    Sphere,
+    WorldEvent,
+)
 
 CONTROL_MODALITIES = ("position", "velocity", "force")
 # The longest period MoBeE may run at (s; our choice: the original ran at 20 ms, and at 0.1 s a
@@ -52,10 +62,16 @@ def _Finite(values) -> bool:
 
 
 def _ShapeErrors(name: str, shape) -> list[str]:
+    if isinstance(shape, Mesh):
+        try:
+            ResolveModelPath(shape.file)
+        except ValueError as e:
+            return [f"object '{name}': mesh file {e}"]
     sizes = {
         Box: lambda s: list(s.size),
         Sphere: lambda s: [s.radius],
         Cylinder: lambda s: [s.radius, s.length],
+        Mesh: lambda s: [s.scale],
     }[type(shape)](shape)
     if isinstance(shape, Box) and len(sizes) != 3:
         return [f"object '{name}': a box's size needs three numbers, got {sizes}"]
@@ -102,7 +118,9 @@ class Companion:
     """
 
     name: str = "katana"
-    robot: ZeroPositionConfig | IcubConfig = dc.field(default_factory=ZeroPositionConfig)
+    robot: ZeroPositionConfig | IcubConfig | ModelFileConfig = dc.field(
+        default_factory=ZeroPositionConfig
+    )
     # Pose of the companion's root in world: metres, degrees.
     position: list[float] = dc.field(default_factory=_Zeros3)
     rpy_deg: list[float] = dc.field(default_factory=_Zeros3)
@@ -153,8 +171,10 @@ class DataLog:
 class StationConfig:
     """The robot, its world and what moves it (see ``diagrams/`` for examples)."""
 
-    # The iCub, or ``!ZeroPositionConfig {file: katana.xml}`` for a robot from a MoBeE XML file.
-    robot: IcubConfig | ZeroPositionConfig = dc.field(default_factory=IcubConfig)
+    # The iCub, ``!ZeroPositionConfig {file: katana.xml}`` for a robot from a MoBeE XML file, or
+    # ``!ModelFileConfig {file: arm.urdf, overlay: arm_overlay.yaml}`` for a URDF or SDFormat
+    # robot with its MoBeE overlay.
+    robot: IcubConfig | ZeroPositionConfig | ModelFileConfig = dc.field(default_factory=IcubConfig)
     objects: list[SceneObject] = dc.field(default_factory=list)
     # Other robots in the same world, each with its own MoBeE (not with the !Dynamic mover).
     companions: list[Companion] = dc.field(default_factory=list)
@@ -220,6 +240,13 @@ def _TimingAndViewErrors(config: StationConfig) -> list[str]:
     errors = []
     if isinstance(config.robot, IcubConfig) and not config.robot.controlled_joints:
         errors.append("robot controlled_joints must name at least one joint")
+    for robot in [config.robot] + [c.robot for c in config.companions]:
+        if isinstance(robot, ModelFileConfig):
+            for key in ("file", "overlay"):
+                try:
+                    ResolveModelPath(getattr(robot, key))
+                except ValueError as e:
+                    errors.append(f"robot {key}: {e}")
     if not (math.isfinite(config.time_step) and MIN_TIME_STEP <= config.time_step <= MAX_TIME_STEP):
         errors.append(
             f"time_step must be >= {MIN_TIME_STEP:g} and <= {MAX_TIME_STEP} s, "

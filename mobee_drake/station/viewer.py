@@ -17,7 +17,6 @@ from pydrake.geometry import (
     SceneGraph,
 )
 from pydrake.math import RigidTransform, RotationMatrix
-from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.perception import PointCloud
 from pydrake.systems.framework import DiagramBuilder, LeafSystem, OutputPort
@@ -27,7 +26,7 @@ from pydrake.systems.rendering import MultibodyPositionToGeometryPose
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.assembly import FreezeJoints
 from mobee_drake.robots.couplings import CoupledPositions, LinearMapSystem
-from mobee_drake.robots.scenario_robot import RobotModelText
+from mobee_drake.robots.scenario_robot import AddGhostRobot
 from mobee_drake.station.config import StationConfig
 from mobee_drake.world.live_world import ROLE_COLORS, LiveWorld
 
@@ -389,15 +388,11 @@ def _AddAttractorRobot(
 ) -> None:
     """A second, translucent robot (illustration only) posed at the attractor: the bodies that
     MoBeE's joints move."""
-    text, extension, root, home = RobotModelText(
-        config.robot, ATTRACTOR_ALPHA, config.visualization.meshes
-    )
     ghost = MultibodyPlant(0.0)
     ghost.RegisterAsSourceForSceneGraph(scene_graph)
-    parser = Parser(ghost, "attractor")
-    (instance,) = parser.AddModelsFromString(text, extension)
-    ghost.RenameModelInstance(instance, "attractor")
-    ghost.WeldFrames(ghost.world_frame(), ghost.GetFrameByName(root, instance), RigidTransform())
+    instance, home = AddGhostRobot(
+        ghost, scene_graph, config.robot, ATTRACTOR_ALPHA, config.visualization.meshes
+    )
     followers = list(mobee.followers)
     moved = list(mobee.joints) + [c.follower for c in followers]
     FreezeJoints(ghost, instance, keep=moved, home=home, source="attractor robot")

@@ -36,6 +36,7 @@ import numpy as np
 from pydrake.geometry import (
     AddContactMaterial,
     Box,
+    Convex,
     Cylinder,
     GeometryId,
     GeometryInstance,
@@ -51,6 +52,7 @@ from pydrake.math import RigidTransform, RollPitchYaw
 from pydrake.multibody.plant import CoulombFriction, MultibodyPlant
 from pydrake.multibody.tree import SpatialInertia, default_model_instance
 
+from mobee_drake.resources import ResolveModelPath
 from mobee_drake.world import objects as schema
 
 ROLE_COLORS = {
@@ -63,11 +65,14 @@ _ROLE_GROUP, _ROLE_PROPERTY = "mobee_world", "role"
 
 
 def MakeShape(shape) -> Shape:
-    """The Drake shape of a scenario shape."""
+    """The Drake shape of a scenario shape (a mesh's file resolved, see
+    :func:`~mobee_drake.resources.ResolveModelPath`)."""
     if isinstance(shape, schema.Box):
         return Box(*shape.size)
     if isinstance(shape, schema.Sphere):
         return Sphere(shape.radius)
+    if isinstance(shape, schema.Mesh):
+        return Convex(str(ResolveModelPath(shape.file)), shape.scale)
     return Cylinder(shape.radius, shape.length)
 
 
@@ -76,6 +81,8 @@ def _ShapeToJson(shape: Shape) -> dict:
         return {"sphere": shape.radius()}
     if isinstance(shape, Box):
         return {"box": list(shape.size())}
+    if isinstance(shape, Convex):
+        return {"convex": [str(shape.source().path()), shape.scale()]}
     return {"cylinder": [shape.radius(), shape.length()]}
 
 
@@ -84,6 +91,8 @@ def _ShapeFromJson(data: dict) -> Shape:
         return Sphere(data["sphere"])
     if "box" in data:
         return Box(*data["box"])
+    if "convex" in data:
+        return Convex(*data["convex"])
     return Cylinder(*data["cylinder"])
 
 

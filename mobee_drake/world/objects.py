@@ -29,11 +29,22 @@ class Cylinder:
 
 
 @dc.dataclass
+class Mesh:
+    """A solid from a mesh file (OBJ, glTF or VTK): MoBeE and the dynamic robot's contacts see
+    its convex hull (Drake's ``Convex``)."""
+
+    # A package:// URI, an absolute path, or a path relative to the scenario's folder.
+    file: str = ""
+    # The factor that takes the file's units to metres.
+    scale: float = 1.0
+
+
+@dc.dataclass
 class SceneObject:
     """An object of the robot's world: MoBeE avoids obstacles and ignores the rest."""
 
     name: str = ""
-    shape: Box | Sphere | Cylinder = dc.field(default_factory=Box)
+    shape: Box | Sphere | Cylinder | Mesh = dc.field(default_factory=Box)
     # Pose in world (the iCub's root frame unless the robot is moved): metres, degrees.
     position: list[float] = dc.field(default_factory=_Zeros3)
     rpy_deg: list[float] = dc.field(default_factory=_Zeros3)
