@@ -1,5 +1,6 @@
-"""The numbers the tutorial and docs/simulation.md quote from the main job are what a fresh run
-gives: each is read from the text and compared with the run at the text's own precision."""
+"""The numbers the README, the tutorial and docs/simulation.md quote from the main job are what
+a fresh run gives: each is read from the text and compared with the run at the text's own
+precision."""
 
 import pathlib
 import re
@@ -11,12 +12,14 @@ import pandas as pd
 
 from mobee_drake.scenario import LoadScenario, RunScenario
 
-DOCS = pathlib.Path(__file__).parents[1] / "docs"
+ROOT = pathlib.Path(__file__).parents[1]
+DOCS = ROOT / "docs"
 
 
 def _Text(name: str) -> str:
-    """A doc with its line breaks and indentation folded into single spaces."""
-    return " ".join((DOCS / name).read_text().split())
+    """A doc (under docs/, or the README) with its line breaks and indentation folded into
+    single spaces."""
+    return " ".join((ROOT / name if name == "README.md" else DOCS / name).read_text().split())
 
 
 def _Quoted(text: str, pattern: str) -> tuple[str, ...]:
@@ -61,6 +64,28 @@ class TestQuotedNumbers(unittest.TestCase):
         self.assertEqual(int(start), round(spring.max()))
         pull, push = _Quoted(text, r"\(([0-9.]+) against ([0-9.]+) at 15 s\)")
         self.assertEqual((pull, push), (f"{spring[-1]:.2f}", f"{f_coll[-1]:.2f}"))
+
+    def test_the_readme(self):
+        text = _Text("README.md")
+        ball = self.main.safety.closest_approach["ball"]
+        printed, cm, short = _Quoted(
+            text, r"\(`ball ([+-][0-9.]+)`: ([0-9.]+) cm\) and the palm (\d+) cm short of its goal"
+        )
+        self.assertEqual(printed, f"{ball:+.4f}")
+        self.assertEqual(cm, f"{100 * ball:.1f}")
+        self.assertEqual(int(short), round(100 * self.Palm(self.main)))
+        _Quoted(text, r"`penetrations of solid geometry: 0 control periods`")
+        self.assertEqual(self.main.safety.penetrating_steps, 0)
+        (title,) = _Quoted(text, r"the ball holds the palm (\d+) cm short of its goal")
+        self.assertEqual(int(title), round(100 * self.Palm(self.main)))
+        # The palm's goal, as the README's plot and the scenario's comment give it.
+        goal = np.array(_Quoted(text, r"goal = np.array\(\[([-0-9.]+), ([-0-9.]+), ([-0-9.]+)\]\)"))
+        comment = (ROOT / "diagrams" / "reach_around_ball.yaml").read_text()
+        stated = _Quoted(comment, r"this attractor at \(([-0-9.]+), ([-0-9.]+), ([-0-9.]+)\)")
+        palm = self.log[["marker.r_palm.x", "marker.r_palm.y", "marker.r_palm.z"]].to_numpy()
+        end = np.linalg.norm(palm[-1] - goal.astype(float))
+        self.assertAlmostEqual(end, self.Palm(self.main), delta=1e-3)  # rounded to 1 mm
+        self.assertEqual(stated, tuple(goal))
 
     def test_the_simulation_doc(self):
         text = _Text("simulation.md")

@@ -1,4 +1,5 @@
-"""What a run achieved: the attractor's outcome against a free reach that converges, the
+"""What a run achieved: the attractor's outcome against a free reach that converges, the markers
+a task involves, targets reached or not against closed forms, the world events applied, the
 exploring agents' figures against their own models, and ``summary.json``."""
 
 import contextlib
@@ -10,9 +11,30 @@ import tempfile
 import unittest
 
 import numpy as np
+from pydrake.geometry import Box, Convex, Cylinder, Sphere
+from pydrake.math import RigidTransform, RollPitchYaw
 
 from mobee_drake import cli
+from mobee_drake.resources import ModelsDirectory
 from mobee_drake.scenario import LoadScenario, RunScenario
+from mobee_drake.world.point_distance import SignedDistance
+
+# The example arm (models/three_link_arm.urdf) swings to joint1 = 90 deg: its tip ends at
+# (0, 0.9, 0), the centre of the cup; its elbow marker at (0, 0.3, 0).
+ARM_TASK = """
+robot: !ModelFileConfig {}
+objects:
+  - {name: cup, shape: !Sphere {radius: 0.05}, position: [0.0, 0.9, 0.0], role: target}
+  - {name: far, shape: !Box {size: [0.1, 0.1, 0.1]}, position: [-0.9, -0.5, 0.0], role: target}
+  - {name: wall, shape: !Box {size: [0.05, 0.05, 0.05]}, position: [-0.5, 0.5, 0.0], role: ghost}
+world_events:
+  - {time: 1.0, object: wall, role: obstacle}
+  - {time: 2.0, object: wall, position: [-0.6, 0.6, 0.0]}
+  - {time: 9.0, object: wall, role: ghost}
+attractor: !FixedAttractor {joints_deg: {joint1: 90}}
+duration: 6.0
+visualization: {trail_marker: tip}
+"""
 
 
 class TestOutcome(unittest.TestCase):
@@ -28,6 +50,32 @@ class TestOutcome(unittest.TestCase):
         blocked = RunScenario(LoadScenario("reach_around_ball", "{duration: 12}")).outcome
         self.assertGreater(blocked["attractor"]["marker_distance_to_goal_m"]["r_palm"], 0.01)
 
+    def _Arm(self, *overrides: str):
+        path = pathlib.Path(tempfile.mkdtemp()) / "arm.yaml"
+        path.write_text(ARM_TASK)
+        return RunScenario(LoadScenario(path, list(overrides))).outcome
+
+    def test_only_the_markers_the_attractor_moves_are_reported(self):
+        # joint1 moves both markers; joint3 only the tip (the elbow marker sits at joint2).
+        swing = self._Arm()["attractor"]["marker_distance_to_goal_m"]
+        self.assertEqual(set(swing), {"tip", "elbow"})
+        wrist = self._Arm("{attractor: !FixedAttractor {joints_deg: {joint1: 0, joint3: 45}}}")
+        self.assertEqual(set(wrist["attractor"]["marker_distance_to_goal_m"]), {"tip"})
+
+    def test_targets_reached_or_not_and_the_events_applied(self):
+        outcome = self._Arm()
+        cup, far = outcome["targets"]["cup"], outcome["targets"]["far"]
+        self.assertEqual((cup["reached"], cup["marker"]), (True, "tip"))
+        self.assertAlmostEqual(cup["distance_m"], -0.05, delta=1e-6)  # the tip at its centre
+        self.assertEqual((far["reached"], far["marker"]), (False, "elbow"))
+        # The elbow at (0, 0.3, 0); the box's nearest corner at (-0.85, -0.45, 0).
+        self.assertAlmostEqual(far["distance_m"], np.hypot(0.85, 0.75), delta=1e-6)
+        # The event at 9 s is after the run's end: not applied.
+        self.assertEqual(
+            outcome["world_events"],
+            ["1 s: wall becomes an obstacle", "2 s: wall moves to [-0.6, 0.6, 0.0]"],
+        )
+
     def test_the_agents_figures(self):
         summary = RunScenario(LoadScenario("explore_hypercube", "{duration: 30}"))
         (agent,) = summary.outcome["client"]["agents"].values()
@@ -38,6 +86,28 @@ class TestOutcome(unittest.TestCase):
         self.assertGreater(agent["state_actions_tried"], 0)
         # Value iteration stopped once no value changed by delta (1e-3) in a sweep.
         self.assertLess(agent["value_iteration_residual"], 1e-3)
+
+
+class TestSignedDistance(unittest.TestCase):
+    """Closed forms: a point's signed distance to each shape, posed off the origin."""
+
+    def test_each_shape(self):
+        X = RigidTransform(RollPitchYaw(0.0, 0.0, np.pi / 2), [1.0, 2.0, 3.0])
+        pillar = ModelsDirectory() / "pillar.obj"  # a hexagonal prism, 0.05 m to its corners
+        for shape, p_O, expected in [
+            (Sphere(0.5), [0.0, 0.0, 2.0], 1.5),
+            (Sphere(0.5), [0.1, 0.0, 0.0], -0.4),
+            (Box(0.2, 0.4, 0.6), [0.4, 0.0, 0.0], 0.3),  # off a face
+            (Box(0.2, 0.4, 0.6), [0.4, 0.5, 0.0], np.hypot(0.3, 0.3)),  # off an edge
+            (Box(0.2, 0.4, 0.6), [0.05, 0.0, 0.0], -0.05),  # inside, to the nearest face
+            (Cylinder(0.1, 1.0), [0.0, 0.3, 0.0], 0.2),  # off the side
+            (Cylinder(0.1, 1.0), [0.0, 0.0, 0.7], 0.2),  # off an end
+            (Cylinder(0.1, 1.0), [0.4, 0.0, 0.9], np.hypot(0.3, 0.4)),  # off the rim
+            (Convex(str(pillar)), [0.0, 0.0, 0.5], 0.3),  # above its top face
+            (Convex(str(pillar)), [0.02, 0.0, 0.0], -0.03 * np.cos(np.pi / 6)),  # to a side
+        ]:
+            with self.subTest(shape=type(shape).__name__, p_O=p_O):
+                self.assertAlmostEqual(SignedDistance(shape, X, X @ np.array(p_O)), expected)
 
 
 class TestSummaryFile(unittest.TestCase):

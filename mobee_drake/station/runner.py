@@ -19,7 +19,7 @@ from mobee_drake.station.checkpoint import (
     SaveCheckpoint,
 )
 from mobee_drake.station.data_log import CheckpointedLog, WriteTable
-from mobee_drake.station.outcome import RunOutcome
+from mobee_drake.station.outcome import RunOutcome, TargetLines
 from mobee_drake.station.recording import CompactRecording
 from mobee_drake.station.safety import CheckStart, SafetyReport
 from mobee_drake.station.world_events import MakeSimulator
@@ -69,7 +69,8 @@ class RunSummary:
         )
         for group, figures in self.outcome.items():
             lines.append(f"outcome, {group}:")
-            lines += [f"  {line}" for line in _Lines(figures)]
+            shown = {"targets": TargetLines, "world_events": list}.get(group, _Lines)(figures)
+            lines += [f"  {line}" for line in shown]
         if self.recording:
             lines.append(f"recording: {self.recording}")
         if self.data_log:
