@@ -117,6 +117,17 @@ class LocalBatteryTest(TemporaryFolder):
                                       r"result.json'")  # fmt: skip
             self.assertEqual(message.count("NotStarted: not started: [Errno 28]"), 6 - len(started))
 
+    def test_plain_progress_lines_end_at_each_runs_count(self):
+        """In a log (not a terminal), a run's last line gives its final count, not the count
+        last seen while it ran (issue 36: '0/600 it')."""
+        printed = io.StringIO()
+        with contextlib.redirect_stderr(printed):
+            RunBattery(Walks(pause=0.3), self.folder, workers=2, progress=True)
+        lines = [line for line in printed.getvalue().splitlines() if line.startswith("walk")]
+        self.assertTrue(lines, printed.getvalue())
+        for line in lines:
+            self.assertRegex(line, r"^walk\d: 8/8 it \(\d+ s\)$")
+
     def test_the_progress_record_is_written_at_most_once_a_second(self):
         """Issue 32: a ch. 7 run rewrote it about 1,000 times, 13 % of the run's time."""
         run = RunFolder(self.folder)

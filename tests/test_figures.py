@@ -8,6 +8,7 @@ import types
 import unittest
 
 from matplotlib.colors import to_rgba
+from matplotlib.text import Text
 import numpy as np
 
 from mobee_drake.experiments import (
@@ -21,7 +22,7 @@ from mobee_drake.experiments import (
 from mobee_drake.experiments.ch7_model_learning import MovingBoxResult, PlanningRun
 from mobee_drake.experiments.ch8_reaching import ReachRun
 from mobee_drake.experiments.exploration import ExplorationRun
-from mobee_drake.experiments.plots import SaveFigure
+from mobee_drake.experiments.plots import SaveFigure, plt
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.reaching.learner import LOG_COLUMNS
 
@@ -86,6 +87,23 @@ def PlottedValues(figure) -> np.ndarray:
     return np.concatenate([np.ravel(np.asarray(v, dtype=float)) for v in values])
 
 
+# A series shows when at least this share of the pixels in its colour when it is drawn alone
+# keep its colour with the other series drawn.
+VISIBLE_SHARE = 0.25
+
+
+def _Pixels(figure) -> np.ndarray:
+    figure.canvas.draw()
+    return np.asarray(figure.canvas.buffer_rgba()).copy()
+
+
+def _PixelsOfColour(figure, lines) -> int:
+    """How many pixels of ``figure`` show the colour of ``lines`` (a series shares one)."""
+    colour = 255 * np.array(to_rgba(lines[0].get_color())[:3])
+    rgb = _Pixels(figure)[..., :3].astype(float)
+    return int((np.abs(rgb - colour).max(axis=2) < 30).sum())
+
+
 class FigureTest(unittest.TestCase):
     def assertDrawsLine(self, figure, x, y, name: str):
         """Some line of ``figure`` is exactly (``x``, ``y``)."""
@@ -120,8 +138,98 @@ class FigureTest(unittest.TestCase):
             named = _LegendColours(legend)
             for patch in axis.patches:
                 self.assertIn(to_rgba(patch.get_facecolor()), named, where)
+            # Every labelled artist (a line, a tick, a bar) is named in the legend.
+            legend_texts = {t.get_text() for t in legend.get_texts()}
+            for artist in [*axis.lines, *axis.collections, *axis.patches]:
+                label = artist.get_label()
+                if label and not label.startswith("_"):
+                    self.assertIn(label, legend_texts, where)
+            self.assertSeriesVisible(axis, where)
+        self.assertTextInside(figure, name)
         with tempfile.TemporaryDirectory() as folder:
             SaveFigure(figure, pathlib.Path(folder) / f"{name}.png", dpi=20)
+
+    def assertTextInside(self, figure, name: str):
+        """Laid out as saved, everything ``figure`` draws (titles, labels, ticks, legends) lies
+        inside its canvas."""
+        figure.tight_layout()
+        figure.canvas.draw()
+        renderer = figure.canvas.get_renderer()
+        drawn = figure.get_tightbbox(renderer)  # inches; only what is drawn
+        width, height = figure.get_size_inches()
+        slack = 1.0 / figure.dpi  # a pixel
+        inside = (
+            drawn.x0 >= -slack
+            and drawn.y0 >= -slack
+            and drawn.x1 <= width + slack
+            and drawn.y1 <= height + slack
+        )
+        if not inside:
+            boxes = {t.get_text(): t.get_window_extent(renderer) for t in figure.findobj(Text)}
+            outside = [
+                text
+                for text, box in boxes.items()
+                if text.strip() and (box.x0 < -1 or box.y0 < -1 or box.x1 > figure.bbox.x1 + 1)
+            ]
+            self.fail(f"{name}: drawn over {drawn} of a {width} x {height} canvas: {outside}")
+
+    def assertSeriesVisible(self, axis, where: str):
+        """Each labelled series of lines in ``axis`` changes the drawn pixels (another series
+        does not hide it entirely), unless its label says it overlaps."""
+        figure = axis.figure
+        series = {}
+        for line in axis.lines:
+            series.setdefault(line.get_label(), []).append(line)
+        # Unlabelled lines continue the labelled series drawn before them (a run per line).
+        label = None
+        for line in axis.lines:
+            if line.get_label().startswith("_"):
+                if label is not None:
+                    series[label].append(line)
+            else:
+                label = line.get_label()
+        for label, lines in series.items():
+            if label.startswith("_") or "overlap" in label:
+                continue
+            others = [line for line in axis.lines if line not in lines and line.get_visible()]
+            shown = _PixelsOfColour(figure, lines)
+            for line in others:
+                line.set_visible(False)
+            alone = _PixelsOfColour(figure, lines)
+            for line in others:
+                line.set_visible(True)
+            self.assertGreater(shown, VISIBLE_SHARE * alone, f"{where}: {label!r} is hidden")
+
+
+class TestTheChecks(FigureTest):
+    """The figure checks catch what they name."""
+
+    def _Figure(self):
+        figure, axis = plt.subplots()
+        axis.plot([0, 1], [0, 1], label="a")
+        axis.set(xlabel="x [m]", ylabel="y [m]", title="t")
+        return figure, axis
+
+    def test_text_outside_the_canvas(self):
+        figure, axis = self._Figure()
+        axis.legend()
+        figure.text(1.05, 0.5, "beyond the right edge")
+        with self.assertRaisesRegex(AssertionError, "beyond the right edge"):
+            self.assertTextInside(figure, "outside")
+
+    def test_a_hidden_series(self):
+        figure, axis = self._Figure()
+        axis.plot([0, 1], [0, 1], label="b", linewidth=4)  # drawn over "a"
+        axis.legend()
+        with self.assertRaisesRegex(AssertionError, "'a' is hidden"):
+            self.assertSeriesVisible(axis, "hidden")
+
+    def test_an_unnamed_artist(self):
+        figure, axis = self._Figure()
+        axis.legend()
+        axis.hlines([0.5], 0, 1, label="unexplained")
+        with self.assertRaisesRegex(AssertionError, "'unexplained' not found"):
+            self.assertReadable(figure, "unnamed")
 
 
 class TestCh7Figures(FigureTest):
@@ -154,6 +262,10 @@ class TestCh7Figures(FigureTest):
             coverage = np.array(run.coverage)
             self.assertDrawsLine(figure, coverage[:, 0], coverage[:, 1], f"7.2 {run}")
         self.assertReadable(figure, "7.2")
+        # Strategies that cover alike: each still shows.
+        for run in runs:
+            run.coverage = [[0, 0], [50, 40], [100, 70]]
+        self.assertReadable(ch7_figures.CoverageFigure(runs), "7.2, coinciding")
 
     def test_rank_4(self):
         space = Lattice([0.2, 0.8], 4)
@@ -252,8 +364,11 @@ class TestCh8Figures(FigureTest):
         by_strategy = {"greedy": [self.Run("greedy", seed) for seed in range(3)]}
         figure = ch8_figures.CumulativeRewardFigure(by_strategy, self.STAGES)
         legend = figure.axes[0].get_legend()
-        self.assertEqual([t.get_text() for t in legend.get_texts()], ["seed 0", "seed 1", "seed 2"])
-        self.assertEqual(len(_LegendColours(legend)), 3)
+        self.assertEqual(
+            [t.get_text() for t in legend.get_texts()],
+            ["sum with the -10 penalties", "seed 0", "seed 1", "seed 2"],
+        )
+        self.assertEqual(len(_LegendColours(legend)), 4)  # three seeds and the black tick
         SaveFigure(figure, pathlib.Path(tempfile.mkdtemp()) / "8.2.png", dpi=20)
 
 
@@ -292,6 +407,15 @@ class TestOtherFigures(FigureTest):
         np.testing.assert_array_equal(np.sort(np.ravel(drawn)), np.sort(counts.ravel()))
         self.assertEqual(np.sum(drawn), 40)
         self.assertReadable(figure, "saggriac goals")
+        # A run too short to set a goal (subgoals only): one panel that says so, not empty
+        # histograms titled "goals 1-0".
+        goals[:, 4] = 0
+        run.goal_log = goals.tolist()
+        run.region_snapshots = [dict(s, first_goal=0, end_goal=0) for s in run.region_snapshots]
+        figure = saggriac_figures.GoalsFigure(run)
+        (axis,) = figure.axes
+        self.assertEqual(axis.get_title(), "no goals (subgoals only)")
+        self.assertReadable(figure, "saggriac goals, none")
 
     def test_roadmap_and_scalability(self):
         points = RNG.uniform(-0.3, 0.0, (6, 3))

@@ -448,12 +448,14 @@ class _Display:
         if not self.enabled:
             return
         running = {job.name: job for job in running}
-        for name in self.runs.keys() - running.keys():
-            self.runs.pop(name).close()
+        for name in self.runs.keys() - running.keys():  # Finished: its bar ends at its count.
+            bar = self.runs.pop(name)
+            done = bar.total if _StoredResult(self.output, name) is not None else self._Done(name)
+            bar.update((done or bar.n) - bar.n)
+            bar.close()
         for name, job in running.items():
-            try:
-                done = json.loads((self.output / "runs" / name / PROGRESS).read_text())["done"]
-            except (OSError, ValueError):  # Not started.
+            done = self._Done(name)
+            if done is None:  # Not started.
                 continue
             if name not in self.runs:
                 self.runs[name] = ProgressBar(
@@ -464,6 +466,13 @@ class _Display:
                     dynamic_ncols=True,
                 )
             self.runs[name].update(done - self.runs[name].n)
+
+    def _Done(self, name: str) -> int | None:
+        """A job's progress record, or None before it has one."""
+        try:
+            return json.loads((self.output / "runs" / name / PROGRESS).read_text())["done"]
+        except (OSError, ValueError):
+            return None
 
     def Close(self) -> None:
         for bar in self.runs.values():

@@ -40,8 +40,11 @@ def HypercubeFigure(results: list[ExplorationRun]) -> Figure:
 def CoverageFigure(results: list[ExplorationRun]) -> Figure:
     """Fig. 7.5: state-actions tried against transitions, one line per run."""
     figure, axis = plt.subplots(figsize=(8, 4))
-    for strategy, colour in zip(
-        ("curious", "random", "least_tried"), ("tab:green", "tab:red", "tab:blue")
+    # Solid under dashed under dotted: strategies whose lines coincide all stay visible.
+    for strategy, colour, style, width in (
+        ("curious", "tab:green", "-", 3.0),
+        ("random", "tab:red", "--", 1.5),
+        ("least_tried", "tab:blue", ":", 1.5),
     ):
         for r in [r for r in results if r.labels["strategy"] == strategy]:
             coverage = np.array(r.coverage)
@@ -49,6 +52,8 @@ def CoverageFigure(results: list[ExplorationRun]) -> Figure:
                 coverage[:, 0],
                 coverage[:, 1],
                 color=colour,
+                linestyle=style,
+                linewidth=width,
                 label=strategy if r.labels["run"] == 0 else None,
             )
     axis.axhline(COVERAGE_STATE_ACTIONS, color="0.5", linestyle=":", label="all state-actions")

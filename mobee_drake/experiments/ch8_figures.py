@@ -6,7 +6,7 @@ import math
 import numpy as np
 
 from mobee_drake.experiments.ch8_reaching import ReachRun
-from mobee_drake.experiments.plots import Figure, StackedBars, plt
+from mobee_drake.experiments.plots import Figure, Legend, StackedBars, plt
 from mobee_drake.reaching.learner import (
     LOG_COLUMNS,
 )
@@ -70,8 +70,9 @@ def CumulativeRewardFigure(by_strategy: dict[str, list[ReachRun]], stages: list[
             np.arange(len(stages)) - 0.35,
             np.arange(len(stages)) + 0.35,
             colors="black",
-            label="with the -10 penalties",
+            label="sum with the -10 penalties",
         )
+        Legend(axis)  # (again: the seeds' colours and the penalties' tick)
         axis.set_xticks(np.arange(len(stages)), [str(s) for s in stages])
         axis.set(
             xlabel="exploratory problem-tries [count]",

@@ -6,7 +6,10 @@ import math
 import numpy as np
 
 from mobee_drake.experiments.plots import Figure, plt
-from mobee_drake.experiments.saggriac import MEASURE_TITLES, NUM_HISTOGRAM_WINDOWS, BabblingRun
+from mobee_drake.experiments.saggriac import MEASURE_TITLES, BabblingRun
+
+# Each group's line style, the first widest: groups whose curves coincide all stay visible.
+_LINE_STYLES = (("-", 3.0), ("--", 1.8), (":", 1.8), ("-.", 1.8))
 
 
 def CurvesFigure(
@@ -37,7 +40,14 @@ def CurvesFigure(
         for axis, measure in zip(axes.flat, measures, strict=False):
             values = np.array([[point[measure] for point in run.curve] for run in group_runs])
             mean, spread = values.mean(axis=0), values.std(axis=0)
-            (line,) = axis.plot(steps, mean, label=f"{group} ({len(group_runs)} seeds)")
+            style, width = _LINE_STYLES[offset % len(_LINE_STYLES)]
+            (line,) = axis.plot(
+                steps,
+                mean,
+                linestyle=style,
+                linewidth=width,
+                label=f"{group} ({len(group_runs)} seeds)",
+            )
             # Error bars shifted per group for readability, as in the paper's figures.
             shift = (offset - (len(groups) - 1) / 2) * 0.01 * steps[-1]
             axis.errorbar(
@@ -179,24 +189,27 @@ def GoalsFigure(run: BabblingRun) -> Figure:
     low, high = config["goal_space_low"], config["goal_space_high"]
     length = config["arm"]["total_length"]
     goals = run.Goals()
-    figure, axes = plt.subplots(
-        1, NUM_HISTOGRAM_WINDOWS + 1, figsize=(4.2 * (NUM_HISTOGRAM_WINDOWS + 1), 5.5)
-    )
     panels = [
         (snapshot["first_goal"], snapshot["end_goal"], snapshot["regions"])
         for snapshot in run.region_snapshots
     ]
     panels.append((0, len(goals), run.region_snapshots[-1]["regions"]))
+    if len(goals) == 0:  # (a short run may set subgoals only: one panel says so)
+        panels = panels[-1:]
+    figure, axes = plt.subplots(
+        1, len(panels), figsize=(max(4.2 * len(panels), 7.0), 5.5), squeeze=False
+    )
     angles = np.linspace(-np.pi / 2, np.pi / 2, 100)
-    for axis, (begin, end, regions) in zip(axes, panels, strict=True):
-        *_, shown = axis.hist2d(
-            goals[begin:end, 1],
-            goals[begin:end, 2],
-            bins=30,
-            range=[[low[0], high[0]], [low[1], high[1]]],
-            cmap="viridis",
-        )
-        figure.colorbar(shown, ax=axis, label="goals per bin [count]", shrink=0.8)
+    for axis, (begin, end, regions) in zip(axes[0], panels, strict=True):
+        if end > begin:
+            *_, shown = axis.hist2d(
+                goals[begin:end, 1],
+                goals[begin:end, 2],
+                bins=30,
+                range=[[low[0], high[0]], [low[1], high[1]]],
+                cmap="viridis",
+            )
+            figure.colorbar(shown, ax=axis, label="goals per bin [count]", shrink=0.8)
         for i, (x0, y0, x1, y1) in enumerate(regions):
             axis.plot(
                 [x0, x1, x1, x0, x0],
@@ -215,15 +228,16 @@ def GoalsFigure(run: BabblingRun) -> Figure:
         axis.set(
             xlabel="goal x [units]",
             ylabel="goal y [units]",
-            title=f"goals {begin + 1}-{end}",
+            title=f"goals {begin + 1}-{end}" if end > begin else "no goals (subgoals only)",
             xlim=(low[0], high[0]),
             ylim=(low[1], high[1]),
             aspect="equal",
         )
-    axes[-1].legend(loc="lower right", fontsize=7, facecolor="0.85")
+        if end <= begin or axis is axes[0][-1]:
+            axis.legend(loc="lower right", fontsize=7, facecolor="0.85")
     spec = run.spec
     figure.suptitle(
-        f"SAGG-RIAC's goals (30 x 30 bins) and regions, experiment {spec.experiment}, "
+        f"SAGG-RIAC's goals (30 x 30 bins) and regions, experiment {spec.experiment},\n"
         f"seed {spec.seed}, {spec.budget} time steps (cf. the paper's Fig. 3)"
     )
     return figure
