@@ -37,6 +37,7 @@ from mobee_drake.world.live_world import MakeShape
 from mobee_drake.world.objects import Box, Cylinder, Mesh, SceneObject
 from mobee_drake.yaml_io import (
     CheckYamlStructure,
+    DidYouMean,
     InvalidYaml,
     LoadYamlFile,
     LoadYamlOverride,
@@ -193,7 +194,7 @@ def LoadScenario(
         except yaml.YAMLError as e:
             raise YamlFileError(InvalidYaml(source, e)) from None
         except (RuntimeError, ValueError, TypeError) as e:
-            raise YamlFileError(f"{source}: {e}") from e
+            raise YamlFileError(f"{source}: {DidYouMean(Scenario, str(e))}") from e
         ValidateScenario(scenario, source)
     return scenario
 

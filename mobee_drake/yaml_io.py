@@ -14,6 +14,7 @@ aliases expand to billions of nodes, which Drake's reader would walk for hours).
 """
 
 import dataclasses as dc
+import difflib
 import pathlib
 import re
 import typing
@@ -138,6 +139,36 @@ def LineOf(text: str, names: list[str]) -> int | None:
     return None
 
 
+def _FieldNames(schema) -> set[str]:
+    """Every field name of ``schema`` and of the dataclasses its fields may hold (unions, lists
+    and dicts looked into)."""
+    names, seen, stack = set(), set(), [schema]
+    while stack:
+        kind = stack.pop()
+        if dc.is_dataclass(kind) and kind not in seen:
+            seen.add(kind)
+            names.update(f.name for f in dc.fields(kind))
+            stack.extend(typing.get_type_hints(kind).values())
+        else:
+            stack.extend(typing.get_args(kind))
+    return names
+
+
+def DidYouMean(schema, message: str) -> str:
+    """Drake's message of fields unknown to ``schema`` with, for each, the closest known field
+    name, if one is close (a typo)."""
+    unknown = re.search(r"The fields \[(.*?)\] were unknown", message)
+    if unknown is None:
+        return message
+    known = _FieldNames(schema)
+    close = {
+        name: match[0]
+        for name in re.findall(r"'([^']+)'", unknown.group(1))
+        if (match := difflib.get_close_matches(name, known, n=1, cutoff=0.75))
+    }
+    return message + "".join(f"; '{a}': did you mean '{b}'?" for a, b in close.items())
+
+
 def LoadYamlFile(*, schema, filename, child_name: str | None = None, defaults=None):
     """Loads ``filename`` (optionally its top-level ``child_name``) into an instance of ``schema``.
 
@@ -179,7 +210,7 @@ def LoadYamlFile(*, schema, filename, child_name: str | None = None, defaults=No
         # Drake's messages quote the offending names: ['shap'], 'x'.
         line = LineOf(text, re.findall(r"'([^']+)'", str(e)))
         where = f"{path}:{line}" if line else f"{path}"
-        raise YamlFileError(f"{where}: {e}") from e
+        raise YamlFileError(f"{where}: {DidYouMean(schema, str(e))}") from e
 
 
 class _TaggedLoader(_SafeLoader):

@@ -336,6 +336,28 @@ class TestScenarios(unittest.TestCase):
         self.assertEqual((code, err.count("\n")), (2, 1))
         self.assertIn("did you mean 'reach_around_ball'", err)
 
+    def test_a_mistyped_key_gets_the_closest_key(self):
+        """In a file (with its line) and in an override, at the top and nested; a name close
+        to nothing gets no guess."""
+        folder = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, folder)
+        (folder / "typo.yaml").write_text(
+            "objects:\n  - name: b\n    shap: !Sphere {radius: 0.1}\n"
+        )
+        for args, message in [
+            ([str(folder / "typo.yaml")], "typo.yaml:3: The fields ['shap'] were unknown to the "
+             "schema; 'shap': did you mean 'shape'?"),
+            (["reach_around_ball", "--set", "{duraton: 5}"], "'duraton': did you mean 'duration'?"),
+            (["reach_around_ball", "--set", "{visualization: {trail_markr: x}}"],
+             "did you mean 'trail_marker'?"),
+        ]:  # fmt: skip
+            with self.subTest(args):
+                code, _, err = _Call("run", *args, "--no-record")
+                self.assertEqual((code, err.count("\n")), (2, 1))
+                self.assertIn(message, err)
+        code, _, err = _Call("run", "reach_around_ball", "--set", "{zzzz: 1}", "--no-record")
+        self.assertNotIn("did you mean", err)
+
 
 class TestScenarioReference(unittest.TestCase):
     def test_the_reference_is_the_config_and_up_to_date(self):
