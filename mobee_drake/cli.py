@@ -284,6 +284,10 @@ _EXPERIMENTS = {
         "ch8_discounting",
         "when ch. 8's greedy reach planner moves, in closed form",
     ),
+    "parallel-behaviours": (
+        "parallel_behaviours",
+        "gaze and palm normal beside the curious planner (ch. 9.4.2)",
+    ),
     "saggriac": ("saggriac_command", "SAGG-RIAC goal babbling on the 15-joint arm"),
     "roadmaps": ("ch4_roadmaps", "adaptive roadmap planning on MoBeE 1.0 (ch. 4.3)"),
     "trm": ("trm_roadmaps", "the task-relevant roadmaps of ch. 3.4"),

@@ -24,13 +24,16 @@ from pydrake.systems.primitives import ConstantVectorSource
 import yaml
 
 from mobee_drake import __version__
+from mobee_drake.behaviours.pointing import PointAt
 from mobee_drake.planning.supervisor import ExploreAttractor
 from mobee_drake.resources import ResolveScenarioFile, UnknownScenario
 from mobee_drake.robots.model_file import ModelFileConfig
 from mobee_drake.station.attractors import FixedAttractor, RandomAttractors, SliderAttractor
 from mobee_drake.station.builder import MakeMobeeStation, Station
+from mobee_drake.station.composition import Behaviour, ComposeBehaviours
 from mobee_drake.station.config import DataLog, StationConfig, StationConfigErrors, Visualization
 from mobee_drake.station.executor import StateActionAttractor
+from mobee_drake.station.parts import ClientPorts, StationParts
 from mobee_drake.station.runner import RunStation, RunSummary
 from mobee_drake.station.viewer import RecordingMeshcat
 from mobee_drake.world.live_world import MakeShape
@@ -49,9 +52,58 @@ from mobee_drake.yaml_io import (
 # experiment of the sources, and short enough that a typo like 1e308 is caught, not simulated).
 MAX_DURATION = 1e7
 # The clients a scenario file can name, by their YAML tags.
-Client = (
-    FixedAttractor | RandomAttractors | SliderAttractor | ExploreAttractor | StateActionAttractor
+# A client that runs among several, on joints of its own.
+BehaviourClient = (
+    FixedAttractor
+    | RandomAttractors
+    | SliderAttractor
+    | ExploreAttractor
+    | StateActionAttractor
+    | PointAt
 )
+
+
+@dc.dataclass
+class BehaviourConfig:
+    """A client on joints (and markers) of its own, beside others (ch. 9.4.2)."""
+
+    name: str = ""
+    # MoBeE's joints it moves; no other behaviour may claim them.
+    joints: list[str] = dc.field(default_factory=list)
+    # The markers it pushes, if any; no other behaviour may push them.
+    markers: list[str] = dc.field(default_factory=list)
+    client: BehaviourClient = dc.field(default_factory=FixedAttractor)
+
+
+@dc.dataclass
+class Behaviours:
+    """Several clients on one robot at once (``mobee_drake.station.composition``): e.g. gaze on
+    the neck and a reach planner on the arm. Joints no behaviour owns stay at home."""
+
+    behaviours: list[BehaviourConfig] = dc.field(default_factory=list)
+
+    def Validate(self) -> None:
+        if not self.behaviours:
+            raise ValueError("Behaviours: list at least one behaviour")
+        for b in self.behaviours:
+            if not b.name or not b.joints:
+                raise ValueError(f"Behaviours: each needs a name and joints, got {b.name!r}")
+            try:
+                b.client.Validate()
+            except ValueError as e:
+                raise ValueError(f"behaviour '{b.name}': {e}") from None
+
+    def AddToBuilder(self, parts: StationParts) -> ClientPorts:
+        return ComposeBehaviours(
+            parts,
+            [
+                Behaviour(b.name, tuple(b.joints), b.client.AddToBuilder, tuple(b.markers))
+                for b in self.behaviours
+            ],
+        )
+
+
+Client = BehaviourClient | Behaviours
 
 
 @dc.dataclass

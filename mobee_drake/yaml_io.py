@@ -156,17 +156,19 @@ def _FieldNames(schema) -> set[str]:
 
 def DidYouMean(schema, message: str) -> str:
     """Drake's message of fields unknown to ``schema`` with, for each, the closest known field
-    name, if one is close (a typo)."""
+    name, if one is close (a typo), or a word that the field belongs to another type (a union
+    read without its tag)."""
     unknown = re.search(r"The fields \[(.*?)\] were unknown", message)
     if unknown is None:
         return message
     known = _FieldNames(schema)
-    close = {
-        name: match[0]
-        for name in re.findall(r"'([^']+)'", unknown.group(1))
-        if (match := difflib.get_close_matches(name, known, n=1, cutoff=0.75))
-    }
-    return message + "".join(f"; '{a}': did you mean '{b}'?" for a, b in close.items())
+    hints = []
+    for name in re.findall(r"'([^']+)'", unknown.group(1)):
+        if name in known:  # a field of another type than the one read here
+            hints.append(f"; '{name}' belongs to another type: is its !Tag missing?")
+        elif match := difflib.get_close_matches(name, known, n=1, cutoff=0.75):
+            hints.append(f"; '{name}': did you mean '{match[0]}'?")
+    return message + "".join(hints)
 
 
 def LoadYamlFile(*, schema, filename, child_name: str | None = None, defaults=None):

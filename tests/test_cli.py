@@ -350,6 +350,8 @@ class TestScenarios(unittest.TestCase):
             (["reach_around_ball", "--set", "{duraton: 5}"], "'duraton': did you mean 'duration'?"),
             (["reach_around_ball", "--set", "{visualization: {trail_markr: x}}"],
              "did you mean 'trail_marker'?"),
+            (["reach_around_ball", "--set", "{attractor: {behaviours: []}}"],
+             "'behaviours' belongs to another type: is its !Tag missing?"),
         ]:  # fmt: skip
             with self.subTest(args):
                 code, _, err = _Call("run", *args, "--no-record")

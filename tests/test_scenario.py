@@ -12,7 +12,7 @@ from pydrake.geometry import Meshcat
 from pydrake.systems.primitives import ConstantVectorSource
 
 from mobee_drake.resources import ScenarioNames
-from mobee_drake.scenario import BuildScenario, LoadScenario, Scenario
+from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario, Scenario
 from mobee_drake.station.builder import MakeMobeeStation
 from mobee_drake.station.config import Dynamic
 from mobee_drake.station.outcome import AttractorOutcome
@@ -141,6 +141,26 @@ class TestShippedScenarios(unittest.TestCase):
         report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
         self.assertGreater(report.closest_approach["ball"], 0.0)
         self.assertEqual(report.penetrating_steps, 0)
+
+    def test_parallel_behaviours(self):
+        """All three behaviours act at once, without a penetration: the agent explores, the
+        head ends looking at the ball, and the palm faces it better than with its wrist held
+        at home (the same run with the palm behaviour only measuring)."""
+        on = RunScenario(LoadScenario("parallel_behaviours", "{duration: 20}"))
+        scenario = LoadScenario("parallel_behaviours", "{duration: 20}")
+        palm = scenario.attractor.behaviours[1]
+        palm.client = dc.replace(palm.client, gain=0.0)
+        off = RunScenario(scenario)
+        figures = on.outcome["client"]
+        self.assertEqual(on.safety.penetrating_steps, 0)
+        self.assertLess(figures["gaze_pointing"]["final_error_deg"], 5.0)
+        self.assertGreaterEqual(
+            figures["reach_exploration_supervisor"]["agents"]["right_arm"]["actions"], 2
+        )
+        palm = "palm_pointing"
+        self.assertLess(
+            figures[palm]["mean_error_deg"], off.outcome["client"][palm]["mean_error_deg"] - 10.0
+        )
 
     def test_icub_and_katana(self):
         """Both robots move: the iCub's arms and its companion Katana."""

@@ -368,6 +368,10 @@ class Mobee(LeafSystem):
         """The index of marker ``name`` in the marker ports (its force is ``3i:3i+3``)."""
         return self._robot.MarkerIndex(name)
 
+    def marker_body(self, name: str):
+        """The plant body that carries marker ``name``."""
+        return self._marker_bodies[self.marker_index(name)]
+
     def joint_index(self, name: str) -> int:
         """The index of joint ``name`` in the n-vectors of this system."""
         return self._robot.JointIndex(name)

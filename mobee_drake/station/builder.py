@@ -283,6 +283,7 @@ def _AddCompanions(
             robot_state=mover.GetOutputPort("state"),
             meshcat=None,
             random_seed=config.random_seed + 1 + i,  # its own draws
+            period=config.time_step,
             prefix=prefix,
         )
         ports = companion.attractor.AddToBuilder(parts)
@@ -449,7 +450,7 @@ def _AddRecords(builder, config, mobee, robot_state, attractor, client, companio
             event_counts=event_ledger.GetOutputPort("counts"),
             scripted_events=scripted_events,
             request_ports=request_ports,
-            client=client.data_log if client is not None else None,
+            clients=Declared(client, "data_log") if client is not None else [],
         )
     return request_ports, event_ledger, scripted_events, data_log
 
@@ -490,6 +491,7 @@ def MakeMobeeStation(
         robot_state=robot_state,
         meshcat=meshcat,
         random_seed=config.random_seed,
+        period=config.time_step,
     )
     client = prebuild_callback(parts) if prebuild_callback else None
     attractor, marker_forces = _ConnectClient(

@@ -250,17 +250,18 @@ def AddDataLog(
     event_counts: OutputPort,
     scripted_events: list[WorldEvent],
     request_ports: list[OutputPort],
-    client: LogsData | None,
+    clients: list[LogsData],
 ) -> DataLogger:
-    """Adds the log's sink and what it reads to ``builder`` (see the module)."""
+    """Adds the log's sink and what it reads to ``builder`` (see the module); the ``clients``
+    systems' columns come last, in order."""
     summary = builder.AddNamedSystem("field_pairs_summary", FieldPairsSummary())
     builder.Connect(mobee.GetOutputPort("field_pairs"), summary.get_input_port())
     client_columns = []
     signals = [robot_state, attractor]
     signals.append(mobee.GetOutputPort("forces"))
     signals += [mobee.GetOutputPort("marker_positions"), summary.get_output_port(), event_counts]
-    if client is not None:
-        client_columns = list(client.DataLogColumns())
+    for client in clients:
+        client_columns += list(client.DataLogColumns())
         signals.append(client.GetOutputPort(DATA_LOG_PORT))
     mux = builder.AddNamedSystem("data_log_signals", Multiplexer([p.size() for p in signals]))
     for i, port in enumerate(signals):

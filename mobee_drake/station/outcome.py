@@ -16,6 +16,7 @@
 import numpy as np
 
 from mobee_drake.station.builder import Station
+from mobee_drake.station.parts import Declared
 from mobee_drake.world.point_distance import SignedDistance
 
 # A marker the attractor moves less than this (m) from its home position is not part of the task.
@@ -117,7 +118,10 @@ def RunOutcome(station: Station, context) -> dict:
     events = WorldEventsOutcome(station, context)
     if events:
         outcome["world_events"] = events
-    client = station.client_ports.outcome if station.client_ports is not None else None
-    if client is not None:
-        outcome["client"] = client.Outcome(client.GetMyContextFromRoot(context))
+    clients = Declared(station.client_ports, "outcome") if station.client_ports else []
+    figures = {c.get_name(): c.Outcome(c.GetMyContextFromRoot(context)) for c in clients}
+    if len(figures) == 1:
+        (outcome["client"],) = figures.values()
+    elif figures:  # behaviours composed: each under its system's name
+        outcome["client"] = figures
     return outcome

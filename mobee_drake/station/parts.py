@@ -13,10 +13,11 @@ the station's diagram, for a script to fix.
 The hooks, each a Protocol here (the station reads them through ``Station.Hooks``, never by
 searching the diagram; a system that implements one undeclared is named in a warning):
 
-- ``outcome`` (:class:`ReportsOutcome`): what the client achieved, in the run's summary;
+- ``outcome`` (:class:`ReportsOutcome`): what the client achieved, in the run's summary (several
+  systems: each under its name);
 - ``action_counters`` (:class:`CountsActions`): actions completed, after each of which a run
   with a checkpoint saves one;
-- ``data_log`` (:class:`LogsData`): columns of the run's data log;
+- ``data_log`` (:class:`LogsData`): columns of the run's data log (one system or several);
 - ``checkpointed`` (:class:`Checkpointed`): state that is more than numbers, in files of its own;
 - ``world_events``: abstract output ports of ``list[WorldEvent]``, requests to edit the world
   (see :mod:`mobee_drake.station.world_events`).
@@ -36,7 +37,13 @@ from typing import Protocol
 
 from pydrake.geometry import Meshcat, SceneGraph
 from pydrake.multibody.plant import MultibodyPlant
-from pydrake.systems.framework import DiagramBuilder, LeafSystem, OutputPort, PortDataType
+from pydrake.systems.framework import (
+    DiagramBuilder,
+    InputPort,
+    LeafSystem,
+    OutputPort,
+    PortDataType,
+)
 
 from mobee_drake.mobee.system import Mobee
 from mobee_drake.world.live_world import LiveWorld
@@ -59,8 +66,17 @@ class StationParts:
     meshcat: Meshcat | None
     # The run's seed: a client draws its random numbers from generators seeded with it.
     random_seed: int
+    # MoBeE's control period (s), the period of a client that acts as often.
+    period: float = 0.01
     # Prefix of the client's system names (a companion robot's name and "_"; "" for the robot).
     prefix: str = ""
+    # The joints the client owns (among composed behaviours, see station/composition.py;
+    # empty: every joint of MoBeE's).
+    joints: tuple[str, ...] = ()
+
+    def OwnedJoints(self) -> list[str]:
+        """The joints the client owns."""
+        return list(self.joints) or list(self.mobee.joints)
 
 
 class ReportsOutcome(Protocol):
@@ -100,11 +116,16 @@ class ClientPorts:
     attractor: OutputPort
     marker_forces: OutputPort | None = None
     config_force: OutputPort | None = None
-    outcome: ReportsOutcome | None = None
+    # One system, or several (behaviours composed: see mobee_drake.station.composition).
+    outcome: ReportsOutcome | list[ReportsOutcome] | None = None
     action_counters: list[CountsActions] = dc.field(default_factory=list)
-    data_log: LogsData | None = None
+    data_log: LogsData | list[LogsData] | None = None
     checkpointed: list[Checkpointed] = dc.field(default_factory=list)
     world_events: list[OutputPort] = dc.field(default_factory=list)
+    # Among composed behaviours: the outputs it offers the others and the inputs it needs from
+    # them, by name (a client that runs alone needs nothing).
+    offers: dict[str, OutputPort] = dc.field(default_factory=dict)
+    needs: dict[str, InputPort] = dc.field(default_factory=dict)
 
 
 class ClientContractError(TypeError):
@@ -173,8 +194,14 @@ def CheckClientPorts(ports: ClientPorts) -> None:
     for hook, protocol in HOOKS.items():
         for system in Declared(ports, hook):
             _CheckImplements(system, protocol, hook)
-    if ports.data_log is not None:
-        _CheckDataLogPort(ports.data_log)
+    for system in Declared(ports, "data_log"):
+        _CheckDataLogPort(system)
+    if ports.needs:
+        raise ClientContractError(
+            f"client system '{_Name(ports.system)}' needs ports ("
+            + ", ".join(ports.needs)
+            + ") that only other behaviours offer: run it among them (station/composition.py)"
+        )
     for port in Declared(ports, "world_events"):
         if not isinstance(port, OutputPort):
             raise ClientContractError(f"world_events must list output ports, got {port!r}")
