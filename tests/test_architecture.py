@@ -3,6 +3,7 @@ backend, and a release that ships what a run needs."""
 
 import ast
 import pathlib
+import re
 import tempfile
 import unittest
 import zipfile
@@ -115,6 +116,14 @@ class TestReadme(unittest.TestCase):
         """In an empty folder, with the wheel installed (as every README example below)."""
         printed = RunPython(self._Example("class BendElbow"), pathlib.Path(tempfile.mkdtemp()))
         self.assertIn("[", printed)  # the robot's state
+
+    def test_the_behaviour_example_runs(self):
+        """The head shakes (neck_yaw follows 30 deg sin(t), behind it as a spring does) while
+        the palm behaviour turns the wrist."""
+        printed = RunPython(self._Example("class ShakeHead"), pathlib.Path(tempfile.mkdtemp()))
+        yaw = float(re.search(r"neck_yaw (-?[0-9.]+) deg", printed).group(1))
+        self.assertGreater(abs(yaw), 1.0)
+        self.assertLess(abs(yaw), 30.0)
 
     def test_the_data_log_example_plots_the_main_job(self):
         folder = pathlib.Path(tempfile.mkdtemp())

@@ -121,12 +121,15 @@ class LocalBatteryTest(TemporaryFolder):
         """In a log (not a terminal), a run's last line gives its final count, not the count
         last seen while it ran (issue 36: '0/600 it')."""
         printed = io.StringIO()
+        uncounted = Job("uncounted", Walk, dict(steps=8, seed=9, pause=0.3))  # no total
         with contextlib.redirect_stderr(printed):
-            RunBattery(Walks(pause=0.3), self.folder, workers=2, progress=True)
+            RunBattery(Walks(pause=0.3) + [uncounted], self.folder, workers=2, progress=True)
         lines = [line for line in printed.getvalue().splitlines() if line.startswith("walk")]
         self.assertTrue(lines, printed.getvalue())
         for line in lines:
             self.assertRegex(line, r"^walk\d: 8/8 it \(\d+ s\)$")
+        # A job that does not count its units has no line of its own ("0 it" said nothing).
+        self.assertNotIn("uncounted", printed.getvalue())
 
     def test_the_progress_record_is_written_at_most_once_a_second(self):
         """Issue 32: a ch. 7 run rewrote it about 1,000 times, 13 % of the run's time."""

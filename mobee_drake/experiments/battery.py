@@ -430,7 +430,8 @@ def TerminationInterrupts():
 
 
 class _Display:
-    """The battery's bar and a bar per running job that has a progress record."""
+    """The battery's bar and a bar per running job that counts its units (a total) and has a
+    progress record."""
 
     def __init__(self, output: pathlib.Path, jobs: int, done: int, description: str, enabled: bool):
         self.output, self.enabled, self.runs = output, enabled, {}
@@ -455,7 +456,7 @@ class _Display:
             bar.close()
         for name, job in running.items():
             done = self._Done(name)
-            if done is None:  # Not started.
+            if done is None or not job.total:  # Not started, or its units unknown: no bar.
                 continue
             if name not in self.runs:
                 self.runs[name] = ProgressBar(
