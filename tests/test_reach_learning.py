@@ -7,11 +7,16 @@ import unittest
 from unittest import mock
 
 import numpy as np
+from pydrake.common.eigen_geometry import AngleAxis
 from pydrake.common.value import AbstractValue
+from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.systems.analysis import Simulator
 
 from mobee_drake.mobee.fields import FieldPairs
 from mobee_drake.planning.supervisor import ActionTiming
+from mobee_drake.reaching.robot import SimulatedRobot
+from mobee_drake.robots.icub import TORSO_JOINTS, IcubConfig
+from mobee_drake.scenario import BuildScenario
 from mobee_drake.station.executor import Phase, ReachForcing, StateActionExecutor
 
 
@@ -205,6 +210,31 @@ class TestBattery(unittest.TestCase):
         robot.SetProblem(palm)  # where the palm was at the goal: in the way
         robot.Transition(goal)
         self.assertTrue(robot.FeltObject())
+
+    def test_the_learning_frame_follows_the_shoulder(self):
+        """With the torso at home a target is where it is; with the torso turned by theta about
+        its yaw axis, the learner sees it turned back by theta about that axis (closed form),
+        which puts it where it is relative to the shoulder."""
+        from mobee_drake.experiments.ch8_reaching import RIGHT_ARM, ReachScenario
+
+        scenario = ReachScenario()
+        scenario.robot = IcubConfig(controlled_joints=list(TORSO_JOINTS) + RIGHT_ARM)
+        robot = SimulatedRobot(BuildScenario(scenario), RIGHT_ARM, self.model.space, 0.05)
+        target = np.array([-0.3, 0.2, 0.1])
+        np.testing.assert_allclose(robot.LearningFrame(target), target, atol=1e-12)
+        mobee, plant = robot.station.mobee, robot.station.plant
+        q = mobee.home
+        q[mobee.joint_index("torso_yaw")] = np.radians(20.0)
+        robot.MoveTo(q)
+        turned = robot.station.robot_state.Eval(robot.context)[mobee.joint_index("torso_yaw")]
+        self.assertGreater(np.degrees(turned), 10.0)  # (settled near 20 deg)
+        joint = plant.GetJointByName("torso_yaw")
+        context = plant.CreateDefaultContext()
+        X_WJ = joint.frame_on_parent().CalcPoseInWorld(context)  # the axis doesn't move
+        axis = X_WJ.rotation() @ joint.revolute_axis()
+        back = RigidTransform(RotationMatrix(AngleAxis(-turned, axis)))
+        expected = X_WJ.translation() + back @ (target - X_WJ.translation())
+        np.testing.assert_allclose(robot.LearningFrame(target), expected, atol=1e-9)
 
     def test_a_noisy_robot_sometimes_settles_in_another_state(self):
         """Issue 33: with actuation noise (sd 0.2 of each joint's range: a joint leaves its state

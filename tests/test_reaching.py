@@ -111,6 +111,9 @@ class FakeRobot:
     def MarkerPosition(self):
         return self.palms[self.state]
 
+    def LearningFrame(self, target):
+        return target
+
 
 def _Learner(
     strategy="greedy",

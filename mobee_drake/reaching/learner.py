@@ -161,6 +161,11 @@ class Robot(Protocol):
     def MarkerPosition(self) -> np.ndarray:
         """Where the reaching marker is now (asked by the goal_babbling strategy)."""
 
+    def LearningFrame(self, target: np.ndarray) -> np.ndarray:
+        """``target`` (world) in the frame the learner learns in, now: the shoulder's, placed as
+        it was with the torso at home (ch. 9.4.2: the learning happens in the shoulder's frame,
+        so a torso that moves does not disturb it). While the torso stays home, ``target``."""
+
 
 @dc.dataclass
 class TryResult:
@@ -178,7 +183,8 @@ class TryResult:
 
 
 # Columns of the action log: problem-try, problem (goal_babbling: the problem nearest the goal),
-# state-action, state before, state after, estimate, reward, target (or goal) x, y, z.
+# state-action, state before, state after, estimate, reward, target (or goal) x, y, z in the
+# learning frame (Robot.LearningFrame: the world's, while the torso stays home).
 LOG_COLUMNS = (
     "try",
     "problem",
@@ -322,10 +328,11 @@ class ReachLearner:
         drawn = REACH_STRATEGIES[strategy].StartTry(self.space.num_states, rng)
         failed = 0
         for action in range(1, self.config.max_actions + 1):
-            q, v = self.Values(self.Rewards(target, strategy, histories, drawn))
+            seen = robot.LearningFrame(target)  # (the shoulder may have moved)
+            q, v = self.Values(self.Rewards(seen, strategy, histories, drawn))
             state = robot.State()
             sa = self._Greedy(q, state, rng)
-            estimate = histories.Predict(sa, target)  # eq. 8.1 or 8.5, before it runs
+            estimate = histories.Predict(sa, seen)  # eq. 8.1 or 8.5, before it runs
             if self.reaching[sa]:
                 reached = robot.Reach(target)
                 reward = ReachReward(reached, target, self.config.predictor.distance_unit)
@@ -341,9 +348,9 @@ class ReachLearner:
                         self.model.Observe(sa, outcome)
                         self._RefreshT()
                 failed += reward < 0
-            histories.Record(sa, target, estimate, reward)
+            histories.Record(sa, seen, estimate, reward)
             if failures is not None and not self.reaching[sa] and reward < 0:
-                failures.append((sa, target, estimate, reward))
+                failures.append((sa, seen, estimate, reward))
             if learn:
                 self.log.append(
                     (
@@ -354,7 +361,7 @@ class ReachLearner:
                         outcome,
                         estimate,
                         reward,
-                        *target,
+                        *seen,
                     )
                 )
             if self.reaching[sa]:

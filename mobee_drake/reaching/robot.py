@@ -10,6 +10,7 @@ therefore must go around the target, and fails when it cannot.
 
 import numpy as np
 from pydrake.geometry import CollisionFilterDeclaration, GeometrySet
+from pydrake.math import RigidTransform
 from pydrake.systems.analysis import InitializeParams
 
 from mobee_drake.planning.actuation_noise import NoisyPosture, ValidateNoise
@@ -73,6 +74,14 @@ class SimulatedRobot:
         self._marker = mobee.marker_index(marker)
         # The current problem's target (None before the first problem).
         self.target: np.ndarray | None = None
+        # The shoulder's frame, and where it stands with every joint at home (a scratch plant
+        # context: the station's plant is not simulated).
+        S, s0 = mobee.PlantStateMap()
+        nq, n = plant.num_positions(), len(self._home)
+        self._position_map, self._position_offset = S[:nq, :n], s0[:nq]
+        self._scratch = plant.CreateDefaultContext()
+        self._shoulder = plant.GetJointByName(joints[0]).frame_on_parent()
+        self._shoulder_at_home = self._ShoulderPose(self._home)
         self._hand = [
             g
             for g, frame in station.robot.geometry_frames.items()
@@ -116,9 +125,14 @@ class SimulatedRobot:
             0,
             self.context.get_time(),
         )
+        self.MoveTo(q_star)
+        return self.State()
+
+    def MoveTo(self, q_star: np.ndarray) -> None:
+        """Sets MoBeE's attractor to ``q_star`` (every joint of MoBeE's) and waits until the
+        robot has settled."""
         self.executor.StartTransition(self._executor_context, q_star)
         self._Finish()
-        return self.State()
 
     def Reach(self, target: np.ndarray) -> np.ndarray:
         scene_graph = self.station.scene_graph
@@ -138,6 +152,23 @@ class SimulatedRobot:
 
     def FeltObject(self) -> bool:
         return self.executor.FeltObject(self._executor_context)
+
+    def _ShoulderPose(self, q: np.ndarray) -> RigidTransform:
+        """X_WS: the shoulder's frame (where the MDP's first joint sits on its parent body) with
+        MoBeE's joints at ``q``."""
+        positions = self._position_map @ q + self._position_offset
+        self.station.plant.SetPositions(self._scratch, positions)
+        return self._shoulder.CalcPoseInWorld(self._scratch)
+
+    def LearningFrame(self, target: np.ndarray) -> np.ndarray:
+        """``target`` where it is relative to the shoulder now, put back in the world as the
+        shoulder stood with the torso at home (see ``Robot.LearningFrame``)."""
+        target = np.asarray(target, dtype=float)
+        q = self.station.robot_state.Eval(self.context)[: len(self._home)]
+        X_WS = self._ShoulderPose(q)
+        if np.array_equal(X_WS.GetAsMatrix34(), self._shoulder_at_home.GetAsMatrix34()):
+            return target  # (exactly: a run without a torso repeats bit for bit)
+        return self._shoulder_at_home @ (X_WS.inverse() @ target)
 
     def MarkerPosition(self) -> np.ndarray:
         """Where the reaching marker (the palm) is now (world, m)."""
