@@ -11,11 +11,14 @@ import unittest
 
 import numpy as np
 import pandas as pd
+from pydrake.common.eigen_geometry import AngleAxis
+from pydrake.math import RotationMatrix
 from pydrake.systems.primitives import ConstantVectorSource
 from test_figures import FigureTest
 
 from mobee_drake import cli
 from mobee_drake.behaviours.pointing import PointingError
+from mobee_drake.behaviours.torso import PlaceTorso, PostureGrid
 from mobee_drake.experiments import parallel_behaviours
 from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario
 from mobee_drake.station.builder import MakeMobeeStation
@@ -217,6 +220,65 @@ class TestPointing(unittest.TestCase):
         logged = pd.read_parquet(log)["gaze_pointing.error_deg"].to_numpy()
         self.assertAlmostEqual(logged[-1], figures["final_error_deg"], places=6)
         self.assertGreater(logged[0], 10.0)
+
+
+class TestTorsoPlacement(unittest.TestCase):
+    def test_the_torso_turns_the_target_onto_the_maps_peak(self):
+        """A map peaked where the target would be seen with the torso turned by 24 deg about
+        its yaw axis (closed form: the target turned back by 24 deg about that axis): the
+        behaviour chooses that yaw, and MoBeE turns the torso there."""
+        scenario = _Scenario(_Gaze())
+        station = BuildScenario(scenario)  # (for the plant's kinematics)
+        plant, context = station.plant, station.plant.CreateDefaultContext()
+        joint = plant.GetJointByName("torso_yaw")
+        X_WJ = joint.frame_on_parent().CalcPoseInWorld(context)
+        axis, centre = X_WJ.rotation() @ joint.revolute_axis(), X_WJ.translation()
+        turn = np.radians(24.0)
+        back = RotationMatrix(AngleAxis(-turn, axis))
+        peak = centre + back @ (np.array(IN_VIEW) - centre)
+        placement = PlaceTorso(
+            reach_map=lambda x: -np.linalg.norm(x - peak, axis=1),
+            target="ball",
+            levels=41,
+            range_fraction=1.0,
+            period=0.1,
+        )
+        composed = MakeMobeeStation(
+            scenario,
+            prebuild_callback=lambda parts: ComposeBehaviours(
+                parts, [Behaviour("torso", ("torso_yaw",), placement.AddToBuilder)]
+            ),
+        )
+        system = composed.diagram.GetSubsystemByName("torso_torso_placement")
+        scores = system.Scores(np.array(IN_VIEW))
+        grid = PostureGrid(composed.mobee, ["torso_yaw"], 41, 1.0)[:, 0]
+        self.assertAlmostEqual(grid[np.argmax(scores)], turn, delta=np.radians(1.3))
+        simulator = MakeSimulator(composed)
+        simulator.AdvanceTo(8.0)
+        yaw = composed.robot_state.Eval(simulator.get_context())[
+            composed.mobee.joint_index("torso_yaw")
+        ]
+        self.assertAlmostEqual(np.degrees(yaw), 24.0, delta=2.0)
+        outcome = system.Outcome(system.GetMyContextFromRoot(simulator.get_context()))
+        self.assertAlmostEqual(
+            outcome["posture_deg"]["torso_yaw"], np.degrees(grid[np.argmax(scores)])
+        )
+
+    def test_a_flat_map_keeps_the_torso_home(self):
+        scenario = _Scenario(_Gaze())
+        placement = PlaceTorso(reach_map=lambda x: np.zeros(len(x)), target="ball", period=0.1)
+        composed = MakeMobeeStation(
+            scenario,
+            prebuild_callback=lambda parts: ComposeBehaviours(
+                parts, [Behaviour("torso", ("torso_yaw", "torso_pitch"), placement.AddToBuilder)]
+            ),
+        )
+        simulator = MakeSimulator(composed)
+        simulator.AdvanceTo(1.0)
+        q = composed.robot_state.Eval(simulator.get_context())
+        for joint in ("torso_yaw", "torso_pitch"):
+            i = composed.mobee.joint_index(joint)
+            self.assertAlmostEqual(q[i], composed.mobee.home[i], delta=1e-9)
 
 
 class TestParallelBehavioursExperiment(FigureTest):
