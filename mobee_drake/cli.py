@@ -289,6 +289,10 @@ _EXPERIMENTS = {
         "gaze and palm normal beside the curious planner (ch. 9.4.2)",
     ),
     "saggriac": ("saggriac_command", "SAGG-RIAC goal babbling on the 15-joint arm"),
+    "torso-reach": (
+        "torso_reach",
+        "a torso that brings targets into the learned reach (ch. 9.4.2)",
+    ),
     "roadmaps": ("ch4_roadmaps", "adaptive roadmap planning on MoBeE 1.0 (ch. 4.3)"),
     "trm": ("trm_roadmaps", "the task-relevant roadmaps of ch. 3.4"),
 }

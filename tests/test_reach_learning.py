@@ -1,5 +1,8 @@
 """The state-action executor (fixed input ports), and the reach-learning battery on the robot."""
 
+import contextlib
+import dataclasses as dc
+import io
 import json
 import pathlib
 import tempfile
@@ -12,6 +15,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.systems.analysis import Simulator
 
+from mobee_drake.experiments.ch8_reaching import LoadTrainedLearner
 from mobee_drake.mobee.fields import FieldPairs
 from mobee_drake.planning.supervisor import ActionTiming
 from mobee_drake.reaching.robot import SimulatedRobot
@@ -235,6 +239,40 @@ class TestBattery(unittest.TestCase):
         back = RigidTransform(RotationMatrix(AngleAxis(-turned, axis)))
         expected = X_WJ.translation() + back @ (target - X_WJ.translation())
         np.testing.assert_allclose(robot.LearningFrame(target), expected, atol=1e-9)
+
+    def test_the_torso_reach_smoke_battery(self):
+        """A learner of 4 problem-tries, evaluated on 3 targets inside and outside the reach,
+        the torso module on and off, 2 seeds: every run reports, the report pairs them, and
+        the outside targets are the inside ones moved away from the shoulder."""
+        from mobee_drake.experiments import torso_reach
+
+        settings = self.Settings("greedy", 0, 4, [4], 1, 4, mdp="simultaneous")
+        learner_dir = self.output / "torso_learner"
+        self.Run("torso_learner", settings)
+        (learner_dir / "job.json").write_text(
+            json.dumps({"settings": dc.asdict(settings), "mdp": "(learned with the reaches)"})
+        )
+        output = self.output / "torso_reach"
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            torso_reach.main(
+                ["--learner", str(learner_dir), "--seeds", "2", "--problems", "3",
+                 "--output", str(output), "--workers", "2"]
+            )  # fmt: skip
+        runs = [
+            torso_reach.TorsoReachRun(**json.loads(path.read_text()))
+            for path in output.glob("runs/*/result.json")
+        ]
+        self.assertEqual(len(runs), 8)
+        self.assertTrue(all(len(r.distances) == 3 and r.robot_seconds > 0 for r in runs))
+        report = (output / "report.md").read_text()
+        self.assertIn("| outside | on | 2 |", report)
+        self.assertIn("outside targets, share reached:", report)
+        # The outside targets are the inside ones moved 10 cm from the shoulder.
+        learner, grid = LoadTrainedLearner(learner_dir)
+        robot = torso_reach.TorsoReachRobot(learner, grid.radius, torso=False)
+        inside = grid.Centres()[:3]
+        moved = torso_reach.Beyond(robot, inside, 0.1) - inside
+        np.testing.assert_allclose(np.linalg.norm(moved, axis=1), 0.1)
 
     def test_a_noisy_robot_sometimes_settles_in_another_state(self):
         """Issue 33: with actuation noise (sd 0.2 of each joint's range: a joint leaves its state

@@ -4,9 +4,10 @@ After ch. 8's learning the reach learner holds a map of how well the arm reaches
 relative to the shoulder: for a target seen in the learning frame (the shoulder's, placed as it
 stands with the torso at home: ``Robot.LearningFrame``), the best predicted reward of a reach
 (:func:`ReachMap`: eq. 8.5 over the reaching state-actions). This behaviour owns the torso's
-joints; every ``period`` it looks at a grid of torso postures around home, sees where each would
-put the target in the learning frame, and sets the torso's attractor to the posture whose map
-value is highest (among equal values, the one nearest home; home itself when no posture beats it).
+joints; when the target is a new one (it looks every ``period``), it looks at a grid of torso
+postures around home, sees where each would put the target in the learning frame, and sets the
+torso's attractor to the posture whose map value is highest (among equal values, the one nearest
+home; home itself when no posture beats it).
 The arm's planner keeps deciding in the shoulder's frame, so the torso's motion does not disturb
 it; MoBeE moves the torso as any joint, fields and limits included.
 
@@ -86,6 +87,8 @@ class TorsoPlacement(LeafSystem):
         self._distance = np.linalg.norm(self._postures - self._home[self._owned], axis=1)
         self._target = self.DeclareVectorInputPort("target", 3)
         self._posture = self.DeclareDiscreteState(self._home[self._owned])
+        # The target the posture was chosen for (NaN: none yet): a choice per target.
+        self._chosen_for = self.DeclareDiscreteState(np.full(3, np.nan))
         self.DeclarePeriodicDiscreteUpdateEvent(period, 0.0, self._Choose)
         self.DeclareVectorOutputPort(
             "attractor", n, self._CalcAttractor, prerequisites_of_calc={self.xd_ticket()}
@@ -97,10 +100,14 @@ class TorsoPlacement(LeafSystem):
         return self._map(seen)
 
     def _Choose(self, context, discrete_state) -> None:
-        scores = self.Scores(self._target.Eval(context))
+        target = self._target.Eval(context)
+        if np.array_equal(target, context.get_discrete_state(self._chosen_for).value()):
+            return  # (the same target: the same choice)
+        scores = self.Scores(target)
         best = np.flatnonzero(scores >= scores.max() - _TIE)
         chosen = best[np.argmin(self._distance[best])]
         discrete_state.set_value(self._posture, self._postures[chosen])
+        discrete_state.set_value(self._chosen_for, target)
 
     def _CalcAttractor(self, context, output: BasicVector) -> None:
         q_star = self._home.copy()

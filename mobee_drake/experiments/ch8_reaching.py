@@ -81,7 +81,7 @@ from mobee_drake.reaching.predictors import (
     PredictorConfig,
 )
 from mobee_drake.reaching.robot import SimulatedRobot
-from mobee_drake.reaching.targets import LoadTargetGrid
+from mobee_drake.reaching.targets import LoadTargetGrid, TargetGrid
 from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS, IcubConfig
 from mobee_drake.scenario import BuildScenario, Scenario
 from mobee_drake.station.executor import ReachForcing, StateActionAttractor
@@ -453,6 +453,27 @@ def RunOne(
         **extra,
     )
     return result.ToJson()
+
+
+def LoadTrainedLearner(run_dir: str | pathlib.Path) -> tuple[ReachLearner, TargetGrid]:
+    """The learner of a run of the battery as its newest checkpoint holds it, and its targets.
+
+    Raises:
+        ValueError: naming the folder, if it is not a run of the battery with a checkpoint.
+    """
+    run_dir = pathlib.Path(run_dir)
+    try:
+        job = json.loads((run_dir / "job.json").read_text())
+        settings = RunSettings(**job["settings"])
+    except (OSError, ValueError, KeyError, TypeError):
+        raise ValueError(f"{run_dir}: not a run of `mobee-drake experiment ch8`") from None
+    generation = CurrentGeneration(run_dir / "checkpoint")
+    if generation is None:
+        raise ValueError(f"{run_dir}: the run has no checkpoint yet")
+    _, learner, grid = _NewLearner(settings, run_dir.parent / job["mdp"] / "model")
+    saved = json.loads((generation / "learner.json").read_text())
+    learner.LoadArrays(np.load(generation / "learner.npz"), saved["learner"])
+    return learner, grid
 
 
 def ReachJob(run: RunFolder, mdp: str, settings: dict) -> dict:

@@ -387,12 +387,14 @@ class ReachLearner:
         self.problem_tries[problem] += 1
         return result
 
-    def Evaluate(self, robot: Robot, seed) -> list[TryResult]:
+    def Evaluate(self, robot: Robot, seed, targets: np.ndarray | None = None) -> list[TryResult]:
         """One exploitation evaluation (ch. 8.3.3) with its own generator ``seed``: a random start
-        state, then every problem, shuffled, greedily; the learner's state is not changed."""
+        state, then every problem, shuffled, greedily; the learner's state is not changed. The
+        problems are the learner's targets, or ``targets`` (one per problem) if given."""
+        targets = self.targets if targets is None else np.asarray(targets, dtype=float)
         rng = np.random.default_rng(seed)
         start = int(rng.integers(self.space.num_states))
-        order = rng.permutation(len(self.targets))
+        order = rng.permutation(len(targets))
         # Ties draw from a generator of their own, so that the start and the order are the same
         # for every learner evaluated with this seed (paired runs), however the walk goes.
         ties = np.random.default_rng(np.random.SeedSequence(seed).spawn(1)[0])
@@ -416,7 +418,7 @@ class ReachLearner:
                 self._Try(
                     robot,
                     int(problem),
-                    self.targets[problem],
+                    targets[problem],
                     "greedy",
                     histories,
                     ties,

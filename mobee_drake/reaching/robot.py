@@ -25,7 +25,8 @@ from mobee_drake.station.world_events import MakeSimulator
 
 class SimulatedRobot:
     """Runs the learner's state-actions on a built station whose client is a
-    :class:`StateActionExecutor` (a scenario with a ``StateActionAttractor``).
+    :class:`StateActionExecutor` (a scenario with a ``StateActionAttractor``), alone or among
+    behaviours (a torso beside it, say).
 
     ``joints`` are the MDP's joints (``space``'s dimensions, in fractions of their ranges); the
     rest of MoBeE's joints stay at home. With ``realtime`` the robot moves in real time (for a
@@ -46,15 +47,19 @@ class SimulatedRobot:
         transition_noise: float = 0.0,
         noise_seed: int = 0,
     ):
-        if not isinstance(station.client, StateActionExecutor):
-            raise ValueError("the reach learner's station needs a StateActionAttractor client")
+        executors = [
+            s for s in station.Hooks("action_counters") if isinstance(s, StateActionExecutor)
+        ]
+        if len(executors) != 1:
+            raise ValueError("the reach learner's station needs one StateActionAttractor client")
         self.station = station
         self.simulator = MakeSimulator(station)
         if realtime:
             self.simulator.set_target_realtime_rate(1.0)
         self.simulator.Initialize()
         self.context = self.simulator.get_mutable_context()
-        self.executor: StateActionExecutor = station.client
+        # (the station's client, or one of its behaviours: station/composition.py)
+        self.executor: StateActionExecutor = executors[0]
         self._executor_context = self.executor.GetMyMutableContextFromRoot(self.context)
         mobee = station.mobee
         unknown = [j for j in joints if j not in mobee.joints]
