@@ -264,6 +264,7 @@ class TestBattery(unittest.TestCase):
         ]
         self.assertEqual(len(runs), 8)
         self.assertTrue(all(len(r.distances) == 3 and r.robot_seconds > 0 for r in runs))
+        self.assertEqual(sum(r.penetrating_steps for r in runs), 0)
         report = (output / "report.md").read_text()
         self.assertIn("| outside | on | 2 |", report)
         self.assertIn("outside targets, share reached:", report)

@@ -61,6 +61,8 @@ class TorsoReachRun:
     distances: list[float | None]
     robot_seconds: float
     wall_seconds: float
+    # Control periods in which the robot's solids penetrated (the safety of the whole).
+    penetrating_steps: int
 
     def Successes(self, within: float) -> float:
         """The share of problems reached within ``within`` of the target's centre."""
@@ -136,6 +138,7 @@ def RunOne(
             distances=distances,
             robot_seconds=(robot.context.get_time() - start) / len(chosen),
             wall_seconds=time.perf_counter() - began,
+            penetrating_steps=robot.Safety().penetrating_steps,
         )
     )
 
@@ -144,8 +147,9 @@ def Report(runs: list[TorsoReachRun], within: float, command: str) -> str:
     """The report's table and the paired comparisons (markdown)."""
     lines = [
         f"| targets | torso module | runs | reached within {100 * within:g} cm (mean over runs) "
-        "| palm to target at the reach's end, cm | robot s per problem | wall s per run |",
-        "|---|---|---:|---:|---:|---:|---:|",
+        "| palm to target at the reach's end, cm | robot s per problem | penetrating periods "
+        "| wall s per run |",
+        "|---|---|---:|---:|---:|---:|---:|---:|",
     ]
     group = {
         (t, c): sorted(
@@ -161,6 +165,7 @@ def Report(runs: list[TorsoReachRun], within: float, command: str) -> str:
                 f"{100 * np.mean([r.Successes(within) for r in rs]):.0f} % | "
                 f"{100 * np.nanmean([r.mean_distance for r in rs]):.1f} | "
                 f"{np.mean([r.robot_seconds for r in rs]):.1f} | "
+                f"{sum(r.penetrating_steps for r in rs)} | "
                 f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
             )
     measures = {
