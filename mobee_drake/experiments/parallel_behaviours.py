@@ -37,7 +37,7 @@ from mobee_drake.experiments.battery import (
 )
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.plots import Legend, SaveFigure, plt
-from mobee_drake.experiments.statistics import ComparePaired, Holm
+from mobee_drake.experiments.statistics import ComparePaired, FiniteMean, Holm
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.scenario import LoadScenario, RunScenario
 
@@ -124,8 +124,8 @@ def Report(runs: list[ParallelRun], command: str) -> str:
     for condition, group in by.items():
         lines.append(
             f"| {condition} | {len(group)} | {np.mean([len(r.end_angles) for r in group]):.1f} | "
-            f"{np.nanmean([r.palm_mean for r in group]):.1f} | "
-            f"{100 * np.nanmean([r.facing for r in group]):.0f} % | "
+            f"{FiniteMean([r.palm_mean for r in group]):.1f} | "
+            f"{100 * FiniteMean([r.facing for r in group]):.0f} % | "
             f"{np.mean([r.gaze_mean for r in group]):.1f} | "
             f"{np.mean([r.gaze_final for r in group]):.2f} | "
             f"{sum(r.penetrating_steps for r in group)} | "

@@ -329,6 +329,13 @@ def Trend(stages, values) -> float:
     return float(np.polyfit(np.log2(stages), values, 1)[0])
 
 
+def FiniteMean(values) -> float:
+    """The mean of the finite ``values`` (NaN marks a run without the measure), NaN if none is."""
+    finite = np.asarray(values, dtype=float)
+    finite = finite[np.isfinite(finite)]
+    return float(finite.mean()) if finite.size else float("nan")
+
+
 def RunMeans(values_per_run) -> np.ndarray:
     """One value per run: the mean of each run's own values (its evaluations at a stage),
     never a pool of them; runs may have different numbers of values, but none may be empty."""

@@ -34,7 +34,7 @@ from mobee_drake.experiments.battery import (
 )
 from mobee_drake.experiments.ch8_reaching import RIGHT_ARM, LoadTrainedLearner, ReachScenario
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
-from mobee_drake.experiments.statistics import ComparePaired, Holm
+from mobee_drake.experiments.statistics import ComparePaired, FiniteMean, Holm
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.reaching.robot import SimulatedRobot
 from mobee_drake.reaching.targets import TARGET_NAME, TargetObject
@@ -163,7 +163,7 @@ def Report(runs: list[TorsoReachRun], within: float, command: str) -> str:
             lines.append(
                 f"| {targets} | {condition} | {len(rs)} | "
                 f"{100 * np.mean([r.Successes(within) for r in rs]):.0f} % | "
-                f"{100 * np.nanmean([r.mean_distance for r in rs]):.1f} | "
+                f"{100 * FiniteMean([r.mean_distance for r in rs]):.1f} | "
                 f"{np.mean([r.robot_seconds for r in rs]):.1f} | "
                 f"{sum(r.penetrating_steps for r in rs)} | "
                 f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
