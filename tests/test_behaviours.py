@@ -7,6 +7,7 @@ import json
 import pathlib
 import shutil
 import tempfile
+import types
 import unittest
 
 import numpy as np
@@ -18,8 +19,9 @@ from test_figures import FigureTest
 
 from mobee_drake import cli
 from mobee_drake.behaviours.pointing import PointingError
-from mobee_drake.behaviours.torso import PlaceTorso, PostureGrid
+from mobee_drake.behaviours.torso import PlaceTorso, PostureGrid, ReachMap
 from mobee_drake.experiments import parallel_behaviours
+from mobee_drake.reaching.predictors import RewardHistories
 from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario
 from mobee_drake.station.builder import MakeMobeeStation
 from mobee_drake.station.composition import Behaviour, BehaviourComposer, ComposeBehaviours
@@ -279,6 +281,26 @@ class TestTorsoPlacement(unittest.TestCase):
         for joint in ("torso_yaw", "torso_pitch"):
             i = composed.mobee.joint_index(joint)
             self.assertAlmostEqual(q[i], composed.mobee.home[i], delta=1e-9)
+
+
+class TestReachMaps(unittest.TestCase):
+    def test_the_two_readings(self):
+        """One transition and two reaches: "evidence" is the best mean reward recorded within
+        5 cm (0 where none was); "prediction" is eq. 8.5, which tends to its prior (1) far away."""
+        histories = RewardHistories(np.array([False, True, True]))
+        records = [
+            (1, [0, 0, 0], 0.6), (1, [0.02, 0, 0], 0.4), (2, [0.3, 0, 0], 0.9),
+            (0, [0.01, 0, 0], 5.0),  # a transition's: not a reach
+        ]  # fmt: skip
+        for sa, target, reward in records:
+            histories.Record(sa, target, 0.0, reward)
+        learner = types.SimpleNamespace(num_transitions=1, num_state_actions=3, histories=histories)
+        points = np.array([[0.01, 0, 0], [0.3, 0.04, 0], [2.0, 0, 0]])
+        np.testing.assert_allclose(ReachMap(learner, "evidence")(points), [0.5, 0.9, 0.0])
+        far = ReachMap(learner, "prediction")(points)[2]
+        self.assertGreater(far, 0.9)  # (the optimistic prior)
+        with self.assertRaisesRegex(ValueError, "unknown reach map 'nearest'"):
+            ReachMap(learner, "nearest")
 
 
 class TestParallelBehavioursExperiment(FigureTest):

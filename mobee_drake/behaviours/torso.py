@@ -30,13 +30,39 @@ from mobee_drake.station.parts import ClientPorts, StationParts
 _TIE = 1e-9
 
 
-def ReachMap(learner: ReachLearner) -> Callable[[np.ndarray], np.ndarray]:
-    """The best predicted reward of a reach (eq. 8.5) for each row of an (k, 3) array of
+# The readings of "a map of the reachability of the workspace relative to the shoulder":
+# "prediction": the best predicted reward of a reach (eq. 8.5), which far from every recorded
+# target tends to eq. 8.5's optimistic prior; "evidence": the best mean reward a reach achieved
+# for the recorded targets within EVIDENCE_RADIUS, 0 where none was recorded.
+REACH_MAPS = ("prediction", "evidence")
+EVIDENCE_RADIUS = 0.05
+
+
+def ReachMap(learner: ReachLearner, kind: str = "prediction") -> Callable[[np.ndarray], np.ndarray]:
+    """The reach map of ``kind`` (one of REACH_MAPS) for each row of an (k, 3) array of
     targets in the learning frame."""
     reaches = range(learner.num_transitions, learner.num_state_actions)
-    return lambda targets: np.array(
-        [max(learner.histories.Predict(sa, x) for sa in reaches) for x in targets]
-    )
+    histories = learner.histories
+    if kind == "prediction":
+        return lambda targets: np.array(
+            [max(histories.Predict(sa, x) for sa in reaches) for x in targets]
+        )
+    if kind != "evidence":
+        raise ValueError(f"unknown reach map '{kind}'; one of {', '.join(REACH_MAPS)}")
+    records = [histories.Records(sa) for sa in reaches]
+
+    def Evidence(targets: np.ndarray) -> np.ndarray:
+        best = np.zeros(len(targets))
+        for recorded, rewards in records:
+            if len(rewards) == 0:
+                continue
+            near = np.linalg.norm(targets[:, None] - recorded[None], axis=2) <= EVIDENCE_RADIUS
+            counts = near.sum(axis=1)
+            means = np.divide(near @ rewards, counts, out=np.zeros(len(targets)), where=counts > 0)
+            best = np.maximum(best, means)
+        return best
+
+    return Evidence
 
 
 class TorsoPlacement(LeafSystem):

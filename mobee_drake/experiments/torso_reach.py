@@ -23,7 +23,7 @@ import time
 
 import numpy as np
 
-from mobee_drake.behaviours.torso import PlaceTorso, ReachMap
+from mobee_drake.behaviours.torso import REACH_MAPS, PlaceTorso, ReachMap
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
@@ -74,15 +74,17 @@ class TorsoReachRun:
         return float(np.mean(reached)) if reached else float("nan")
 
 
-def TorsoReachRobot(learner, radius: float, torso: bool) -> SimulatedRobot:
+def TorsoReachRobot(
+    learner, radius: float, torso: bool, reach_map: str = "prediction"
+) -> SimulatedRobot:
     """The reach learner's robot with the torso's joints controlled, and, with ``torso``, the
-    torso module beside the state-action executor."""
+    torso module (its map of the kind ``reach_map``) beside the state-action executor."""
     scenario = ReachScenario()
     scenario.robot = IcubConfig(controlled_joints=list(TORSO_JOINTS) + RIGHT_ARM)
     scenario.objects = [TargetObject(_PARKED, radius)]  # SetProblem moves it
     if not torso:
         return SimulatedRobot(BuildScenario(scenario), RIGHT_ARM, learner.space, radius)
-    placement = PlaceTorso(reach_map=ReachMap(learner), target=TARGET_NAME)
+    placement = PlaceTorso(reach_map=ReachMap(learner, reach_map), target=TARGET_NAME)
     station = MakeMobeeStation(
         scenario,
         prebuild_callback=lambda parts: ComposeBehaviours(
@@ -113,11 +115,11 @@ def Beyond(robot: SimulatedRobot, targets: np.ndarray, distance: float) -> np.nd
 
 def RunOne(
     run: RunFolder, learner_dir: str, seed: int, targets: str, condition: str, beyond: float,
-    problems: int,
+    problems: int, reach_map: str = "prediction",
 ) -> dict:  # fmt: skip
     """The battery job: one evaluation of the trained learner."""
     learner, grid = LoadTrainedLearner(learner_dir)
-    robot = TorsoReachRobot(learner, grid.radius, torso=condition == "on")
+    robot = TorsoReachRobot(learner, grid.radius, torso=condition == "on", reach_map=reach_map)
     chosen = grid.Centres()[:problems]
     if targets == "outside":
         chosen = Beyond(robot, chosen, beyond)
@@ -208,6 +210,13 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--problems", type=PositiveInt, default=27, help="the first N of the learner's targets"
     )
+    parser.add_argument(
+        "--map",
+        choices=REACH_MAPS,
+        default="prediction",
+        help="the torso's reach map: eq. 8.5's best prediction, or the best mean reward recorded "
+        "within 5 cm (0 where none was)",
+    )
     parser.add_argument("--output", default="results/torso_reach", help="the battery folder")
     parser.add_argument("--doc", help="a doc whose generated block 'torso-reach' gets the report")
     AddBackendArguments(parser)
@@ -230,6 +239,7 @@ def main(argv: list[str] | None = None) -> None:
                 condition=condition,
                 beyond=args.beyond,
                 problems=args.problems,
+                reach_map=args.map,
             ),
         )  # fmt: skip
         for seed in range(args.seeds)

@@ -196,6 +196,10 @@ class RewardHistories:
             self._rewards[state_action],
         )
 
+    def Records(self, state_action: int) -> tuple[np.ndarray, np.ndarray]:
+        """``H_{s,a}``'s targets (n, 3) and rewards (n) so far."""
+        return self._targets[state_action], self._rewards[state_action]
+
     def Predict(self, state_action: int, target) -> float:
         """The expected reward (eq. 8.1 for transitions, 8.5 for reaches)."""
         prior = 1.0 if self.reaching[state_action] else 0.0
