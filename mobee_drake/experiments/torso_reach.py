@@ -218,13 +218,18 @@ def main(argv: list[str] | None = None) -> None:
         "within 5 cm (0 where none was)",
     )
     parser.add_argument("--output", default="results/torso_reach", help="the battery folder")
-    parser.add_argument("--doc", help="a doc whose generated block 'torso-reach' gets the report")
+    parser.add_argument(
+        "--doc",
+        help="a doc whose generated block 'torso-reach' (with --map evidence, "
+        "'torso-reach-evidence') gets the report",
+    )
     AddBackendArguments(parser)
     args = parser.parse_args(argv)
+    block = "torso-reach" if args.map == "prediction" else f"torso-reach-{args.map}"
     try:
         LoadTrainedLearner(args.learner)
         if args.doc:
-            GeneratedTable(args.doc, "torso-reach")
+            GeneratedTable(args.doc, block)
     except (OSError, ValueError) as error:
         parser.error(str(error))
     learner_dir = str(pathlib.Path(args.learner).resolve())
@@ -254,7 +259,7 @@ def main(argv: list[str] | None = None) -> None:
     with OwnedFolder(output, "battery"):
         (output / "report.md").write_text(report + "\n")
     if args.doc:
-        WriteGeneratedTable(args.doc, "torso-reach", command.strip(), report)
+        WriteGeneratedTable(args.doc, block, command.strip(), report)
     print(report)
 
 
