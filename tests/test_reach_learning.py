@@ -274,6 +274,16 @@ class TestBattery(unittest.TestCase):
         inside = grid.Centres()[:3]
         moved = torso_reach.Beyond(robot, inside, 0.1) - inside
         np.testing.assert_allclose(np.linalg.norm(moved, axis=1), 0.1)
+        # A target that appears where the palm is is counted as appearing inside the robot, and
+        # its problem's penetrating periods are not counted among the others'.
+        watched = torso_reach.AppearanceWatch(robot)
+        watched.SetProblem(robot.MarkerPosition())
+        robot.Transition(robot.State())  # MoBeE pushes the arm out of the target
+        watched.SetProblem(np.array([1.0, 1.0, 1.0]))
+        watched.Close()
+        self.assertEqual(watched.appeared_inside, 1)
+        self.assertGreater(robot.Safety().penetrating_steps, 0)
+        self.assertEqual(watched.other, 0)
 
     def test_a_noisy_robot_sometimes_settles_in_another_state(self):
         """Issue 33: with actuation noise (sd 0.2 of each joint's range: a joint leaves its state

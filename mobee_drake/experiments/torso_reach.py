@@ -42,6 +42,7 @@ from mobee_drake.robots.icub import TORSO_JOINTS, IcubConfig
 from mobee_drake.scenario import BuildScenario
 from mobee_drake.station.builder import MakeMobeeStation
 from mobee_drake.station.composition import Behaviour, ComposeBehaviours
+from mobee_drake.station.safety import Penetrations
 
 TARGET_SETS = ("inside", "outside")
 CONDITIONS = ("off", "on")
@@ -61,8 +62,12 @@ class TorsoReachRun:
     distances: list[float | None]
     robot_seconds: float
     wall_seconds: float
-    # Control periods in which the robot's solids penetrated (the safety of the whole).
+    # Control periods in which the robot's solids penetrated (the safety of the whole); the
+    # problems whose target appeared inside the robot (ch. 8's targets may appear where the arm
+    # rests; MoBeE then pushes the arm out), and the penetrating periods of the other problems.
     penetrating_steps: int
+    appeared_inside: int = 0
+    other_penetrating_steps: int = 0
 
     def Successes(self, within: float) -> float:
         """The share of problems reached within ``within`` of the target's centre."""
@@ -113,6 +118,29 @@ def Beyond(robot: SimulatedRobot, targets: np.ndarray, distance: float) -> np.nd
     return targets + distance * away / np.linalg.norm(away, axis=1, keepdims=True)
 
 
+class AppearanceWatch:
+    """The robot, watched for targets that appear inside it (see TorsoReachRun)."""
+
+    def __init__(self, robot: SimulatedRobot):
+        self.robot, self.appeared_inside, self.other = robot, 0, 0
+        self._inside, self._start = True, 0
+
+    def __getattr__(self, name):  # (the rest of the Robot protocol, unwatched)
+        return getattr(self.robot, name)
+
+    def Close(self) -> None:
+        """Ends the current problem's count."""
+        if not self._inside:
+            self.other += self.robot.Safety().penetrating_steps - self._start
+
+    def SetProblem(self, target: np.ndarray) -> None:
+        self.Close()
+        self.robot.SetProblem(target)
+        self._inside = bool(Penetrations(self.robot.station.diagram, self.robot.context))
+        self.appeared_inside += self._inside
+        self._start = self.robot.Safety().penetrating_steps
+
+
 def RunOne(
     run: RunFolder, learner_dir: str, seed: int, targets: str, condition: str, beyond: float,
     problems: int, reach_map: str = "prediction",
@@ -124,7 +152,9 @@ def RunOne(
     if targets == "outside":
         chosen = Beyond(robot, chosen, beyond)
     began, start = time.perf_counter(), robot.context.get_time()
-    results = learner.Evaluate(robot, seed, chosen)
+    watched = AppearanceWatch(robot)
+    results = learner.Evaluate(watched, seed, chosen)
+    watched.Close()
     by_problem = {r.problem: r for r in results}
     distances = [
         None
@@ -141,6 +171,8 @@ def RunOne(
             robot_seconds=(robot.context.get_time() - start) / len(chosen),
             wall_seconds=time.perf_counter() - began,
             penetrating_steps=robot.Safety().penetrating_steps,
+            appeared_inside=watched.appeared_inside,
+            other_penetrating_steps=watched.other,
         )
     )
 
@@ -150,8 +182,9 @@ def Report(runs: list[TorsoReachRun], within: float, command: str) -> str:
     lines = [
         f"| targets | torso module | runs | reached within {100 * within:g} cm (mean over runs) "
         "| palm to target at the reach's end, cm | robot s per problem | penetrating periods "
+        "| targets that appeared inside the robot | penetrating periods of the other problems "
         "| wall s per run |",
-        "|---|---|---:|---:|---:|---:|---:|---:|",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     group = {
         (t, c): sorted(
@@ -168,6 +201,8 @@ def Report(runs: list[TorsoReachRun], within: float, command: str) -> str:
                 f"{100 * FiniteMean([r.mean_distance for r in rs]):.1f} | "
                 f"{np.mean([r.robot_seconds for r in rs]):.1f} | "
                 f"{sum(r.penetrating_steps for r in rs)} | "
+                f"{sum(r.appeared_inside for r in rs)} | "
+                f"{sum(r.other_penetrating_steps for r in rs)} | "
                 f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
             )
     measures = {
