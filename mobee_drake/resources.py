@@ -16,9 +16,6 @@ import pathlib
 
 from pydrake.multibody.parsing import PackageMap
 
-PACKAGE_NAME = "mobee_drake"
-_PACKAGE_URL = f"package://{PACKAGE_NAME}/"
-
 
 def ModelsDirectory() -> pathlib.Path:
     """The folder of the shipped models (``models/`` in the repository)."""
@@ -40,12 +37,24 @@ def MobeePackageMap() -> PackageMap:
     return package_map
 
 
+def _PackageFile(url: str) -> pathlib.Path:
+    """The file a ``package://`` URI names (ValueError naming an unknown package)."""
+    package = url[len("package://") :].split("/", 1)[0]
+    if not MobeePackageMap().Contains(package):
+        raise ValueError(
+            f"{url}: unknown package '{package}' (known: "
+            + ", ".join(sorted(MobeePackageMap().GetPackageNames()))
+            + "; add yours to ROS_PACKAGE_PATH)"
+        )
+    return pathlib.Path(MobeePackageMap().ResolveUrl(url))
+
+
 def ResolveModelFile(name: str | pathlib.Path) -> pathlib.Path:
-    """The file of a model: ``package://mobee_drake/...``, an absolute path, or a path relative
-    to the shipped models folder."""
+    """The file of a model: a ``package://`` URI (``package://mobee_drake/...``), an absolute
+    path, or a path relative to the shipped models folder."""
     text = str(name)
-    if text.startswith(_PACKAGE_URL):
-        return pathlib.Path(MobeePackageMap().ResolveUrl(text))
+    if text.startswith("package://"):
+        return _PackageFile(text)
     path = pathlib.Path(text)
     return path if path.is_absolute() else ModelsDirectory() / path
 
@@ -56,17 +65,7 @@ def ResolveModelPath(name: str) -> pathlib.Path:
     Raises:
         ValueError: naming the URI's unknown package, or the missing file.
     """
-    if name.startswith("package://"):
-        package = name[len("package://") :].split("/", 1)[0]
-        if not MobeePackageMap().Contains(package):
-            raise ValueError(
-                f"{name}: unknown package '{package}' (known: "
-                + ", ".join(sorted(MobeePackageMap().GetPackageNames()))
-                + "; add yours to ROS_PACKAGE_PATH)"
-            )
-        path = pathlib.Path(MobeePackageMap().ResolveUrl(name))
-    else:
-        path = pathlib.Path(name)
+    path = _PackageFile(name) if name.startswith("package://") else pathlib.Path(name)
     if not path.is_file():
         raise ValueError(f"{name}: no such file")
     return path

@@ -63,16 +63,14 @@ class PointingController(LeafSystem):
     ):
         super().__init__()
         n, m = len(mobee.joints), len(mobee.marker_names)
-        self._plant, self._gain, self._damping = plant, gain, damping
+        self._plant, self._mobee, self._gain, self._damping = plant, mobee, gain, damping
         self._home = mobee.home
         self._owned = np.array([mobee.joint_index(j) for j in joints], dtype=int)
         self._marker = mobee.marker_index(marker)
         self._body = mobee.marker_body(marker)
-        S, s0 = mobee.PlantStateMap()
-        nq = plant.num_positions()
-        self._position_map, self._position_offset = S[:nq, :n], s0[:nq]
+        S, _ = mobee.PlantStateMap()
         # The owned joints' columns of the map from MoBeE's joint velocities to the plant's.
-        self._velocity_map = S[nq:, n:][:, self._owned]
+        self._velocity_map = S[plant.num_positions() :, n:][:, self._owned]
         limits = [plant.GetJointByName(j) for j in joints]
         self._lower = np.array([j.position_lower_limits()[0] for j in limits])
         self._upper = np.array([j.position_upper_limits()[0] for j in limits])
@@ -97,8 +95,7 @@ class PointingController(LeafSystem):
 
     def _CalcPlantContext(self, context, value) -> None:
         q = self._state.Eval(context)[: len(self._home)]
-        positions = self._position_map @ q + self._position_offset
-        self._plant.SetPositions(value.get_mutable_value(), positions)
+        self._plant.SetPositions(value.get_mutable_value(), self._mobee.PlantPositions(q))
 
     def _Error(self, context) -> tuple[float, np.ndarray]:
         i = self._marker

@@ -94,15 +94,14 @@ class TorsoPlacement(LeafSystem):
         self._map, self._home, self._joints = reach_map, mobee.home, list(joints)
         self._owned = np.array([mobee.joint_index(j) for j in joints], dtype=int)
         self._postures = np.asarray(postures, dtype=float)
-        S, s0 = mobee.PlantStateMap()
-        nq, n = plant.num_positions(), len(self._home)
+        n = len(self._home)
         context = plant.CreateDefaultContext()
         shoulder = plant.GetJointByName(shoulder_joint).frame_on_parent()
 
         def Shoulder(posture):
             q = self._home.copy()
             q[self._owned] = posture
-            plant.SetPositions(context, S[:nq, :n] @ q + s0[:nq])
+            plant.SetPositions(context, mobee.PlantPositions(q))
             return shoulder.CalcPoseInWorld(context)
 
         at_home = Shoulder(self._home[self._owned])

@@ -111,10 +111,7 @@ def TorsoReachRobot(
 def Beyond(robot: SimulatedRobot, targets: np.ndarray, distance: float) -> np.ndarray:
     """``targets`` moved ``distance`` farther from the shoulder (as it stands at home: where the
     arm's first joint sits on the chest)."""
-    plant = robot.station.plant
-    frame = plant.GetJointByName(RIGHT_ARM[0]).frame_on_parent()
-    shoulder = frame.CalcPoseInWorld(plant.CreateDefaultContext()).translation()
-    away = targets - shoulder
+    away = targets - robot.shoulder_at_home.translation()
     return targets + distance * away / np.linalg.norm(away, axis=1, keepdims=True)
 
 

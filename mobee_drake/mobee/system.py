@@ -397,6 +397,11 @@ class Mobee(LeafSystem):
         """The joints that follow the controlled ones (a motor's other joints)."""
         return self._robot.followers
 
+    def PlantPositions(self, q: np.ndarray) -> np.ndarray:
+        """The plant's positions with MoBeE's joints at ``q`` (their followers following), the
+        other joints at their defaults."""
+        return self._robot.PlantPositions(q, self._default_positions.copy())
+
     def PlantStateMap(self) -> tuple[np.ndarray, np.ndarray]:
         """(S, s0) with ``x_plant = S [q; v] + s0`` for this robot's entries of the plant's state
         (its controlled joints and the joints that follow them)."""
@@ -451,8 +456,7 @@ class Mobee(LeafSystem):
     def _CalcPlantContext(self, context, value) -> None:
         plant_context = value.get_mutable_value()
         q, _ = self._ReadState(context)
-        positions = self._robot.PlantPositions(q, self._default_positions.copy())
-        self._plant.SetPositions(plant_context, positions)
+        self._plant.SetPositions(plant_context, self.PlantPositions(q))
 
     def _CalcFieldPairs(self, context, output) -> None:
         output.set_value(self._fields.FindPairs(self._query_port.Eval(context)))

@@ -81,9 +81,6 @@ class SimulatedRobot:
         self.target: np.ndarray | None = None
         # The shoulder's frame, and where it stands with every joint at home (a scratch plant
         # context: the station's plant is not simulated).
-        S, s0 = mobee.PlantStateMap()
-        nq, n = plant.num_positions(), len(self._home)
-        self._position_map, self._position_offset = S[:nq, :n], s0[:nq]
         self._scratch = plant.CreateDefaultContext()
         self._shoulder = plant.GetJointByName(joints[0]).frame_on_parent()
         self._shoulder_at_home = self._ShoulderPose(self._home)
@@ -161,9 +158,13 @@ class SimulatedRobot:
     def _ShoulderPose(self, q: np.ndarray) -> RigidTransform:
         """X_WS: the shoulder's frame (where the MDP's first joint sits on its parent body) with
         MoBeE's joints at ``q``."""
-        positions = self._position_map @ q + self._position_offset
-        self.station.plant.SetPositions(self._scratch, positions)
+        self.station.plant.SetPositions(self._scratch, self.station.mobee.PlantPositions(q))
         return self._shoulder.CalcPoseInWorld(self._scratch)
+
+    @property
+    def shoulder_at_home(self) -> RigidTransform:
+        """X_WS with every joint at home: the learning frame's place in the world."""
+        return self._shoulder_at_home
 
     def LearningFrame(self, target: np.ndarray) -> np.ndarray:
         """``target`` where it is relative to the shoulder now, put back in the world as the

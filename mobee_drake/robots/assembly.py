@@ -22,6 +22,17 @@ from mobee_drake.robots.overlay import (
 )
 
 
+def ModelParser(
+    plant: MultibodyPlant, model_name: str | None, package_map: PackageMap | None = None
+) -> Parser:
+    """Drake's parser for ``plant`` (models named ``model_name``), resolving ``package://`` URIs
+    with ``package_map`` besides its own."""
+    parser = Parser(plant, model_name)
+    if package_map is not None:
+        parser.package_map().AddMap(package_map)
+    return parser
+
+
 def AddRobotWithOverlay(
     plant: MultibodyPlant,
     scene_graph: SceneGraph,
@@ -52,16 +63,10 @@ def AddRobotWithOverlay(
     """
     model_file = str(model_file)
 
-    def add_model(p: MultibodyPlant) -> ModelInstanceIndex:
-        parser = Parser(p, model_name)
-        if package_map is not None:
-            parser.package_map().AddMap(package_map)
-        return parser.AddModels(model_file)[0]
-
     return AddModelWithOverlay(
         plant,
         scene_graph,
-        add_model=add_model,
+        add_model=lambda p: ModelParser(p, model_name, package_map).AddModels(model_file)[0],
         overlay=LoadOverlay(overlay_file),
         controlled_joints=controlled_joints,
         home=home,

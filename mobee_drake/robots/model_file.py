@@ -16,12 +16,11 @@ import math
 
 from pydrake.geometry import IllustrationProperties, Rgba, RoleAssign, SceneGraph
 from pydrake.math import RigidTransform
-from pydrake.multibody.parsing import Parser
 from pydrake.multibody.plant import MultibodyPlant
 from pydrake.multibody.tree import ModelInstanceIndex
 
 from mobee_drake.resources import MobeePackageMap, ResolveModelPath
-from mobee_drake.robots.assembly import AddRobotWithOverlay
+from mobee_drake.robots.assembly import AddRobotWithOverlay, ModelParser
 from mobee_drake.robots.overlay import LoadOverlay, RobotOverlay
 
 # The colour of a visual without one of its own (Drake's default grey).
@@ -46,18 +45,14 @@ class ModelFileConfig:
         return {name: math.radians(value) for name, value in self.home_deg.items()}
 
 
-def _Parser(plant: MultibodyPlant, model_name: str | None) -> Parser:
-    parser = Parser(plant, model_name)
-    parser.package_map().AddMap(MobeePackageMap())
-    return parser
-
-
 def MovingJoints(config: ModelFileConfig) -> list[str]:
     """The joints MoBeE controls: the configured ones, or every joint of the model that moves."""
     if config.controlled_joints:
         return list(config.controlled_joints)
     scratch = MultibodyPlant(0.0)
-    (instance,) = _Parser(scratch, None).AddModels(str(ResolveModelPath(config.file)))
+    (instance,) = ModelParser(scratch, None, MobeePackageMap()).AddModels(
+        str(ResolveModelPath(config.file))
+    )
     return [
         scratch.get_joint(i).name()
         for i in scratch.GetJointIndices(instance)
@@ -98,7 +93,9 @@ def AddTintedModel(
 ) -> tuple[ModelInstanceIndex, str]:
     """Adds the robot's model alone (no overlay) to ``plant``, every visual drawn with opacity
     ``alpha``; returns its instance and its overlay's reference link."""
-    (instance,) = _Parser(plant, "attractor").AddModels(str(ResolveModelPath(config.file)))
+    (instance,) = ModelParser(plant, "attractor", MobeePackageMap()).AddModels(
+        str(ResolveModelPath(config.file))
+    )
     source = plant.get_source_id()
     inspector = scene_graph.model_inspector()
     for index in plant.GetBodyIndices(instance):
