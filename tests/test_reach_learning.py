@@ -15,6 +15,7 @@ from pydrake.common.value import AbstractValue
 from pydrake.math import RigidTransform, RotationMatrix
 from pydrake.systems.analysis import Simulator
 
+from mobee_drake.behaviours.torso import PostureGrid
 from mobee_drake.experiments.ch8_reaching import LoadTrainedLearner
 from mobee_drake.mobee.fields import FieldPairs
 from mobee_drake.planning.supervisor import ActionTiming
@@ -284,6 +285,28 @@ class TestBattery(unittest.TestCase):
         self.assertEqual(watched.appeared_inside, 1)
         self.assertGreater(robot.Safety().penetrating_steps, 0)
         self.assertEqual(watched.other, 0)
+        # With --settle the torso comes to rest where the module puts it before the arm acts.
+        # The evidence map is made to peak (a record above any reach's reward) where one of the
+        # grid's postures would show the target: the torso settles in that posture.
+        module = torso_reach.TorsoModule("evidence", levels=3, range_fraction=0.8, settle=True)
+        self.assertEqual(module.Label(), "evidence-levels3-range0.8-settled")
+        self.assertEqual(torso_reach.TorsoModule().Label(), "")
+        mobee, target = robot.station.mobee, moved[0] + inside[0]
+        posture = PostureGrid(mobee, TORSO_JOINTS, 3, 0.8)[12]  # (yaw -40 deg)
+        torso = np.array([mobee.joint_index(j) for j in TORSO_JOINTS])
+        q = mobee.home.copy()
+        q[torso] = posture
+        robot.MoveTo(q)
+        learner.histories.Record(learner.num_transitions, robot.LearningFrame(target), 0.0, 5.0)
+        robot = torso_reach.TorsoReachRobot(learner, grid.radius, torso=True, module=module)
+        began = robot.context.get_time()
+        torso_reach.SettledTorso(robot).SetProblem(target)
+        x = robot.station.robot_state.Eval(robot.context)
+        np.testing.assert_allclose(x[torso], posture, atol=np.radians(2.0))
+        self.assertLess(np.abs(x[len(mobee.joints) + torso]).max(), np.radians(2.0))
+        self.assertGreater(robot.context.get_time(), began + 1.0)
+        executor = robot.executor
+        self.assertEqual(executor.CompletedActions(executor.GetMyContextFromRoot(robot.context)), 0)
 
     def test_a_noisy_robot_sometimes_settles_in_another_state(self):
         """Issue 33: with actuation noise (sd 0.2 of each joint's range: a joint leaves its state

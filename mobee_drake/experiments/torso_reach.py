@@ -14,9 +14,11 @@ two measures; on the inside targets the comparison is the check that the module 
 what the arm reaches alone.
 
 Run: ``mobee-drake experiment torso-reach --learner results/ch8/runs/<run> [--seeds 10]
-[--beyond 0.1] [--output results/torso_reach] [--doc docs/behaviours.md]``.
+[--beyond 0.1] [--map evidence] [--torso-levels 9] [--torso-range 0.8] [--settle]
+[--output results/torso_reach] [--doc docs/behaviours.md]``.
 """
 
+import argparse
 import dataclasses as dc
 import pathlib
 import time
@@ -43,6 +45,7 @@ from mobee_drake.scenario import BuildScenario
 from mobee_drake.station.builder import MakeMobeeStation
 from mobee_drake.station.composition import Behaviour, ComposeBehaviours
 from mobee_drake.station.safety import Penetrations
+from mobee_drake.station.settling import ActionTiming
 
 TARGET_SETS = ("inside", "outside")
 CONDITIONS = ("off", "on")
@@ -79,17 +82,44 @@ class TorsoReachRun:
         return float(np.mean(reached)) if reached else float("nan")
 
 
+@dc.dataclass(frozen=True)
+class TorsoModule:
+    """The torso module's settings: its reach map (one of REACH_MAPS), its grid of postures
+    (``levels`` angles per joint over ``range_fraction`` of each joint's range), and whether the
+    torso settles where the module puts it before the arm's first action of each problem."""
+
+    reach_map: str = "prediction"
+    levels: int = PlaceTorso.levels
+    range_fraction: float = PlaceTorso.range_fraction
+    settle: bool = False
+
+    def Label(self) -> str:
+        """The settings that differ from the defaults, joined by '-' ('' for none)."""
+        default = TorsoModule()
+        parts = [self.reach_map] if self.reach_map != default.reach_map else []
+        if self.levels != default.levels:
+            parts.append(f"levels{self.levels}")
+        if self.range_fraction != default.range_fraction:
+            parts.append(f"range{self.range_fraction:g}")
+        return "-".join(parts + (["settled"] if self.settle else []))
+
+
 def TorsoReachRobot(
-    learner, radius: float, torso: bool, reach_map: str = "prediction"
+    learner, radius: float, torso: bool, module: TorsoModule = TorsoModule()
 ) -> SimulatedRobot:
     """The reach learner's robot with the torso's joints controlled, and, with ``torso``, the
-    torso module (its map of the kind ``reach_map``) beside the state-action executor."""
+    torso ``module`` beside the state-action executor."""
     scenario = ReachScenario()
     scenario.robot = IcubConfig(controlled_joints=list(TORSO_JOINTS) + RIGHT_ARM)
     scenario.objects = [TargetObject(_PARKED, radius)]  # SetProblem moves it
     if not torso:
         return SimulatedRobot(BuildScenario(scenario), RIGHT_ARM, learner.space, radius)
-    placement = PlaceTorso(reach_map=ReachMap(learner, reach_map), target=TARGET_NAME)
+    placement = PlaceTorso(
+        reach_map=ReachMap(learner, module.reach_map),
+        target=TARGET_NAME,
+        levels=module.levels,
+        range_fraction=module.range_fraction,
+    )
     station = MakeMobeeStation(
         scenario,
         prebuild_callback=lambda parts: ComposeBehaviours(
@@ -138,19 +168,52 @@ class AppearanceWatch:
         self._start = self.robot.Safety().penetrating_steps
 
 
+class SettledTorso:
+    """The robot, whose torso settles where the module puts it once a problem's target has
+    appeared, before the arm's first action (the arm holds where it is meanwhile): the learner
+    then decides every action of a problem with the torso in place. Settled is the actions'
+    test (:class:`ActionTiming`) on the torso's joints, from the module's first choice."""
+
+    def __init__(self, robot, period: float = PlaceTorso.period):
+        self.robot, self._period, self._timing = robot, period, ActionTiming()
+        mobee = robot.station.mobee
+        self._speeds = len(mobee.joints) + np.array([mobee.joint_index(j) for j in TORSO_JOINTS])
+
+    def __getattr__(self, name):  # (the rest of the Robot protocol, as it is)
+        return getattr(self.robot, name)
+
+    def SetProblem(self, target: np.ndarray) -> None:
+        self.robot.SetProblem(target)
+        simulator, context = self.robot.simulator, self.robot.context
+        simulator.AdvanceTo(context.get_time() + self._period)  # (the module chooses)
+        started, slow_since = context.get_time(), np.inf
+        while True:
+            now = context.get_time()
+            v = self.robot.station.robot_state.Eval(context)[self._speeds]
+            slow_since = self._timing.SlowSince(slow_since, now, v)
+            if self._timing.Ended(now, started, slow_since):
+                return
+            simulator.AdvanceTo(now + self._period / 5)
+
+
 def RunOne(
     run: RunFolder, learner_dir: str, seed: int, targets: str, condition: str, beyond: float,
-    problems: int, reach_map: str = "prediction",
+    problems: int, **module,
 ) -> dict:  # fmt: skip
-    """The battery job: one evaluation of the trained learner."""
+    """The battery job: one evaluation of the trained learner (``module``: the torso module's
+    settings that differ from TorsoModule's defaults)."""
     learner, grid = LoadTrainedLearner(learner_dir)
-    robot = TorsoReachRobot(learner, grid.radius, torso=condition == "on", reach_map=reach_map)
+    module = TorsoModule(**module)
+    on = condition == "on"
+    robot = TorsoReachRobot(learner, grid.radius, torso=on, module=module)
     chosen = grid.Centres()[:problems]
     if targets == "outside":
         chosen = Beyond(robot, chosen, beyond)
     began, start = time.perf_counter(), robot.context.get_time()
     watched = AppearanceWatch(robot)
-    results = learner.Evaluate(watched, seed, chosen)
+    results = learner.Evaluate(
+        SettledTorso(watched) if on and module.settle else watched, seed, chosen
+    )
     watched.Close()
     by_problem = {r.problem: r for r in results}
     distances = [
@@ -224,6 +287,13 @@ def Report(runs: list[TorsoReachRun], within: float, command: str) -> str:
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
 
 
+def _Fraction(text: str) -> float:
+    value = PositiveFloat(text)
+    if value > 1.0:
+        raise argparse.ArgumentTypeError(f"{text} is not a fraction in (0, 1]")
+    return value
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = CommandParser(
         prog="mobee-drake experiment torso-reach", description=__doc__.split("\n\n")[0]
@@ -249,15 +319,41 @@ def main(argv: list[str] | None = None) -> None:
         help="the torso's reach map: eq. 8.5's best prediction, or the best mean reward recorded "
         "within 5 cm (0 where none was)",
     )
+    parser.add_argument(
+        "--torso-levels",
+        type=PositiveInt,
+        default=TorsoModule.levels,
+        help="the torso's grid: angles per joint",
+    )
+    parser.add_argument(
+        "--torso-range",
+        type=_Fraction,
+        default=TorsoModule.range_fraction,
+        help="the torso's grid: the share of each joint's range it spans, around home",
+    )
+    parser.add_argument(
+        "--settle",
+        action="store_true",
+        help="let the torso settle where the module puts it before the arm's first action",
+    )
     parser.add_argument("--output", default="results/torso_reach", help="the battery folder")
     parser.add_argument(
         "--doc",
-        help="a doc whose generated block 'torso-reach' (with --map evidence, "
-        "'torso-reach-evidence') gets the report",
+        help="a doc whose generated block 'torso-reach' gets the report (with the torso "
+        "module's settings that differ from the defaults appended, e.g. "
+        "'torso-reach-evidence-settled')",
     )
     AddBackendArguments(parser)
     args = parser.parse_args(argv)
-    block = "torso-reach" if args.map == "prediction" else f"torso-reach-{args.map}"
+    module = TorsoModule(args.map, args.torso_levels, args.torso_range, args.settle)
+    # (The grid's and settling's settings at their defaults stay out of the jobs, so the
+    # batteries run before they were options keep their jobs.)
+    changed = {
+        field.name: getattr(module, field.name)
+        for field in dc.fields(module)
+        if field.name == "reach_map" or getattr(module, field.name) != field.default
+    }
+    block = "-".join(filter(None, ["torso-reach", module.Label()]))
     try:
         LoadTrainedLearner(args.learner)
         if args.doc:
@@ -276,7 +372,7 @@ def main(argv: list[str] | None = None) -> None:
                 condition=condition,
                 beyond=args.beyond,
                 problems=args.problems,
-                reach_map=args.map,
+                **changed,
             ),
         )  # fmt: skip
         for seed in range(args.seeds)
