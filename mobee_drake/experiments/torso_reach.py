@@ -18,7 +18,6 @@ Run: ``mobee-drake experiment torso-reach --learner results/ch8/runs/<run> [--se
 [--output results/torso_reach] [--doc docs/behaviours.md]``.
 """
 
-import argparse
 import dataclasses as dc
 import pathlib
 import time
@@ -26,7 +25,12 @@ import time
 import numpy as np
 
 from mobee_drake.behaviours.torso import REACH_MAPS, PlaceTorso, ReachMap
-from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
+from mobee_drake.experiments.arguments import (
+    CommandParser,
+    Fraction,
+    PositiveFloat,
+    PositiveInt,
+)
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
@@ -287,13 +291,6 @@ def Report(runs: list[TorsoReachRun], within: float, command: str) -> str:
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
 
 
-def _Fraction(text: str) -> float:
-    value = PositiveFloat(text)
-    if value > 1.0:
-        raise argparse.ArgumentTypeError(f"{text} is not a fraction in (0, 1]")
-    return value
-
-
 def main(argv: list[str] | None = None) -> None:
     parser = CommandParser(
         prog="mobee-drake experiment torso-reach", description=__doc__.split("\n\n")[0]
@@ -327,7 +324,7 @@ def main(argv: list[str] | None = None) -> None:
     )
     parser.add_argument(
         "--torso-range",
-        type=_Fraction,
+        type=Fraction,
         default=TorsoModule.range_fraction,
         help="the torso's grid: the share of each joint's range it spans, around home",
     )
