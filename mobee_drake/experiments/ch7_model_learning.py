@@ -46,10 +46,9 @@ from mobee_drake.experiments.exploration import (
     ExplorationRun,
     ExplorationScenario,
     Explore,
-    Misses,
     StartExploration,
 )
-from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
+from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel, MissShares
 from mobee_drake.planning.planner import GreedyPlan
 from mobee_drake.planning.supervisor import ExploringAgent
 from mobee_drake.robots.icub import (
@@ -398,7 +397,7 @@ def _MovingBox(seed: int, horizon: float) -> tuple[SceneObject, list[WorldEvent]
 
 def _Reliability(explorer) -> np.ndarray:
     """Per state-action, the share of its tries that reached its goal (1 when tried < 5 times)."""
-    return np.where(explorer.tries >= 5, 1 - Misses(explorer), 1.0)
+    return np.where(explorer.tries >= 5, 1 - MissShares(explorer), 1.0)
 
 
 def DetourProblems(space, unreliable: np.ndarray) -> list[tuple[int, int]]:

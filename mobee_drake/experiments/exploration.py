@@ -5,12 +5,11 @@ import dataclasses
 import pathlib
 import time
 
-import numpy as np
 from pydrake.systems.analysis import InitializeParams
 
 from mobee_drake.experiments.battery import JobStopped
 from mobee_drake.mobee.params import Dissertation
-from mobee_drake.planning.explorers import INITIALIZATIONS
+from mobee_drake.planning.explorers import MissShares
 from mobee_drake.planning.supervisor import ExploreAttractor, ExploringAgent
 from mobee_drake.scenario import BuildScenario, ResumableConfiguration, Scenario
 from mobee_drake.station.checkpoint import HasCheckpoint, LoadCheckpoint, SaveCheckpoint
@@ -103,14 +102,6 @@ def StartExploration(scenario: Scenario, checkpoint: pathlib.Path | None = None)
     return station, simulator, supervisor, supervisor.GetMyContextFromRoot(simulator.get_context())
 
 
-def Misses(explorer) -> np.ndarray:
-    """Per state-action, the share of its tries that did not end in its goal state (0 untried)."""
-    space, counts = explorer.space, explorer.transitions.counts
-    initial = 1 + INITIALIZATIONS[explorer.config.initialization]  # goal counts before tries
-    hits = counts[np.arange(space.num_state_actions), space.action_goal] - initial
-    return np.where(explorer.tries > 0, 1 - hits / np.maximum(explorer.tries, 1), 0.0)
-
-
 def Explore(
     scenario: Scenario,
     stop,
@@ -165,7 +156,7 @@ def Explore(
         agents=supervisor.agent_names,
         tries=[r.explorer.tries.tolist() for r in records],
         values=[r.explorer.Values()[0].tolist() for r in records],
-        misses=[Misses(r.explorer).tolist() for r in records],
+        misses=[MissShares(r.explorer).tolist() for r in records],
         goals=[r.explorer.space.centres[r.explorer.space.action_goal].tolist() for r in records],
         actions=[r.actions_done for r in records],
         snapshots=taken,

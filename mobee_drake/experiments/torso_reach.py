@@ -336,10 +336,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--output", default="results/torso_reach", help="the battery folder")
     parser.add_argument(
         "--doc",
-        help="a doc whose generated block 'torso-reach' gets the report (with the torso "
-        "module's settings that differ from the defaults appended, e.g. "
+        help="a doc whose generated block gets the report: --block, or 'torso-reach' with the "
+        "torso module's settings that differ from the defaults appended (e.g. "
         "'torso-reach-evidence-settled')",
     )
+    parser.add_argument("--block", help="the name of the doc's generated block (see --doc)")
     AddBackendArguments(parser)
     args = parser.parse_args(argv)
     module = TorsoModule(args.map, args.torso_levels, args.torso_range, args.settle)
@@ -350,7 +351,7 @@ def main(argv: list[str] | None = None) -> None:
         for field in dc.fields(module)
         if field.name == "reach_map" or getattr(module, field.name) != field.default
     }
-    block = "-".join(filter(None, ["torso-reach", module.Label()]))
+    block = args.block or "-".join(filter(None, ["torso-reach", module.Label()]))
     try:
         LoadTrainedLearner(args.learner)
         if args.doc:

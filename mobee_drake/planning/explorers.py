@@ -119,6 +119,31 @@ class Explorer:
         return self.rewards[state_action]
 
 
+def _InitialCounts(explorer: Explorer) -> np.ndarray:
+    """The counts of Alg. 6's initialisation: each state-action once in its own state, then
+    in its goal (each first observation of an outcome counts 2: the new bin's 1 and itself)."""
+    space = explorer.space
+    rows = np.arange(space.num_state_actions)
+    initial = np.zeros_like(explorer.transitions.counts)
+    initial[rows, space.action_state] = 2.0
+    initial[rows, space.action_goal] = 1.0 + INITIALIZATIONS[explorer.config.initialization]
+    return initial
+
+
+def ObservedOutcomes(explorer: Explorer) -> np.ndarray:
+    """(state-actions, states): the outcomes observed since the initialisation."""
+    counts, initial = explorer.transitions.counts, _InitialCounts(explorer)
+    new_bins = (counts > 0) & (initial == 0)  # (each began with a 1 of its own)
+    return np.rint(counts - initial - new_bins).astype(int)
+
+
+def MissShares(explorer: Explorer) -> np.ndarray:
+    """Per state-action, the share of its tries that did not arrive in its goal (0: untried)."""
+    space = explorer.space
+    hits = ObservedOutcomes(explorer)[np.arange(space.num_state_actions), space.action_goal]
+    return np.where(explorer.tries > 0, 1 - hits / np.maximum(explorer.tries, 1), 0.0)
+
+
 def ExplorerToArrays(explorer: Explorer) -> tuple[dict[str, np.ndarray], dict]:
     """The learned model as arrays (counts, rewards, tries, the space) and the rest as JSON-able
     data (configuration, generator state), for saving and exact resuming."""

@@ -1,0 +1,307 @@
+"""A state-action space that reshapes itself as its agent learns (dissertation ch. 9.4.5).
+
+The source's future work: states found unreachable could be pruned and the interesting regions
+built up, shortcuts made between frequently linked far-apart states and often infeasible
+transitions removed, "all of this ... facilitated by intrinsic motivation": an addition is
+interesting (its model starts optimistic, as every state-action's does, Alg. 6) until it is
+predictable. Each rule below reads only the agent's learned model and what it has done; a round
+of maintenance (:func:`Maintain`) applies every enabled rule at once, and
+:func:`CarryExplorer` moves the learned model onto the new space: nothing learned about a state
+or state-action that stays is lost, and new ones start as the agent's first ones did.
+
+The rules (:class:`MaintenanceConfig` holds their parameters):
+
+- ``prune``: a state no action has ever arrived in, after ``prune_after`` tries of the actions
+  into it, is dropped with every action into or out of it (the lattice's states beyond the
+  shoulder's cable constraints, ch. 7.3). The state the robot is in is never dropped.
+- ``drop``: a transition tried ``drop_after`` times that missed its goal on at least
+  ``drop_miss_share`` of them is removed, unless it is its state's last action.
+- ``shortcut``: when the agent has gone from a state through a second to a third, not a
+  neighbour of the first, ``shortcut_after`` times (two consecutive actions that each arrived),
+  an action from the first straight to the third is added.
+- ``grow``: halfway between a state pruned in this round and each state that had an action into
+  it, a new state, joined both ways to every state within that action's length of it: the
+  boundary of the reachable region is probed more finely, down to ``min_spacing``, and while the
+  space has fewer than ``max_states`` states.
+"""
+
+import dataclasses as dc
+
+import numpy as np
+
+from mobee_drake.planning.explorers import Explorer, MissShares, ObservedOutcomes
+from mobee_drake.planning.state_space import StateActionSpace
+
+RULES = ("prune", "drop", "shortcut", "grow")
+
+
+@dc.dataclass
+class MaintenanceConfig:
+    """When the space is maintained and by which rules (see the module)."""
+
+    # Actions between rounds of maintenance (0: never).
+    every: int = 100
+    rules: list[str] = dc.field(default_factory=lambda: list(RULES))
+    prune_after: int = 6
+    drop_after: int = 5
+    drop_miss_share: float = 0.8
+    shortcut_after: int = 5
+    # A new state is at least this far (fractions of range) from every other.
+    min_spacing: float = 0.05
+    # The space grows while it has fewer states than this (0: no limit).
+    max_states: int = 0
+
+    def Errors(self) -> list[str]:
+        """What is wrong with the settings that their types cannot say (empty: nothing)."""
+        errors = [f"unknown rule '{r}'; the rules are {', '.join(RULES)}" for r in self.rules]
+        errors = [e for e, r in zip(errors, self.rules) if r not in RULES]
+        for name in ("every", "max_states"):
+            if getattr(self, name) < 0:
+                errors.append(f"{name} must be >= 0, got {getattr(self, name)}")
+        for name in ("prune_after", "drop_after", "shortcut_after"):
+            if getattr(self, name) < 1:
+                errors.append(f"{name} must be >= 1, got {getattr(self, name)}")
+        if not 0 < self.drop_miss_share <= 1:
+            errors.append(f"drop_miss_share must be in (0, 1], got {self.drop_miss_share}")
+        if not self.min_spacing > 0:
+            errors.append(f"min_spacing must be > 0, got {self.min_spacing}")
+        return errors
+
+
+@dc.dataclass(frozen=True)
+class SpaceChange:
+    """One change of a round, in the indices of the space before the round: a ``rule``'s dropped
+    state, dropped or added action (``states``: its state and goal) or new state (``centre``,
+    and ``states``: the pruned state and the state it grew from)."""
+
+    actions_done: int
+    rule: str
+    states: tuple[int, ...]
+    centre: tuple[float, ...] = ()
+
+
+def EditSpace(
+    space: StateActionSpace,
+    *,
+    drop_states=(),
+    drop_actions=(),
+    new_centres=(),
+    new_actions=(),
+) -> tuple[StateActionSpace, np.ndarray, np.ndarray]:
+    """``space`` with ``new_centres`` appended (their indices follow the old states'),
+    ``new_actions`` added ((state, goal) pairs over old and new indices), then
+    ``drop_actions`` (old state-action indices) and ``drop_states`` (old or new indices, with
+    every action into or out of them) removed. Returns the new space, the new index of each old
+    state and of each old state-action (-1: dropped). States keep their order, new ones last;
+    actions are sorted by state, then goal."""
+    centres = np.vstack([space.centres, np.reshape(new_centres, (-1, space.centres.shape[1]))])
+    total = len(centres)
+    kept_states = np.ones(total, dtype=bool)
+    kept_states[list(drop_states)] = False
+    state_index = np.where(kept_states, np.cumsum(kept_states) - 1, -1)
+    old = np.arange(space.num_state_actions)
+    kept_old = np.ones(space.num_state_actions, dtype=bool)
+    kept_old[list(drop_actions)] = False
+    pairs = {
+        (int(s), int(g)): int(sa)
+        for sa, s, g in zip(old, space.action_state, space.action_goal)
+        if kept_old[sa]
+    }
+    for s, g in new_actions:
+        pairs.setdefault((int(s), int(g)), -1)
+    kept = sorted(
+        (state_index[s], state_index[g], sa)
+        for (s, g), sa in pairs.items()
+        if s != g and kept_states[s] and kept_states[g]
+    )
+    action_index = np.full(space.num_state_actions, -1)
+    for new, (_, _, sa) in enumerate(kept):
+        if sa >= 0:
+            action_index[sa] = new
+    states = np.array([s for s, _, _ in kept], dtype=int)
+    goals = np.array([g for _, g, _ in kept], dtype=int)
+    edited = StateActionSpace(centres[kept_states], states, goals)
+    return edited, state_index[: space.num_states], action_index
+
+
+def CarryExplorer(
+    explorer: Explorer, space: StateActionSpace, state_index: np.ndarray, action_index: np.ndarray
+) -> Explorer:
+    """``explorer``'s model moved onto ``space`` (see :func:`EditSpace` for the indices): each
+    kept state-action keeps its counts, intrinsic reward and tries, its outcomes in kept states
+    (prune drops only states no action arrived in, so no outcome observed is lost); new
+    state-actions start optimistic (Alg. 6's initialisation). The generator carries on."""
+    carried = Explorer(space, explorer.config)
+    carried.rng = explorer.rng
+    old = np.flatnonzero(action_index >= 0)
+    new = action_index[old]
+    columns = np.flatnonzero(state_index >= 0)
+    counts = np.zeros((len(old), space.num_states))
+    counts[:, state_index[columns]] = explorer.transitions.counts[np.ix_(old, columns)]
+    carried.transitions.counts[new] = counts
+    carried.rewards[new] = explorer.rewards[old]
+    carried.tries[new] = explorer.tries[old]
+    return carried
+
+
+class Maintenance:
+    """One agent's space maintenance: its settings, what it has seen of the agent's chains of
+    actions (for ``shortcut``), and every change made so far."""
+
+    def __init__(self, config: MaintenanceConfig, num_states: int):
+        for error in config.Errors():
+            raise ValueError(f"space maintenance: {error}")
+        self.config = config
+        # chains[a, c]: how often the agent went a -> b -> c, each action arriving.
+        self.chains = np.zeros((num_states, num_states), dtype=int)
+        self._previous = -1  # the start of the last action, if it arrived (else -1)
+        self.changes: list[SpaceChange] = []
+
+    def Observe(self, space: StateActionSpace, state: int, state_action: int, outcome: int):
+        """Notes an action's outcome (the agent's model observes it separately)."""
+        arrived = outcome == space.action_goal[state_action]
+        if arrived and self._previous >= 0 and self._previous != outcome:
+            self.chains[self._previous, outcome] += 1
+        self._previous = state if arrived else -1
+
+    def Due(self, actions_done: int) -> bool:
+        """Whether a round is due after ``actions_done`` actions."""
+        every = self.config.every
+        return every > 0 and actions_done > 0 and actions_done % every == 0
+
+    def Apply(self, explorer: Explorer, state: int, actions_done: int) -> tuple[Explorer, int]:
+        """A round of every enabled rule on ``explorer``'s space, the robot in ``state``:
+        the explorer on the new space and the robot's state there. A state whose every action
+        would go (to pruned states, with nothing grown beside it) keeps those goals."""
+        space = explorer.space
+        pruned = _Prunable(explorer, self.config, state) if "prune" in self.config.rules else []
+        while True:
+            changes = self._Changes(explorer, pruned, actions_done)
+            if not changes:
+                return explorer, state
+            edited, state_index, action_index = EditSpace(
+                space,
+                drop_states=pruned,
+                drop_actions=[_ActionOf(space, *c.states) for c in changes if c.rule == "drop"],
+                new_centres=[c.centre for c in changes if c.rule == "grow"],
+                new_actions=_NewActions(space, changes),
+            )
+            kept = np.flatnonzero(state_index >= 0)
+            stranded = kept[
+                np.bincount(edited.action_state, minlength=edited.num_states)[state_index[kept]]
+                == 0
+            ]
+            if not len(stranded):
+                break
+            goals = space.action_goal[np.isin(space.action_state, stranded)]
+            pruned = [u for u in pruned if u not in goals]
+        for change in changes:
+            if change.rule == "shortcut":  # (an action now: no chain to count)
+                self.chains[change.states] = 0
+        self.chains = _Moved(self.chains, state_index, edited.num_states)
+        self._previous = state_index[self._previous] if self._previous >= 0 else -1
+        self.changes += changes
+        carried = CarryExplorer(explorer, edited, state_index, action_index)
+        return carried, int(state_index[state])
+
+    def _Changes(
+        self, explorer: Explorer, pruned: list[int], actions_done: int
+    ) -> list[SpaceChange]:
+        """Every enabled rule's changes, given the states to prune."""
+        config, space, rules = self.config, explorer.space, set(self.config.rules)
+        changes = [SpaceChange(actions_done, "prune", (s,)) for s in pruned]
+        if "drop" in rules:
+            changes += [
+                SpaceChange(
+                    actions_done, "drop", (int(space.action_state[sa]), int(space.action_goal[sa]))
+                )
+                for sa in _Droppable(explorer, config, pruned)
+            ]
+        if "shortcut" in rules:
+            changes += [
+                SpaceChange(actions_done, "shortcut", pair) for pair in self._Shortcuts(space)
+            ]
+        if "grow" in rules:
+            changes += _Growth(space, config, pruned, actions_done)
+        return changes
+
+    def _Shortcuts(self, space: StateActionSpace) -> list[tuple[int, int]]:
+        linked = set(zip(space.action_state.tolist(), space.action_goal.tolist()))
+        often = np.argwhere(self.chains >= self.config.shortcut_after)
+        return [(int(a), int(c)) for a, c in often if (a, c) not in linked]
+
+
+def _ActionOf(space: StateActionSpace, state: int, goal: int) -> int:
+    actions = space.Actions(state)
+    return int(actions[space.action_goal[actions] == goal][0])
+
+
+def _Prunable(explorer: Explorer, config: MaintenanceConfig, state: int) -> list[int]:
+    """States never arrived in whose incoming actions were tried ``prune_after`` times."""
+    space = explorer.space
+    arrived = ObservedOutcomes(explorer).sum(axis=0) > 0
+    tried_into = np.bincount(space.action_goal, weights=explorer.tries, minlength=space.num_states)
+    prunable = ~arrived & (tried_into >= config.prune_after)
+    prunable[state] = False
+    return np.flatnonzero(prunable).tolist()
+
+
+def _Droppable(explorer: Explorer, config: MaintenanceConfig, pruned: list[int]) -> list[int]:
+    """Often infeasible transitions of the states that stay, each state keeping an action."""
+    space = explorer.space
+    infeasible = (explorer.tries >= config.drop_after) & (
+        MissShares(explorer) >= config.drop_miss_share
+    )
+    infeasible &= ~np.isin(space.action_goal, pruned)  # (dropped with their goal anyway)
+    dropped = []
+    for s in range(space.num_states):
+        if s in pruned:
+            continue
+        actions = space.Actions(s)
+        staying = actions[~np.isin(space.action_goal[actions], pruned)]
+        bad = staying[infeasible[staying]]
+        if len(bad) == len(staying):  # (its best-known action stays)
+            bad = bad[np.argsort(MissShares(explorer)[bad], kind="stable")[1:]]
+        dropped += bad.tolist()
+    return dropped
+
+
+def _Growth(
+    space: StateActionSpace, config: MaintenanceConfig, pruned: list[int], actions_done: int
+) -> list[SpaceChange]:
+    """New states halfway between each pruned state and the states with an action into it."""
+    centres, grown = space.centres, []
+    for u in pruned:
+        for r in space.action_state[space.action_goal == u]:
+            if r in pruned:
+                continue
+            if config.max_states and space.num_states + len(grown) >= config.max_states:
+                return grown
+            middle = (centres[r] + centres[u]) / 2
+            others = np.vstack([centres, [c.centre for c in grown]]) if grown else centres
+            if np.linalg.norm(others - middle, axis=1).min() >= config.min_spacing:
+                grown.append(SpaceChange(actions_done, "grow", (u, int(r)), tuple(middle)))
+    return grown
+
+
+def _NewActions(space: StateActionSpace, changes: list[SpaceChange]) -> list[tuple[int, int]]:
+    """The shortcuts, and each new state joined both ways to every state (old or new) within
+    the length of the action it grew from."""
+    pairs = [c.states for c in changes if c.rule == "shortcut"]
+    grown = [c for c in changes if c.rule == "grow"]
+    centres = np.vstack([space.centres] + [[c.centre] for c in grown])
+    for i, change in enumerate(grown):
+        new = space.num_states + i
+        u, r = change.states
+        reach = np.linalg.norm(space.centres[u] - space.centres[r]) + 1e-9
+        near = np.flatnonzero(np.linalg.norm(centres - centres[new], axis=1) <= reach)
+        pairs += [(new, int(o)) for o in near if o != new] + [(int(o), new) for o in near]
+    return pairs
+
+
+def _Moved(chains: np.ndarray, state_index: np.ndarray, num_states: int) -> np.ndarray:
+    """The chain counts of the states that stay, in their new indices (new states: none)."""
+    moved = np.zeros((num_states, num_states), dtype=int)
+    kept = np.flatnonzero(state_index >= 0)
+    moved[np.ix_(state_index[kept], state_index[kept])] = chains[np.ix_(kept, kept)]
+    return moved

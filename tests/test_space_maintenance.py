@@ -1,0 +1,187 @@
+"""A state-action space that reshapes itself (ch. 9.4.5): each rule and the carried-over model
+against closed forms on small spaces."""
+
+import unittest
+
+import numpy as np
+
+from mobee_drake.planning.explorers import Explorer, MissShares, ObservedOutcomes
+from mobee_drake.planning.space_maintenance import (
+    CarryExplorer,
+    EditSpace,
+    Maintenance,
+    MaintenanceConfig,
+)
+from mobee_drake.planning.state_space import FromGraph, Lattice
+
+# The square: states 0 (0.25, 0.25), 1 (0.25, 0.75), 2 (0.75, 0.25), 3 (0.75, 0.75); actions
+# 0: 0->1, 1: 0->2, 2: 1->0, 3: 1->3, 4: 2->0, 5: 2->3, 6: 3->1, 7: 3->2.
+SQUARE = Lattice([0.25, 0.75], 2)
+
+
+def _Tried(explorer: Explorer, state_action: int, outcome: int, times: int) -> None:
+    for _ in range(times):
+        explorer.Observe(state_action, outcome)
+
+
+class TestTheModelsStatistics(unittest.TestCase):
+    def test_observed_outcomes_and_misses(self):
+        """A fresh model has observed nothing; then exactly what was observed, a first outcome
+        in a new bin counted once (its bin's own 1 is not an observation)."""
+        explorer = Explorer(SQUARE)
+        self.assertFalse(ObservedOutcomes(explorer).any())
+        _Tried(explorer, 0, 1, 2)  # arrived twice
+        _Tried(explorer, 0, 0, 1)  # stayed once
+        _Tried(explorer, 0, 3, 1)  # a new outcome
+        observed = ObservedOutcomes(explorer)
+        np.testing.assert_array_equal(observed[0], [1, 2, 0, 1])
+        self.assertFalse(observed[1:].any())
+        self.assertAlmostEqual(MissShares(explorer)[0], 0.5)
+        self.assertEqual(MissShares(explorer)[1], 0.0)  # (untried)
+
+
+class TestEditSpace(unittest.TestCase):
+    def test_drop_a_state_add_one_and_actions(self):
+        """Drop state 3 of the square, add a state (index 4 before the drop) joined to 1 and
+        a shortcut 0 -> 4: the remaining actions, renumbered, sorted by state then goal."""
+        edited, state_index, action_index = EditSpace(
+            SQUARE,
+            drop_states=[3],
+            drop_actions=[1],  # 0 -> 2
+            new_centres=[[0.5, 0.75]],
+            new_actions=[(4, 1), (1, 4), (0, 4)],
+        )
+        np.testing.assert_array_equal(state_index, [0, 1, 2, -1])
+        np.testing.assert_allclose(edited.centres, [*SQUARE.centres[:3], [0.5, 0.75]])
+        pairs = list(zip(edited.action_state.tolist(), edited.action_goal.tolist()))
+        self.assertEqual(pairs, [(0, 1), (0, 3), (1, 0), (1, 3), (2, 0), (3, 1)])
+        # 0->1 stays first, 0->2 is dropped, 1->0 third, 1->3 and 2->3 went with state 3 ...
+        np.testing.assert_array_equal(action_index, [0, -1, 2, -1, 4, -1, -1, -1])
+
+    def test_the_model_is_carried_over(self):
+        """Kept state-actions keep counts (columns renumbered), rewards and tries; new ones
+        start as a fresh model's; the generator carries on."""
+        explorer = Explorer(SQUARE, seed=3)
+        _Tried(explorer, 0, 1, 3)
+        _Tried(explorer, 4, 2, 2)  # 2 -> 0 missed twice
+        explorer.rng.random()
+        edited, state_index, action_index = EditSpace(
+            SQUARE, drop_states=[3], new_centres=[[0.5, 0.75]], new_actions=[(4, 1), (1, 4)]
+        )
+        carried = CarryExplorer(explorer, edited, state_index, action_index)
+        fresh = Explorer(edited)
+        for old, new in enumerate(action_index):
+            if new < 0:
+                continue
+            np.testing.assert_array_equal(
+                carried.transitions.counts[new, :3], explorer.transitions.counts[old, :3]
+            )
+            self.assertEqual(carried.tries[new], explorer.tries[old])
+            self.assertEqual(carried.rewards[new], explorer.rewards[old])
+        added = np.setdiff1d(np.arange(edited.num_state_actions), action_index)
+        self.assertEqual(len(added), 2)
+        np.testing.assert_array_equal(
+            carried.transitions.counts[added], fresh.transitions.counts[added]
+        )
+        np.testing.assert_array_equal(carried.rewards[added], fresh.rewards[added])
+        np.testing.assert_array_equal(ObservedOutcomes(carried)[action_index[0]], [0, 3, 0, 0])
+        self.assertEqual(carried.rng.random(), _Generator(3, skip=1).random())
+
+
+def _Generator(seed: int, skip: int) -> np.random.Generator:
+    rng = np.random.default_rng(seed)
+    for _ in range(skip):
+        rng.random()
+    return rng
+
+
+class TestTheRules(unittest.TestCase):
+    def test_an_unreachable_state_is_pruned_and_its_boundary_grown(self):
+        """Every try into state 3 stays where it started: after prune_after of them state 3
+        goes, with its 4 actions, and a state grows halfway between it and each of 1 and 2,
+        joined both ways to the states within a side of it (1 or 2, and each other)."""
+        explorer = Explorer(SQUARE)
+        _Tried(explorer, 3, 1, 3)  # 1 -> 3 stayed in 1
+        _Tried(explorer, 5, 2, 2)  # 2 -> 3 stayed in 2
+        maintenance = Maintenance(MaintenanceConfig(rules=["prune", "grow"], prune_after=6), 4)
+        same, state = maintenance.Apply(explorer, 0, 5)
+        self.assertIs(same, explorer)  # 5 tries: not yet
+        _Tried(explorer, 5, 2, 1)
+        reshaped, state = maintenance.Apply(explorer, 0, 6)
+        self.assertEqual(state, 0)
+        np.testing.assert_allclose(reshaped.space.centres[3:], [[0.5, 0.75], [0.75, 0.5]])
+        pairs = set(zip(reshaped.space.action_state.tolist(), reshaped.space.action_goal.tolist()))
+        grown = {(1, 3), (3, 1), (2, 4), (4, 2), (3, 4), (4, 3)}
+        self.assertEqual(pairs, {(0, 1), (0, 2), (1, 0), (2, 0)} | grown)
+        self.assertEqual(
+            [(c.rule, c.states) for c in maintenance.changes],
+            [("prune", (3,)), ("grow", (3, 1)), ("grow", (3, 2))],
+        )
+        # The 3 tries of 1 -> 3, now 1 -> (0.5, 0.75), are not carried: a new action.
+        self.assertEqual(reshaped.tries.sum(), 0)
+
+    def test_the_robots_state_is_never_pruned(self):
+        explorer = Explorer(SQUARE)
+        _Tried(explorer, 3, 1, 6)
+        reshaped, state = Maintenance(MaintenanceConfig(rules=["prune"]), 4).Apply(explorer, 3, 6)
+        self.assertIs(reshaped, explorer)
+        self.assertEqual(state, 3)
+
+    def test_an_often_infeasible_transition_is_dropped_but_not_a_states_last(self):
+        """0 -> 1 missed 4 of 5: dropped. 2's both actions missed every time: the one that
+        missed least stays."""
+        explorer = Explorer(SQUARE)
+        _Tried(explorer, 0, 0, 4)
+        _Tried(explorer, 0, 1, 1)
+        _Tried(explorer, 4, 2, 5)
+        _Tried(explorer, 5, 2, 4)
+        _Tried(explorer, 5, 3, 1)
+        maintenance = Maintenance(MaintenanceConfig(rules=["drop"]), 4)
+        reshaped, _ = maintenance.Apply(explorer, 0, 10)
+        self.assertEqual([c.states for c in maintenance.changes], [(0, 1), (2, 0)])
+        pairs = set(zip(reshaped.space.action_state.tolist(), reshaped.space.action_goal.tolist()))
+        self.assertEqual(pairs, {(0, 2), (1, 0), (1, 3), (2, 3), (3, 1), (3, 2)})
+
+    def test_a_chain_often_taken_gets_a_shortcut(self):
+        """0 -> 1 -> 3, each arriving, 5 times: an action 0 -> 3 (the diagonal), optimistic.
+        A chain broken by a miss does not count."""
+        maintenance = Maintenance(MaintenanceConfig(rules=["shortcut"], shortcut_after=5), 4)
+        for _ in range(4):
+            maintenance.Observe(SQUARE, 0, 0, 1)
+            maintenance.Observe(SQUARE, 1, 3, 3)
+        maintenance.Observe(SQUARE, 0, 0, 0)  # missed
+        maintenance.Observe(SQUARE, 0, 0, 1)
+        maintenance.Observe(SQUARE, 1, 3, 3)
+        explorer = Explorer(SQUARE)
+        reshaped, _ = maintenance.Apply(explorer, 3, 20)
+        self.assertEqual([c.states for c in maintenance.changes], [(0, 3)])
+        shortcut = reshaped.space.Actions(0)[-1]
+        self.assertEqual(reshaped.space.action_goal[shortcut], 3)
+        self.assertEqual(reshaped.rewards[shortcut], Explorer(reshaped.space).rewards[shortcut])
+        self.assertFalse(maintenance.chains.any())  # (it became an action: counted afresh)
+
+    def test_settings_are_checked(self):
+        with self.assertRaisesRegex(ValueError, "unknown rule 'trim'"):
+            Maintenance(MaintenanceConfig(rules=["trim"]), 4)
+        with self.assertRaisesRegex(ValueError, "drop_miss_share"):
+            Maintenance(MaintenanceConfig(drop_miss_share=0.0), 4)
+        self.assertTrue(Maintenance(MaintenanceConfig(every=50), 4).Due(100))
+        self.assertFalse(Maintenance(MaintenanceConfig(every=0), 4).Due(100))
+
+
+class TestARoadmapSpace(unittest.TestCase):
+    def test_growth_stops_at_the_spacing(self):
+        """On a line 0 - 1 whose state 1 is unreachable, growth halves the gap each round
+        until a new state would be nearer than min_spacing; then the last unreachable state
+        stays, as 0's only action goes to it."""
+        space = FromGraph([[0.0], [0.8]], [(0, 1)])
+        explorer = Explorer(space)
+        maintenance = Maintenance(
+            MaintenanceConfig(rules=["prune", "grow"], prune_after=1, min_spacing=0.15), 2
+        )
+        centres = []
+        for round_ in range(6):
+            _Tried(explorer, explorer.space.Actions(0)[0], 0, 1)
+            explorer, _ = maintenance.Apply(explorer, 0, round_)
+            centres.append(explorer.space.centres[:, 0].tolist())
+        self.assertEqual(centres, [[0.0, 0.4], [0.0, 0.2]] + 4 * [[0.0, 0.2]])
