@@ -53,6 +53,8 @@ def _TypeName(annotation) -> str:
         classes = _Classes(annotation)
         if len(classes) > 1:
             return "one of " + ", ".join(f"`!{c.__name__}`" for c in classes)
+        if classes and type(None) in typing.get_args(annotation):
+            return f"`{classes[0].__name__}` or none"
     if typing.get_origin(annotation) is list and _Classes(annotation):
         return "list of " + " or ".join(f"`{c.__name__}`" for c in _Classes(annotation))
     if typing.get_origin(annotation) in (list, dict):

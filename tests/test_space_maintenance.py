@@ -1,6 +1,7 @@
 """A state-action space that reshapes itself (ch. 9.4.5): each rule and the carried-over model
 against closed forms on small spaces."""
 
+import pathlib
 import unittest
 
 import numpy as np
@@ -185,3 +186,87 @@ class TestARoadmapSpace(unittest.TestCase):
             explorer, _ = maintenance.Apply(explorer, 0, round_)
             centres.append(explorer.space.centres[:, 0].tolist())
         self.assertEqual(centres, [[0.0, 0.4], [0.0, 0.2]] + 4 * [[0.0, 0.2]])
+
+
+class TestOnTheSupervisor(unittest.TestCase):
+    """The supervisor with the robot's state fixed by the test: a robot that never moves."""
+
+    def _Dut(self):
+        from mobee_drake.planning.explorers import ExplorerConfig
+        from mobee_drake.planning.supervisor import ActionTiming, Agent, ExplorationSupervisor
+
+        line = FromGraph([[0.0], [0.5], [1.0]], [(0, 1), (1, 2)])
+        agent = Agent(
+            name="arm",
+            joints=["a"],
+            space=line,
+            explorer=ExplorerConfig(strategy="least_tried"),
+            maintenance=MaintenanceConfig(every=4, rules=["prune", "grow"], prune_after=2),
+        )
+        return ExplorationSupervisor(
+            agents=[agent],
+            joints=["a"],
+            lower=np.array([-1.0]),
+            upper=np.array([1.0]),
+            home=np.array([0.0]),
+            timing=ActionTiming(settle_time=0.0, min_duration=0.0),
+        )
+
+    def _Poll(self, dut, context, actions: int) -> None:
+        for _ in range(actions):  # (each poll ends an action: the robot is still)
+            context.SetTime(context.get_time() + 0.2)
+            dut.CalcForcedUnrestrictedUpdate(context, context.get_mutable_state())
+
+    def test_the_space_closes_in_on_a_robot_that_never_moves(self):
+        """The robot stays at 0.5 (state 1): every try misses. After 4 actions (least-tried:
+        each neighbour twice) both neighbours go and states grow halfway to them, joined to
+        the robot's state and to each other (within the 0.5 they grew from); 4 actions later
+        the same again at a quarter. The data log counts the space and its changes."""
+        dut = self._Dut()
+        context = dut.CreateDefaultContext()
+        dut.GetInputPort("robot_state").FixValue(context, [0.0, 0.0])  # (0.5 of [-1, 1])
+        dut.ExecuteInitializationEvents(context)
+        self._Poll(dut, context, 4)
+        (record,) = dut.Records(context)
+        np.testing.assert_allclose(record.explorer.space.centres[:, 0], [0.5, 0.25, 0.75])
+        self.assertEqual(record.state, 0)
+        np.testing.assert_allclose(dut.GetOutputPort("data_log").Eval(context)[3:], [3, 6, 4])
+        goal = record.explorer.space.action_goal[record.state_action]
+        attractor = dut.GetOutputPort("attractor").Eval(context)
+        self.assertAlmostEqual(attractor[0], -1 + 2 * record.explorer.space.centres[goal, 0])
+        self._Poll(dut, context, 4)
+        (record,) = dut.Records(context)
+        np.testing.assert_allclose(record.explorer.space.centres[:, 0], [0.5, 0.375, 0.625])
+        self.assertEqual(
+            [c.rule for c in record.maintenance.changes], 2 * ["prune", "prune", "grow", "grow"]
+        )
+        self.assertEqual(
+            [name for name, _ in dut.DataLogColumns()][3:],
+            ["agent.arm.states", "agent.arm.state_actions", "agent.arm.space_changes"],
+        )
+
+    def test_a_checkpoint_keeps_the_space_and_its_maintenance(self):
+        """Saved after 6 actions and read into a new supervisor, the run goes on exactly as
+        the one not interrupted."""
+        import tempfile
+
+        straight, resumed = self._Dut(), self._Dut()
+        contexts = []
+        for dut in (straight, resumed):
+            context = dut.CreateDefaultContext()
+            dut.GetInputPort("robot_state").FixValue(context, [0.0, 0.0])
+            dut.ExecuteInitializationEvents(context)
+            contexts.append(context)
+        self._Poll(straight, contexts[0], 6)
+        with tempfile.TemporaryDirectory() as folder:
+            straight.WriteCheckpoint(contexts[0], pathlib.Path(folder))
+            resumed.ReadCheckpoint(contexts[1], pathlib.Path(folder))
+        contexts[1].SetTime(contexts[0].get_time())
+        for dut, context in zip((straight, resumed), contexts):
+            self._Poll(dut, context, 6)
+        (a,), (b,) = (dut.Records(c) for dut, c in zip((straight, resumed), contexts))
+        np.testing.assert_array_equal(a.explorer.space.centres, b.explorer.space.centres)
+        np.testing.assert_array_equal(a.explorer.transitions.counts, b.explorer.transitions.counts)
+        np.testing.assert_array_equal(a.maintenance.chains, b.maintenance.chains)
+        self.assertEqual(a.maintenance.changes, b.maintenance.changes)
+        self.assertEqual(len(a.maintenance.changes), 12)

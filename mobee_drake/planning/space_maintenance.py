@@ -41,10 +41,14 @@ class MaintenanceConfig:
 
     # Actions between rounds of maintenance (0: never).
     every: int = 100
+    # The rules applied at each round, of prune, drop, shortcut and grow.
     rules: list[str] = dc.field(default_factory=lambda: list(RULES))
+    # prune: tries of the actions into a state, none arriving, before the state is dropped.
     prune_after: int = 6
+    # drop: tries of a transition, and the share of them that missed, before it is removed.
     drop_after: int = 5
     drop_miss_share: float = 0.8
+    # shortcut: chains of two arriving actions from one state to a third before the shortcut.
     shortcut_after: int = 5
     # A new state is at least this far (fractions of range) from every other.
     min_spacing: float = 0.05
@@ -224,6 +228,23 @@ class Maintenance:
         if "grow" in rules:
             changes += _Growth(space, config, pruned, actions_done)
         return changes
+
+    def ToData(self) -> tuple[np.ndarray, dict]:
+        """(the chain counts, the rest as JSON-able data), for a checkpoint."""
+        changes = [dc.asdict(c) for c in self.changes]
+        return self.chains.copy(), dict(previous=int(self._previous), changes=changes)
+
+    @classmethod
+    def FromData(cls, config: MaintenanceConfig, chains, data: dict) -> "Maintenance":
+        """The inverse of :meth:`ToData`, under ``config``."""
+        maintenance = cls(config, len(chains))
+        maintenance.chains = np.array(chains, dtype=int)
+        maintenance._previous = data["previous"]
+        maintenance.changes = [
+            SpaceChange(**dict(c, states=tuple(c["states"]), centre=tuple(c["centre"])))
+            for c in data["changes"]
+        ]
+        return maintenance
 
     def _Shortcuts(self, space: StateActionSpace) -> list[tuple[int, int]]:
         linked = set(zip(space.action_state.tolist(), space.action_goal.tolist()))

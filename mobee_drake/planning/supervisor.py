@@ -15,6 +15,7 @@ records are immutable: copying one returns the same object, and an update builds
 of a model.
 """
 
+import copy
 import dataclasses as dc
 import json
 import pathlib
@@ -33,6 +34,7 @@ from mobee_drake.planning.explorers import (
     ExplorerToArrays,
     LoadAgentModel,
 )
+from mobee_drake.planning.space_maintenance import Maintenance, MaintenanceConfig
 from mobee_drake.planning.state_space import FromGraph, Lattice, StateActionSpace
 from mobee_drake.station.parts import ClientPorts, StationParts
 from mobee_drake.station.settling import ActionTiming
@@ -51,9 +53,26 @@ class AgentRecord:
     actions_done: int
     # A planner that arrived in its goal state stops there (its attractor stays on the goal).
     arrived: bool = False
+    # The maintenance of a space that reshapes itself (ch. 9.4.5; None: a fixed space). The
+    # explorer's space is the agent's space now.
+    maintenance: Maintenance | None = None
 
     def __deepcopy__(self, memo) -> "AgentRecord":
         return self
+
+
+# The data log's columns of an agent (and of one whose space reshapes itself): name, unit.
+_LOGGED = (("state", "index"), ("state_action", "index"), ("actions_done", "count"))
+_LOGGED_MAINTENANCE = (("states", "count"), ("state_actions", "count"), ("space_changes", "count"))
+
+
+def _LoggedValues(record: AgentRecord) -> tuple:
+    """The values of an agent's data-log columns (see ExplorationSupervisor.DataLogColumns)."""
+    logged = (record.state, record.state_action, record.actions_done)
+    if record.maintenance is None:
+        return logged
+    space = record.explorer.space
+    return logged + (space.num_states, space.num_state_actions, len(record.maintenance.changes))
 
 
 @dc.dataclass
@@ -68,6 +87,8 @@ class Agent:
     model: Explorer | None = None
     # Seeds the agent's generator (a fresh model's; a given model brings its own).
     seed: int = 0
+    # Reshapes the space as the agent learns (ch. 9.4.5; None: the space stays).
+    maintenance: MaintenanceConfig | None = None
 
 
 class ExplorationSupervisor(LeafSystem):
@@ -150,45 +171,37 @@ class ExplorationSupervisor(LeafSystem):
         # What the station's data log keeps of each agent (see DataLogColumns).
         self.DeclareVectorOutputPort(
             "data_log",
-            3 * len(self._agents),
+            len(self.DataLogColumns()),
             lambda context, output: output.SetFromVector(
-                [
-                    x
-                    for r in self.Records(context)
-                    for x in (r.state, r.state_action, r.actions_done)
-                ]
+                [x for r in self.Records(context) for x in _LoggedValues(r)]
             ),
             prerequisites_of_calc={self.abstract_state_ticket(self._records)},
         )
 
     def DataLogColumns(self) -> list[tuple[str, str]]:
         """Per agent: the state its action started from, the state-action in flight, and the
-        actions it has completed (see :mod:`mobee_drake.station.data_log`)."""
-        return [
-            (f"agent.{agent.name}.{column}", unit)
-            for agent in self._agents
-            for column, unit in (
-                ("state", "index"),
-                ("state_action", "index"),
-                ("actions_done", "count"),
-            )
-        ]
+        actions it has completed; for an agent whose space reshapes itself, also its states,
+        its state-actions and the changes made so far (see :mod:`mobee_drake.station.data_log`).
+        """
+        columns = []
+        for agent in self._agents:
+            logged = _LOGGED + (_LOGGED_MAINTENANCE if agent.maintenance is not None else ())
+            columns += [(f"agent.{agent.name}.{column}", unit) for column, unit in logged]
+        return columns
 
-    def _StateOf(self, agent: Agent, columns: np.ndarray, q: np.ndarray) -> int:
-        return agent.space.StateOfConfiguration(
-            q[columns], self._lower[columns], self._upper[columns]
-        )
+    def _StateOf(self, space: StateActionSpace, columns: np.ndarray, q: np.ndarray) -> int:
+        return space.StateOfConfiguration(q[columns], self._lower[columns], self._upper[columns])
 
     def _Begin(
         self,
-        agent: Agent,
         columns,
         explorer: Explorer,
         q: np.ndarray,
         time: float,
         actions_done: int,
+        maintenance: Maintenance | None,
     ) -> AgentRecord:
-        state = self._StateOf(agent, columns, q)
+        state = self._StateOf(explorer.space, columns, q)
         return AgentRecord(
             explorer=explorer,
             state=state,
@@ -196,13 +209,13 @@ class ExplorationSupervisor(LeafSystem):
             started=time,
             slow_since=np.inf,
             actions_done=actions_done,
+            maintenance=maintenance,
         )
 
     def _Start(self, context, state) -> None:
         q = self._state_port.Eval(context)[: self._n]
         records = tuple(
             self._Begin(
-                agent,
                 columns,
                 agent.model.Copy()
                 if agent.model
@@ -210,6 +223,7 @@ class ExplorationSupervisor(LeafSystem):
                 q,
                 context.get_time(),
                 0,
+                agent.maintenance and Maintenance(agent.maintenance, agent.space.num_states),
             )
             for agent, columns in zip(self._agents, self._columns)
         )
@@ -221,15 +235,16 @@ class ExplorationSupervisor(LeafSystem):
         now, timing = context.get_time(), self._timing
         records = list(context.get_abstract_state(int(self._records)).get_value())
         changed = False
-        for i, (agent, columns) in enumerate(zip(self._agents, self._columns)):
+        for i, columns in enumerate(self._columns):
             record = records[i]
             if record.arrived:
                 continue
             slow_since = timing.SlowSince(record.slow_since, now, v[columns])
             if timing.Ended(now, record.started, slow_since):
                 explorer = record.explorer.Copy()
-                outcome = self._StateOf(agent, columns, q)
+                outcome = self._StateOf(explorer.space, columns, q)
                 explorer.Observe(record.state_action, outcome)
+                explorer, maintenance = self._Maintain(record, explorer, outcome)
                 if explorer.seeks_goal and outcome == explorer.config.goal_state:
                     records[i] = dc.replace(
                         record,
@@ -240,7 +255,7 @@ class ExplorationSupervisor(LeafSystem):
                     )
                 else:
                     records[i] = self._Begin(
-                        agent, columns, explorer, q, now, record.actions_done + 1
+                        columns, explorer, q, now, record.actions_done + 1, maintenance
                     )
                 changed = True
             elif slow_since != record.slow_since:
@@ -249,12 +264,26 @@ class ExplorationSupervisor(LeafSystem):
         if changed:
             state.get_mutable_abstract_state(int(self._records)).set_value(tuple(records))
 
+    @staticmethod
+    def _Maintain(record: AgentRecord, explorer: Explorer, outcome: int):
+        """(the explorer, the maintenance) after the action of ``record`` ended in ``outcome``
+        and ``explorer`` observed it: a round of maintenance when one is due (a copy of the
+        record's maintenance changes; the record stays as it was)."""
+        if record.maintenance is None:
+            return explorer, None
+        maintenance = copy.deepcopy(record.maintenance)
+        maintenance.Observe(record.explorer.space, record.state, record.state_action, outcome)
+        if maintenance.Due(record.actions_done + 1):
+            explorer, _ = maintenance.Apply(explorer, outcome, record.actions_done + 1)
+        return explorer, maintenance
+
     def _CalcAttractor(self, context, output) -> None:
         q_star = self._home.copy()
         records = context.get_abstract_state(int(self._records)).get_value()
         for i, (agent, columns, record) in enumerate(zip(self._agents, self._columns, records)):
             lower, upper = self._lower[columns], self._upper[columns]
-            centre = agent.space.Centre(agent.space.action_goal[record.state_action], lower, upper)
+            space = record.explorer.space
+            centre = space.Centre(space.action_goal[record.state_action], lower, upper)
             q_star[columns] = NoisyPosture(
                 centre, lower, upper, self._noise, agent.seed, i, record.started
             )
@@ -277,7 +306,7 @@ class ExplorationSupervisor(LeafSystem):
         if agent not in self.agent_names:
             raise ValueError(f"unknown agent '{agent}'; agents: " + ", ".join(self.agent_names))
         i = self.agent_names.index(agent)
-        config, columns = self._agents[i], self._columns[i]
+        columns = self._columns[i]
         records = list(self.Records(context))
         explorer = records[i].explorer.Copy()
         if not explorer.seeks_goal:
@@ -285,19 +314,24 @@ class ExplorationSupervisor(LeafSystem):
                 f"agent '{agent}' explores ('{explorer.config.strategy}'); only an agent whose "
                 "strategy seeks a goal (the 'planner') takes goals"
             )
-        if not 0 <= goal < config.space.num_states:
+        space = explorer.space
+        if not 0 <= goal < space.num_states:
             raise ValueError(
-                f"agent '{agent}': goal state {goal} is not a state "
-                f"(0..{config.space.num_states - 1})"
+                f"agent '{agent}': goal state {goal} is not a state (0..{space.num_states - 1})"
             )
         explorer.config = dc.replace(explorer.config, goal_state=goal)
         q = self._state_port.Eval(context)[: self._n]
-        state = self._StateOf(config, columns, q)
+        state = self._StateOf(space, columns, q)
         if state == goal:
             records[i] = dc.replace(records[i], explorer=explorer, state=state, arrived=True)
         else:
             records[i] = self._Begin(
-                config, columns, explorer, q, context.get_time(), records[i].actions_done
+                columns,
+                explorer,
+                q,
+                context.get_time(),
+                records[i].actions_done,
+                records[i].maintenance,
             )
         self.SetRecords(context, tuple(records))
 
@@ -339,8 +373,14 @@ class ExplorationSupervisor(LeafSystem):
         its generator's state and the action in flight) for every agent."""
         for name, record in zip(self.agent_names, self.Records(context)):
             arrays, data = ExplorerToArrays(record.explorer)
+            data["record"] = {
+                field.name: getattr(record, field.name)
+                for field in dc.fields(record)
+                if field.name not in ("explorer", "maintenance")
+            }
+            if record.maintenance is not None:
+                arrays["maintenance_chains"], data["maintenance"] = record.maintenance.ToData()
             np.savez(folder / f"{name}.npz", **arrays)
-            data["record"] = {k: v for k, v in dc.asdict(record).items() if k != "explorer"}
             # Not slow (inf) is written null: JSON has no infinity.
             slow = float(record.slow_since)
             data["record"]["slow_since"] = slow if np.isfinite(slow) else None
@@ -348,12 +388,18 @@ class ExplorationSupervisor(LeafSystem):
 
     def ReadCheckpoint(self, context, folder: pathlib.Path) -> None:
         records = []
-        for name in self.agent_names:
-            data = json.loads((folder / f"{name}.json").read_text())
-            explorer = ExplorerFromArrays(np.load(folder / f"{name}.npz"), data)
+        for agent in self._agents:
+            data = json.loads((folder / f"{agent.name}.json").read_text())
+            arrays = np.load(folder / f"{agent.name}.npz")
+            explorer = ExplorerFromArrays(arrays, data)
             record = data["record"]
             record["slow_since"] = np.inf if record["slow_since"] is None else record["slow_since"]
-            records.append(AgentRecord(explorer=explorer, **record))
+            maintenance = None
+            if agent.maintenance is not None:
+                maintenance = Maintenance.FromData(
+                    agent.maintenance, arrays["maintenance_chains"], data["maintenance"]
+                )
+            records.append(AgentRecord(explorer=explorer, maintenance=maintenance, **record))
         self.SetRecords(context, tuple(records))
 
 
@@ -390,8 +436,11 @@ class ExploringAgent:
     # Actions to the k nearest states; 0: to the nearest equidistant ones.
     nearest: int = 0
     explorer: ExplorerConfig = dc.field(default_factory=ExplorerConfig)
-    # Start from a model learned before: a checkpoint folder holding ``<name>.npz/json``.
+    # Start from a model learned before: a checkpoint folder holding ``<name>.npz/json`` (with
+    # ``maintenance``, its space as it had reshaped itself).
     model: str = ""
+    # Reshape the space as the agent learns (ch. 9.4.5, docs/adaptive_space.md); none: fixed.
+    maintenance: MaintenanceConfig | None = None
 
 
 @dc.dataclass
@@ -443,6 +492,8 @@ class ExploreAttractor:
                 )
             for error in agent.explorer.Errors():
                 raise ValueError(f"{where}: explorer {error}")
+            for error in agent.maintenance.Errors() if agent.maintenance else ():
+                raise ValueError(f"{where}: maintenance {error}")
 
     def AddToBuilder(self, parts: StationParts) -> ClientPorts:
         mobee = parts.mobee
@@ -460,6 +511,8 @@ class ExploreAttractor:
                 if config.model
                 else None
             )
+            if model is not None and config.maintenance is not None:
+                space = model.space  # (as it had reshaped itself)
             agents.append(
                 Agent(
                     name=config.name,
@@ -468,6 +521,7 @@ class ExploreAttractor:
                     explorer=config.explorer,
                     model=model,
                     seed=seed,
+                    maintenance=config.maintenance,
                 )
             )
         supervisor = parts.builder.AddNamedSystem(
