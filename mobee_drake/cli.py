@@ -278,6 +278,10 @@ _BENCHMARKS = {
     "viewer": ("bench_viewer", "Meshcat in a real browser: sizes, stream, slider latency"),
 }
 _EXPERIMENTS = {
+    "adaptive-space": (
+        "adaptive_space",
+        "a state-action space that reshapes itself as the curious agent learns (ch. 9.4.5)",
+    ),
     "ch7": ("ch7_command", "the model-learning experiments of ch. 7 (the curious agent)"),
     "ch8": ("ch8_command", "learning to reach, ch. 8: strategies, readings, claims"),
     "ch8-discounting": (

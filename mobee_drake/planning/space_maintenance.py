@@ -301,7 +301,7 @@ def _Growth(
             middle = (centres[r] + centres[u]) / 2
             others = np.vstack([centres, [c.centre for c in grown]]) if grown else centres
             if np.linalg.norm(others - middle, axis=1).min() >= config.min_spacing:
-                grown.append(SpaceChange(actions_done, "grow", (u, int(r)), tuple(middle)))
+                grown.append(SpaceChange(actions_done, "grow", (u, int(r)), tuple(middle.tolist())))
     return grown
 
 

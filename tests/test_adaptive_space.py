@@ -1,0 +1,74 @@
+"""The adaptive-space experiment (ch. 9.4.5): its measures against closed forms and its smoke
+battery on the robot."""
+
+import contextlib
+import io
+import json
+import pathlib
+import shutil
+import tempfile
+import unittest
+
+import numpy as np
+
+from mobee_drake.experiments import adaptive_space
+from mobee_drake.planning.explorers import Explorer
+from mobee_drake.planning.state_space import Lattice
+
+
+class TestMeasures(unittest.TestCase):
+    def test_coverage_counts_valid_configurations_near_arrived_in_states(self):
+        """Only state 0 (0.25, 0.25) of the square was arrived in: of three valid
+        configurations, the one on it and the one 0.071 away are within 0.1; the one on state
+        3, never arrived in, is not."""
+        explorer = Explorer(Lattice([0.25, 0.75], 2))
+        explorer.Observe(2, 0)  # 1 -> 0 arrived
+        explorer.Observe(0, 0)  # 0 -> 1 stayed in 0
+        valid = np.array([[0.25, 0.25], [0.3, 0.3], [0.75, 0.75]])
+        self.assertAlmostEqual(adaptive_space.Coverage(explorer, valid, 0.1), 2 / 3)
+        self.assertAlmostEqual(adaptive_space.Coverage(explorer, valid, 0.05), 1 / 3)
+        self.assertEqual(adaptive_space.Coverage(Explorer(explorer.space), valid, 1.0), 0.0)
+
+    def test_the_valid_configurations_keep_the_constraints(self):
+        """The sample keeps some draws and drops others (the shoulder's cable constraints cut
+        the corners of the range), all within [0, 1]."""
+        valid = adaptive_space.ValidConfigurations(200, seed=1)
+        self.assertTrue(20 < len(valid) < 200)
+        self.assertTrue(np.all((valid >= 0) & (valid <= 1)))
+
+
+class TestSmokeBattery(unittest.TestCase):
+    def setUp(self):
+        self.output = pathlib.Path(tempfile.mkdtemp()) / "adaptive"
+        self.addCleanup(shutil.rmtree, self.output.parent)
+
+    def test_the_smoke_battery(self):
+        """2 seeds x 40 actions on the rank-4 lattice, fixed and maintained every 10 actions
+        (a state pruned after one try into it): every run reports; only the maintained ones
+        change their space, and its size in the report is what the runs ended with; no
+        penetration."""
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            adaptive_space.main(
+                ["--seeds", "2", "--actions", "40", "--tests", "5", "--every", "10",
+                 "--prune-after", "1", "--spaces", "rank4", "--output", str(self.output),
+                 "--workers", "2"]
+            )  # fmt: skip
+        runs = [
+            adaptive_space.AdaptiveSpaceRun(**json.loads(path.read_text()))
+            for path in self.output.glob("runs/*/result.json")
+        ]
+        self.assertEqual(len(runs), 4)
+        for run in runs:
+            with self.subTest(condition=run.condition, seed=run.seed):
+                self.assertEqual(run.actions, 40)
+                self.assertGreater(run.tests, 0)
+                self.assertEqual(run.penetrating_steps, 0)
+                self.assertTrue(0 < run.coverage < 1)
+                maintained = run.condition == "maintained"
+                self.assertEqual(sum(run.changes.values()) > 0, maintained)
+                self.assertEqual(run.states != 256, maintained)
+        report = (self.output / "report.md").read_text()
+        maintained = [r for r in runs if r.condition == "maintained"]
+        states = np.mean([r.states for r in maintained])
+        self.assertRegex(report, rf"\| rank4 \| maintained \| 2 \| 40 \| .* \| {states:.0f} \|")
+        self.assertIn("rank4, prediction error:", report)
