@@ -4,8 +4,11 @@ The curious agent of ch. 7 explores the right arm's shoulder and elbow for ``--a
 on a fixed space and on the same space maintained by the rules of
 :mod:`mobee_drake.planning.space_maintenance`, ``--seeds`` runs of each, paired by seed (the same
 generator). The spaces (``--spaces``): ch. 7.3's rank-4 lattice at 12.5-87.5 % (256 states; its
-corner states beyond the shoulder's cable constraints are never entered) and ch. 7.2's rank-3
-lattice (81 states, all reachable).
+corner states beyond the shoulder's cable constraints are never entered), ch. 7.2's rank-3
+lattice (81 states, all reachable), and ``trm``: a task-relevant roadmap over the valid
+configurations themselves (:mod:`mobee_drake.trm.configuration`; ``--trm-spacing``, at most
+``--trm-states`` states, the rank-4 lattice's number by default), built once by the battery's
+job ``roadmap``, its vertices the states and its edges the actions both ways.
 
 Per run, at the end:
 
@@ -57,9 +60,13 @@ from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel, Obser
 from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
 from mobee_drake.planning.supervisor import ExploringAgent
 from mobee_drake.robots.icub import IcubConfig
+from mobee_drake.trm.configuration import BuildConfigurationRoadmap
 
-# The spaces compared: their lattice levels (fractions of each joint's range).
-SPACES = {"rank4": [0.125, 0.375, 0.625, 0.875], "rank3": [0.25, 0.5, 0.75]}
+# The lattices compared: their levels (fractions of each joint's range); and "trm", a roadmap
+# over the valid configurations (mobee_drake.trm.configuration), built once per battery.
+LATTICES = {"rank4": [0.125, 0.375, 0.625, 0.875], "rank3": [0.25, 0.5, 0.75]}
+SPACES = (*LATTICES, "trm")
+ROADMAP_JOB = "roadmap"
 CONDITIONS = ("fixed", "maintained")
 AGENT = "right_arm"
 VALID_SAMPLES = 2000
@@ -127,6 +134,15 @@ def PredictionError(explorer, tests: int, seed: int) -> tuple[float, int]:
     return (float(np.mean(errors)) if errors else float("nan")), len(errors)
 
 
+def RoadmapJob(run: RunFolder, *, spacing: float, max_vertices: int) -> dict:
+    """The battery job that builds the "trm" space's roadmap (in ``run.path / "roadmap"``)."""
+    roadmap = BuildConfigurationRoadmap(RIGHT_ARM, spacing, max_vertices, progress=run.Progress)
+    roadmap.Save(run.path / "roadmap")
+    return dict(
+        vertices=len(roadmap.q), edges=len(roadmap.edges), build_seconds=roadmap.build_seconds
+    )
+
+
 def AdaptiveSpaceJob(
     run: RunFolder, *, space: str, condition: str, seed: int, actions: int, tests: int,
     radius: float, maintenance: MaintenanceConfig,
@@ -135,9 +151,12 @@ def AdaptiveSpaceJob(
     agent = ExploringAgent(
         name=AGENT,
         joints=RIGHT_ARM,
-        levels=SPACES[space],
         maintenance=maintenance if condition == "maintained" else None,
     )
+    if space in LATTICES:
+        agent.levels = LATTICES[space]
+    else:
+        agent.roadmap = str(run.path.parent / ROADMAP_JOB / "roadmap")
     explored = ExplorationRun.FromJson(
         ExploreJob(
             run,
@@ -231,7 +250,19 @@ def main(argv: list[str] | None = None) -> None:
     parser = CommandParser(
         prog="mobee-drake experiment adaptive-space", description=__doc__.split("\n\n")[0]
     )
-    parser.add_argument("--spaces", nargs="+", choices=list(SPACES), default=list(SPACES))
+    parser.add_argument("--spaces", nargs="+", choices=SPACES, default=list(SPACES))
+    parser.add_argument(
+        "--trm-spacing",
+        type=PositiveFloat,
+        default=0.5,
+        help="the trm space: its roadmap's spacing d (fractions of range)",
+    )
+    parser.add_argument(
+        "--trm-states",
+        type=PositiveInt,
+        default=256,
+        help="the trm space: at most this many states (the rank-4 lattice's number, by default)",
+    )
     parser.add_argument(
         "--seeds", type=PositiveInt, default=10, help="runs per space and condition"
     )
@@ -300,6 +331,14 @@ def main(argv: list[str] | None = None) -> None:
         for condition in CONDITIONS
     ]
     output = pathlib.Path(args.output)
+    if "trm" in args.spaces:  # (its roadmap first: the trm runs read it)
+        roadmap = Job(
+            ROADMAP_JOB,
+            RoadmapJob,
+            dict(spacing=args.trm_spacing, max_vertices=args.trm_states),
+            total=args.trm_states,
+        )
+        RunBattery([roadmap], output, backend=BackendOf(args), description="trm space")
     results = RunBattery(jobs, output, backend=BackendOf(args), description="adaptive space")
     runs = [AdaptiveSpaceRun(**r) for r in results.values()]
     command = "mobee-drake experiment adaptive-space " + " ".join(argv if argv is not None else [])

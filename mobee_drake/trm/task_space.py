@@ -8,6 +8,8 @@ R^n; it concatenates task functions, each giving one or more coordinates:
 - :class:`MarkerAlong`: a marker's position along one direction ("move the hand back and forth",
   Table 3.2's ``x_1 + x_2 + x_3`` is the direction (1, 1, 1) unnormalised);
 - :class:`JointCoordinates`: some joint positions ("move in the null space of the cost");
+- :class:`JointFractions`: the same as fractions of each joint's range (a roadmap over the
+  configurations themselves, an MDP's state space, ch. 9.4.5);
 - :class:`MarkerAngle`: the angle between a marker's direction and a fixed one ("turn the hand
   with respect to the gaze", Fig. 3.5);
 - :class:`MarkerHeading`: the angle of a marker's direction in a plane, from a reference axis
@@ -60,6 +62,25 @@ class JointCoordinates:
 
 
 @dc.dataclass(frozen=True)
+class JointFractions:
+    """Some joint positions as fractions of their ranges (0 at ``lower``, 1 at ``upper``): a
+    roadmap over the configurations themselves, spread evenly in the units of an MDP's states
+    (ch. 9.4.5)."""
+
+    joints: tuple[int, ...]  # indices into the model's joints
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+
+    @property
+    def size(self) -> int:
+        return len(self.joints)
+
+    def __call__(self, evaluation: PoseEvaluation) -> np.ndarray:
+        lower = np.asarray(self.lower)
+        return (evaluation.q[list(self.joints)] - lower) / (np.asarray(self.upper) - lower)
+
+
+@dc.dataclass(frozen=True)
 class MarkerAngle:
     """arccos(u . direction) (rad): how far a marker's direction is turned from ``direction``."""
 
@@ -97,7 +118,14 @@ class MarkerHeading:
         return np.array([np.arctan2(np.cross(r, u) @ n, r @ u)])
 
 
-TaskFunction = MarkerCoordinates | MarkerAlong | JointCoordinates | MarkerAngle | MarkerHeading
+TaskFunction = (
+    MarkerCoordinates
+    | MarkerAlong
+    | JointCoordinates
+    | JointFractions
+    | MarkerAngle
+    | MarkerHeading
+)
 
 
 @dc.dataclass(frozen=True)
