@@ -37,27 +37,52 @@ class TestMeasures(unittest.TestCase):
         self.assertTrue(np.all((valid >= 0) & (valid <= 1)))
 
 
+class TestConfigurationRoadmap(unittest.TestCase):
+    def test_every_vertex_is_a_valid_configuration_in_fractions(self):
+        """A roadmap of 12 vertices over the right arm's shoulder and elbow: every vertex keeps
+        the limits and the constraints and collides with nothing, its task point is its
+        configuration in fractions of range, and no two are nearer than half the spacing."""
+        from mobee_drake.ngik.kinematic_model import KinematicModel
+        from mobee_drake.robots.icub import IcubConfig
+        from mobee_drake.trm.configuration import BuildConfigurationRoadmap
+
+        roadmap = BuildConfigurationRoadmap(adaptive_space.RIGHT_ARM, 0.6, 12)
+        self.assertEqual(len(roadmap.q), 12)
+        model = KinematicModel(IcubConfig(controlled_joints=adaptive_space.RIGHT_ARM))
+        for q, y in zip(roadmap.q, roadmap.y):
+            self.assertTrue(model.IsValid(q))
+            self.assertFalse(model.Evaluate(q).collision_pairs)
+            np.testing.assert_allclose(y, (q - model.lower) / (model.upper - model.lower))
+        gaps = np.linalg.norm(roadmap.y[:, None] - roadmap.y[None], axis=2)
+        self.assertGreaterEqual(gaps[np.triu_indices(12, 1)].min(), 0.3)
+
+
 class TestSmokeBattery(unittest.TestCase):
     def setUp(self):
         self.output = pathlib.Path(tempfile.mkdtemp()) / "adaptive"
         self.addCleanup(shutil.rmtree, self.output.parent)
 
     def test_the_smoke_battery(self):
-        """2 seeds x 40 actions on the rank-4 lattice, fixed and maintained every 10 actions
-        (a state pruned after one try into it): every run reports; only the maintained ones
-        change their space, and its size in the report is what the runs ended with; no
-        penetration."""
+        """2 seeds x 40 actions on the rank-4 lattice and on a roadmap of 12 states, fixed and
+        maintained every 10 actions (a state pruned after one try into it): every run reports;
+        on the lattice only the maintained ones change their space, and its size in the report
+        is what the runs ended with; no penetration."""
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             adaptive_space.main(
                 ["--seeds", "2", "--actions", "40", "--tests", "5", "--every", "10",
-                 "--prune-after", "1", "--spaces", "rank4", "--output", str(self.output),
-                 "--workers", "2"]
+                 "--prune-after", "1", "--spaces", "rank4", "trm", "--trm-spacing", "0.6",
+                 "--trm-states", "12", "--output", str(self.output), "--workers", "2"]
             )  # fmt: skip
         runs = [
             adaptive_space.AdaptiveSpaceRun(**json.loads(path.read_text()))
-            for path in self.output.glob("runs/*/result.json")
+            for path in self.output.glob("runs/*_seed*/result.json")
         ]
-        self.assertEqual(len(runs), 4)
+        self.assertEqual(len(runs), 8)
+        roadmap = json.loads((self.output / "runs" / "roadmap" / "result.json").read_text())
+        self.assertEqual(roadmap["vertices"], 12)
+        unchanged = [r for r in runs if r.space == "trm" and not sum(r.changes.values())]
+        self.assertTrue(unchanged and all(r.states == 12 for r in unchanged))
+        runs = [r for r in runs if r.space == "rank4"]
         for run in runs:
             with self.subTest(condition=run.condition, seed=run.seed):
                 self.assertEqual(run.actions, 40)
