@@ -17,24 +17,29 @@ from mobee_drake.planning.state_space import Lattice
 
 
 class TestMeasures(unittest.TestCase):
-    def test_coverage_counts_valid_configurations_near_arrived_in_states(self):
-        """Only state 0 (0.25, 0.25) of the square was arrived in: of three valid
-        configurations, the one on it and the one 0.071 away are within 0.1; the one on state
-        3, never arrived in, is not."""
+    def test_the_distance_to_the_nearest_arrived_in_state(self):
+        """Only state 0 (0.25, 0.25) of the square was arrived in: the valid configurations'
+        distances are to it alone, state 3 (never arrived in) does not count."""
         explorer = Explorer(Lattice([0.25, 0.75], 2))
         explorer.Observe(2, 0)  # 1 -> 0 arrived
         explorer.Observe(0, 0)  # 0 -> 1 stayed in 0
         valid = np.array([[0.25, 0.25], [0.3, 0.3], [0.75, 0.75]])
-        self.assertAlmostEqual(adaptive_space.Coverage(explorer, valid, 0.1), 2 / 3)
-        self.assertAlmostEqual(adaptive_space.Coverage(explorer, valid, 0.05), 1 / 3)
-        self.assertEqual(adaptive_space.Coverage(Explorer(explorer.space), valid, 1.0), 0.0)
+        np.testing.assert_allclose(
+            adaptive_space.Nearest(explorer, valid), [0.0, 0.05 * np.sqrt(2), 0.5 * np.sqrt(2)]
+        )
+        fresh = Explorer(explorer.space)
+        self.assertTrue(np.all(np.isinf(adaptive_space.Nearest(fresh, valid))))
 
-    def test_the_valid_configurations_keep_the_constraints(self):
-        """The sample keeps some draws and drops others (the shoulder's cable constraints cut
-        the corners of the range), all within [0, 1]."""
-        valid = adaptive_space.ValidConfigurations(200, seed=1)
-        self.assertTrue(20 < len(valid) < 200)
-        self.assertTrue(np.all((valid >= 0) & (valid <= 1)))
+    def test_the_valid_configurations_keep_the_constraints_and_the_obstacles(self):
+        """The iCub's sample keeps some draws and drops others (the shoulder's cable
+        constraints cut the corners of the range); the Katana has no constraint clauses, but
+        its scenario's obstacles drop some draws too. All within [0, 1]."""
+        arms = adaptive_space.Arms()
+        for name in ("icub", "katana"):
+            with self.subTest(robot=name):
+                valid = adaptive_space.ValidConfigurations(arms[name], 200, seed=1)
+                self.assertTrue(20 < len(valid) < 200)
+                self.assertTrue(np.all((valid >= 0) & (valid <= 1)))
 
 
 class TestConfigurationRoadmap(unittest.TestCase):
@@ -46,9 +51,10 @@ class TestConfigurationRoadmap(unittest.TestCase):
         from mobee_drake.robots.icub import IcubConfig
         from mobee_drake.trm.configuration import BuildConfigurationRoadmap
 
-        roadmap = BuildConfigurationRoadmap(adaptive_space.RIGHT_ARM, 0.6, 12)
+        robot = IcubConfig(controlled_joints=adaptive_space.RIGHT_ARM)
+        roadmap = BuildConfigurationRoadmap(robot, adaptive_space.RIGHT_ARM, 0.6, 12)
         self.assertEqual(len(roadmap.q), 12)
-        model = KinematicModel(IcubConfig(controlled_joints=adaptive_space.RIGHT_ARM))
+        model = KinematicModel(robot)
         for q, y in zip(roadmap.q, roadmap.y):
             self.assertTrue(model.IsValid(q))
             self.assertFalse(model.Evaluate(q).collision_pairs)
@@ -78,7 +84,7 @@ class TestSmokeBattery(unittest.TestCase):
             for path in self.output.glob("runs/*_seed*/result.json")
         ]
         self.assertEqual(len(runs), 8)
-        roadmap = json.loads((self.output / "runs" / "roadmap" / "result.json").read_text())
+        roadmap = json.loads((self.output / "runs" / "icub_roadmap" / "result.json").read_text())
         self.assertEqual(roadmap["vertices"], 12)
         unchanged = [r for r in runs if r.space == "trm" and not sum(r.changes.values())]
         self.assertTrue(unchanged and all(r.states == 12 for r in unchanged))
@@ -95,5 +101,7 @@ class TestSmokeBattery(unittest.TestCase):
         report = (self.output / "report.md").read_text()
         maintained = [r for r in runs if r.condition == "maintained"]
         states = np.mean([r.states for r in maintained])
-        self.assertRegex(report, rf"\| rank4 \| maintained \| 2 \| 40 \| .* \| {states:.0f} \|")
-        self.assertIn("rank4, prediction error:", report)
+        self.assertRegex(
+            report, rf"\| icub \| rank4 \| maintained \| 2 \| 40 \| .* \| {states:.0f} \|"
+        )
+        self.assertIn("icub rank4, prediction error:", report)

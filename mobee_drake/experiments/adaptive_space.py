@@ -14,9 +14,12 @@ Per run, at the end:
 
 - *coverage*: the share of a fixed sample of the arm's valid configurations (within the joint
   limits, every constraint clause satisfied, no collision; ``VALID_SAMPLES`` of them, drawn
-  uniformly in fractions of each joint's range) within ``--radius`` (fractions of range) of the
-  centre of a state the robot arrived in: how much of what the arm can do the agent has been
-  near, whatever its space;
+  uniformly in fractions of each joint's range) within ``--radius`` (fractions of range; by
+  default the lattices' spacing, within which every point of the range lies of some lattice
+  state) of the centre of a state the robot arrived in: how much of what the arm can do the
+  agent has been near, whatever its space;
+- *dispersion*: the mean distance (fractions of range) from those valid configurations to the
+  nearest centre of a state the robot arrived in (no threshold);
 - *prediction error*: ``--tests`` state-actions of states the robot arrived in, drawn at random,
   run once each on a fresh robot (put in the state's centre first; skipped if it does not get
   there): one minus the probability the learned model gave the outcome (held out: the model
@@ -50,7 +53,7 @@ from mobee_drake.experiments.battery import (
     RunFolder,
 )
 from mobee_drake.experiments.ch7_model_learning import RIGHT_ARM, ExploreJob, Stop
-from mobee_drake.experiments.ch8_reaching import ReachRobot
+from mobee_drake.experiments.ch8_reaching import ReachScenario
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
 from mobee_drake.experiments.statistics import ComparePaired, Holm
@@ -59,8 +62,38 @@ from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel, ObservedOutcomes
 from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
 from mobee_drake.planning.supervisor import ExploringAgent
+from mobee_drake.reaching.robot import SimulatedRobot
 from mobee_drake.robots.icub import IcubConfig
+from mobee_drake.robots.zero_position import ZeroPositionConfig
+from mobee_drake.scenario import BuildScenario, LoadScenario
 from mobee_drake.trm.configuration import BuildConfigurationRoadmap
+
+
+@dc.dataclass(frozen=True)
+class Arm:
+    """A robot's arm the agent explores: the scenario's robot, the agent's joints, the reaching
+    marker of the test robot (its state-action executor's), and the world's objects."""
+
+    robot: object
+    joints: tuple[str, ...]
+    marker: str
+    objects: tuple = ()
+
+
+def Arms() -> dict[str, Arm]:
+    """The arms of ``--robots``: the iCub's right shoulder and elbow (ch. 7), and the Katana's
+    first four joints among the shipped Katana scenario's obstacles (App. B), whose states
+    inside them are never entered."""
+    return {
+        "icub": Arm(IcubConfig(controlled_joints=RIGHT_ARM), tuple(RIGHT_ARM), "r_palm"),
+        "katana": Arm(
+            ZeroPositionConfig(file="katana.xml"),
+            ("arm_0", "arm_1", "arm_2", "arm_3"),
+            "wrist",
+            tuple(LoadScenario("katana").objects),
+        ),
+    }
+
 
 # The lattices compared: their levels (fractions of each joint's range); and "trm", a roadmap
 # over the valid configurations (mobee_drake.trm.configuration), built once per battery.
@@ -74,13 +107,16 @@ VALID_SAMPLES = 2000
 
 @dc.dataclass
 class AdaptiveSpaceRun:
-    """One run: a space, fixed or maintained, a seed (see the module for the measures)."""
+    """One run: a robot, a space, fixed or maintained, a seed (see the module for the
+    measures)."""
 
+    robot: str
     space: str
     condition: str
     seed: int
     actions: int
     coverage: float
+    dispersion: float
     prediction_error: float
     tests: int
     tried_share: float
@@ -92,29 +128,41 @@ class AdaptiveSpaceRun:
     penetrating_steps: int
 
 
-def ValidConfigurations(count: int = VALID_SAMPLES, seed: int = 0) -> np.ndarray:
-    """(k, 4): valid configurations of the right arm's shoulder and elbow, as fractions of each
-    joint's range (see the module), from ``count`` uniform draws."""
-    model = KinematicModel(IcubConfig(controlled_joints=RIGHT_ARM))
-    fractions = np.random.default_rng(seed).random((count, len(RIGHT_ARM)))
+def ValidConfigurations(arm: Arm, count: int = VALID_SAMPLES, seed: int = 0) -> np.ndarray:
+    """(k, joints): valid configurations of ``arm``'s joints (the others at home), as fractions
+    of each joint's range (see the module), from ``count`` uniform draws."""
+    model = KinematicModel(arm.robot, list(arm.objects))
+    columns = [model.JointIndex(j) for j in arm.joints]
+    lower, upper = model.lower[columns], model.upper[columns]
     valid = []
-    for f in fractions:
-        q = model.lower + f * (model.upper - model.lower)
+    for f in np.random.default_rng(seed).random((count, len(columns))):
+        q = model.home.copy()
+        q[columns] = lower + f * (upper - lower)
         if model.IsValid(q) and not model.Evaluate(q).collision_pairs:
             valid.append(f)
-    return np.array(valid)
+    return np.array(valid).reshape(-1, len(columns))
 
 
-def Coverage(explorer, valid: np.ndarray, radius: float) -> float:
-    """The share of ``valid`` within ``radius`` of an arrived-in state's centre."""
+def Nearest(explorer, valid: np.ndarray) -> np.ndarray:
+    """Per configuration of ``valid``, its distance to the nearest arrived-in state's centre
+    (inf when the robot arrived nowhere)."""
     arrived = explorer.space.centres[ObservedOutcomes(explorer).sum(axis=0) > 0]
     if not len(arrived):
-        return 0.0
-    nearest = np.min(np.linalg.norm(valid[:, None] - arrived[None], axis=2), axis=1)
-    return float(np.mean(nearest <= radius))
+        return np.full(len(valid), np.inf)
+    return np.min(np.linalg.norm(valid[:, None] - arrived[None], axis=2), axis=1)
 
 
-def PredictionError(explorer, tests: int, seed: int) -> tuple[float, int]:
+def TestRobot(arm: Arm, space) -> SimulatedRobot:
+    """A fresh robot for the held-out tests: the reach learner's station (its state-action
+    executor) with ``arm``'s robot and objects."""
+    scenario = ReachScenario()
+    scenario.robot, scenario.objects = arm.robot, list(arm.objects)
+    scenario.attractor.forcing.marker = arm.marker
+    scenario.visualization.trail_marker = ""  # (headless)
+    return SimulatedRobot(BuildScenario(scenario), list(arm.joints), space, 0.05)
+
+
+def PredictionError(arm: Arm, explorer, tests: int, seed: int) -> tuple[float, int]:
     """(the mean of one minus the model's probability of each held-out test's outcome, the
     tests run): see the module."""
     space = explorer.space
@@ -122,7 +170,7 @@ def PredictionError(explorer, tests: int, seed: int) -> tuple[float, int]:
     candidates = np.flatnonzero(np.isin(space.action_state, arrived))
     rng = np.random.default_rng(seed)
     chosen = rng.choice(candidates, size=min(tests, len(candidates)), replace=False)
-    robot = ReachRobot(space, target_radius=0.05)
+    robot = TestRobot(arm, space)
     T = explorer.transitions.Probabilities()
     errors = []
     for sa in chosen:
@@ -134,9 +182,14 @@ def PredictionError(explorer, tests: int, seed: int) -> tuple[float, int]:
     return (float(np.mean(errors)) if errors else float("nan")), len(errors)
 
 
-def RoadmapJob(run: RunFolder, *, spacing: float, max_vertices: int) -> dict:
-    """The battery job that builds the "trm" space's roadmap (in ``run.path / "roadmap"``)."""
-    roadmap = BuildConfigurationRoadmap(RIGHT_ARM, spacing, max_vertices, progress=run.Progress)
+def RoadmapJob(run: RunFolder, *, robot: str, spacing: float, max_vertices: int) -> dict:
+    """The battery job that builds ``robot``'s "trm" space (its roadmap in ``run.path /
+    "roadmap"``)."""
+    arm = Arms()[robot]
+    roadmap = BuildConfigurationRoadmap(
+        arm.robot, list(arm.joints), spacing, max_vertices, objects=arm.objects,
+        progress=run.Progress,
+    )  # fmt: skip
     roadmap.Save(run.path / "roadmap")
     return dict(
         vertices=len(roadmap.q), edges=len(roadmap.edges), build_seconds=roadmap.build_seconds
@@ -144,28 +197,31 @@ def RoadmapJob(run: RunFolder, *, spacing: float, max_vertices: int) -> dict:
 
 
 def AdaptiveSpaceJob(
-    run: RunFolder, *, space: str, condition: str, seed: int, actions: int, tests: int,
-    radius: float, maintenance: MaintenanceConfig,
+    run: RunFolder, *, robot: str, space: str, condition: str, seed: int, actions: int,
+    tests: int, radius: float, maintenance: MaintenanceConfig,
 ) -> dict:  # fmt: skip
     """The battery job: one run (see the module)."""
+    arm = Arms()[robot]
     agent = ExploringAgent(
         name=AGENT,
-        joints=RIGHT_ARM,
+        joints=list(arm.joints),
         maintenance=maintenance if condition == "maintained" else None,
     )
     if space in LATTICES:
         agent.levels = LATTICES[space]
     else:
-        agent.roadmap = str(run.path.parent / ROADMAP_JOB / "roadmap")
+        agent.roadmap = str(run.path.parent / f"{robot}_{ROADMAP_JOB}" / "roadmap")
     explored = ExplorationRun.FromJson(
         ExploreJob(
             run,
             agents=[agent],
             stop=Stop(actions=actions),
-            labels=dict(space=space, condition=condition, seed=seed),
+            labels=dict(robot=robot, space=space, condition=condition, seed=seed),
+            objects=arm.objects,
             random_seed=seed,
             chunk=5.0,
             keep_model=True,
+            robot=None if robot == "icub" else arm.robot,  # (the iCub's upper body, as ch. 7)
         )
     )
     folder = run.path / "model"
@@ -174,15 +230,18 @@ def AdaptiveSpaceJob(
     changes = collections.Counter(
         c["rule"] for c in saved.get("maintenance", {}).get("changes", [])
     )
-    error, tested = PredictionError(explorer, tests, seed)
+    error, tested = PredictionError(arm, explorer, tests, seed)
     done = explored.actions[0]
+    nearest = Nearest(explorer, ValidConfigurations(arm))
     return dc.asdict(
         AdaptiveSpaceRun(
+            robot=robot,
             space=space,
             condition=condition,
             seed=seed,
             actions=done,
-            coverage=Coverage(explorer, ValidConfigurations(), radius),
+            coverage=float(np.mean(nearest <= radius)),
+            dispersion=float(np.mean(nearest)),
             prediction_error=error,
             tests=tested,
             tried_share=float(np.mean(explorer.tries > 0)),
@@ -198,45 +257,60 @@ def AdaptiveSpaceJob(
 
 _MEASURES = {
     "coverage": lambda r: r.coverage,
+    "dispersion": lambda r: r.dispersion,
     "prediction error": lambda r: r.prediction_error,
     "state-actions tried": lambda r: r.tried_share,
 }
 
 
-def Report(runs: list[AdaptiveSpaceRun], command: str) -> str:
-    """The report's table and the paired comparisons (markdown)."""
-    lines = [
-        "| space | condition | runs | actions | coverage | prediction error (tests) "
-        "| state-actions tried | states | state-actions | changes (prune/drop/shortcut/grow) "
-        "| robot s per action | penetrating periods | wall s per run |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|",
-    ]
+def _Groups(runs: list[AdaptiveSpaceRun]) -> dict[tuple, list[AdaptiveSpaceRun]]:
+    """The runs by (robot, space, condition), each group in seed order."""
     group = collections.defaultdict(list)
     for r in sorted(runs, key=lambda r: r.seed):
-        group[(r.space, r.condition)].append(r)
-    for (space, condition), rs in sorted(group.items()):
-        changes = "/".join(f"{np.mean([r.changes[rule] for r in rs]):.0f}" for rule in RULES)
-        lines.append(
-            f"| {space} | {condition} | {len(rs)} | {np.mean([r.actions for r in rs]):.0f} | "
-            f"{100 * np.mean([r.coverage for r in rs]):.1f} % | "
-            f"{np.nanmean([r.prediction_error for r in rs]):.3f} "
-            f"({np.mean([r.tests for r in rs]):.0f}) | "
-            f"{100 * np.mean([r.tried_share for r in rs]):.0f} % | "
-            f"{np.mean([r.states for r in rs]):.0f} | "
-            f"{np.mean([r.state_actions for r in rs]):.0f} | {changes} | "
-            f"{np.mean([r.robot_seconds_per_action for r in rs]):.2f} | "
-            f"{sum(r.penetrating_steps for r in rs)} | "
-            f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
-        )
+        group[(r.robot, r.space, r.condition)].append(r)
+    return dict(sorted(group.items()))
+
+
+def _Row(key: tuple, rs: list[AdaptiveSpaceRun]) -> str:
+    changes = "/".join(f"{np.mean([r.changes[rule] for r in rs]):.0f}" for rule in RULES)
+    return (
+        f"| {' | '.join(key)} | {len(rs)} | {np.mean([r.actions for r in rs]):.0f} | "
+        f"{100 * np.mean([r.coverage for r in rs]):.1f} % | "
+        f"{np.mean([r.dispersion for r in rs]):.3f} | "
+        f"{np.nanmean([r.prediction_error for r in rs]):.3f} "
+        f"({np.mean([r.tests for r in rs]):.0f}) | "
+        f"{100 * np.mean([r.tried_share for r in rs]):.0f} % | "
+        f"{np.mean([r.states for r in rs]):.0f} | "
+        f"{np.mean([r.state_actions for r in rs]):.0f} | {changes} | "
+        f"{np.mean([r.robot_seconds_per_action for r in rs]):.2f} | "
+        f"{sum(r.penetrating_steps for r in rs)} | "
+        f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
+    )
+
+
+def Report(runs: list[AdaptiveSpaceRun], command: str) -> str:
+    """The report's table and the paired comparisons (markdown)."""
+    group = _Groups(runs)
+    lines = [
+        "| robot | space | condition | runs | actions | coverage | dispersion "
+        "| prediction error (tests) | state-actions tried | states | state-actions "
+        "| changes (prune/drop/shortcut/grow) | robot s per action | penetrating periods "
+        "| wall s per run |",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|",
+        *(_Row(key, rs) for key, rs in group.items()),
+    ]
     compared = {}
-    for space in sorted({r.space for r in runs}):
-        on, off = group[(space, "maintained")], group[(space, "fixed")]
+    for robot, space in sorted({(r.robot, r.space) for r in runs}):
+        on, off = (
+            group.get((robot, space, "maintained"), []),
+            group.get((robot, space, "fixed"), []),
+        )
         seeds = sorted({r.seed for r in on} & {r.seed for r in off})
         if len(seeds) < 2:
             continue
         on, off = ([r for r in rs if r.seed in seeds] for rs in (on, off))
         for name, f in _MEASURES.items():
-            compared[f"{space}, {name}"] = ComparePaired(
+            compared[f"{robot} {space}, {name}"] = ComparePaired(
                 [f(r) for r in on], [f(r) for r in off], [0] * len(seeds)
             )
     if compared:
@@ -250,6 +324,7 @@ def main(argv: list[str] | None = None) -> None:
     parser = CommandParser(
         prog="mobee-drake experiment adaptive-space", description=__doc__.split("\n\n")[0]
     )
+    parser.add_argument("--robots", nargs="+", choices=("icub", "katana"), default=["icub"])
     parser.add_argument("--spaces", nargs="+", choices=SPACES, default=list(SPACES))
     parser.add_argument(
         "--trm-spacing",
@@ -271,7 +346,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--radius",
         type=PositiveFloat,
-        default=0.125,
+        default=0.25,
         help="coverage: a valid configuration this near (fractions of range) an arrived-in "
         "state's centre counts as covered",
     )
@@ -313,9 +388,10 @@ def main(argv: list[str] | None = None) -> None:
     )
     jobs = [
         Job(
-            f"{space}_{condition}_seed{seed}",
+            f"{robot}_{space}_{condition}_seed{seed}",
             AdaptiveSpaceJob,
             dict(
+                robot=robot,
                 space=space,
                 condition=condition,
                 seed=seed,
@@ -327,18 +403,22 @@ def main(argv: list[str] | None = None) -> None:
             total=args.actions,
         )
         for seed in range(args.seeds)
+        for robot in args.robots
         for space in args.spaces
         for condition in CONDITIONS
     ]
     output = pathlib.Path(args.output)
-    if "trm" in args.spaces:  # (its roadmap first: the trm runs read it)
-        roadmap = Job(
-            ROADMAP_JOB,
-            RoadmapJob,
-            dict(spacing=args.trm_spacing, max_vertices=args.trm_states),
-            total=args.trm_states,
-        )
-        RunBattery([roadmap], output, backend=BackendOf(args), description="trm space")
+    if "trm" in args.spaces:  # (the roadmaps first: the trm runs read them)
+        roadmaps = [
+            Job(
+                f"{robot}_{ROADMAP_JOB}",
+                RoadmapJob,
+                dict(robot=robot, spacing=args.trm_spacing, max_vertices=args.trm_states),
+                total=args.trm_states,
+            )
+            for robot in args.robots
+        ]
+        RunBattery(roadmaps, output, backend=BackendOf(args), description="trm spaces")
     results = RunBattery(jobs, output, backend=BackendOf(args), description="adaptive space")
     runs = [AdaptiveSpaceRun(**r) for r in results.values()]
     command = "mobee-drake experiment adaptive-space " + " ".join(argv if argv is not None else [])

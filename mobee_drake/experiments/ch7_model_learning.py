@@ -103,13 +103,15 @@ def ExploreJob(
     table_contacts: bool = False,
     keep_model: bool = False,
     transition_noise: float = 0.0,
+    robot=None,
 ) -> dict:
     """The battery job of one exploration run: ``agents`` explore among ``objects`` until
     ``stop``; the result is :func:`Explore`'s data with ``labels``. With ``keep_model`` the run is
     checkpointed (and resumed after a kill) in ``run.path / "model"``, which keeps the final
     learned models. ``transition_noise`` makes the robot stochastic (see
-    :mod:`mobee_drake.planning.actuation_noise`)."""
-    scenario = ExplorationScenario(agents, objects, random_seed=random_seed)
+    :mod:`mobee_drake.planning.actuation_noise`); ``robot`` is the scenario's robot (the iCub's
+    upper body by default)."""
+    scenario = ExplorationScenario(agents, objects, robot=robot, random_seed=random_seed)
     scenario.world_events = list(world_events)
     scenario.attractor.transition_noise = transition_noise
     explored = Explore(

@@ -76,7 +76,9 @@ def ExplorationScenario(
     configuration, by default the upper body's joints; agent i's generator is seeded with
     ``random_seed + i``)."""
     scenario = Scenario()
-    scenario.robot = robot or scenario.robot
+    if robot is not None:
+        scenario.robot = robot
+        scenario.visualization.trail_marker = ""  # (headless; the default marker is the iCub's)
     scenario.objects = list(objects)
     scenario.attractor = ExploreAttractor(agents=agents)
     scenario.time_step = 0.02

@@ -14,22 +14,23 @@ import numpy as np
 from mobee_drake.ngik.costs import CollisionCost
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.ngik.solver import IkProblem
-from mobee_drake.robots.icub import IcubConfig
 from mobee_drake.trm.roadmap import BuildTrm, TaskRelevantRoadmap, TrmConfig
 from mobee_drake.trm.task_space import JointFractions, TaskSpace
 
 
 def BuildConfigurationRoadmap(
+    robot,
     joints: list[str],
     spacing: float,
     max_vertices: int,
+    *,
+    objects=(),
     seed: int = 0,
-    robot=None,
     progress=None,
 ) -> TaskRelevantRoadmap:
-    """The roadmap over ``joints``' valid configurations of ``robot`` (the iCub with those
-    joints controlled, by default), grown from home (see the module)."""
-    model = KinematicModel(robot or IcubConfig(controlled_joints=list(joints)))
+    """The roadmap over ``joints``' valid configurations of ``robot`` (a scenario's robot
+    configuration) among ``objects``, grown from home (see the module)."""
+    model = KinematicModel(robot, list(objects))
     columns = tuple(model.JointIndex(j) for j in joints)
     problem = IkProblem(model, [CollisionCost()], joints=list(joints))
     task = TaskSpace(
