@@ -105,3 +105,4 @@ class TestSmokeBattery(unittest.TestCase):
             report, rf"\| icub \| rank4 \| maintained \| 2 \| 40 \| .* \| {states:.0f} \|"
         )
         self.assertIn("icub rank4, prediction error:", report)
+        self.assertIn("The trm spaces: icub, 12 states and", report)

@@ -32,7 +32,7 @@ Per run, at the end:
 Maintained minus fixed is compared paired by seed, Holm-corrected over the spaces and the three
 measures.
 
-Run: ``mobee-drake experiment adaptive-space [--seeds 10] [--actions 3000]
+Run: ``mobee-drake experiment adaptive-space [--robots icub katana] [--seeds 10] [--actions 2000]
 [--output results/adaptive_space] [--doc docs/adaptive_space.md]``.
 """
 
@@ -288,8 +288,9 @@ def _Row(key: tuple, rs: list[AdaptiveSpaceRun]) -> str:
     )
 
 
-def Report(runs: list[AdaptiveSpaceRun], command: str) -> str:
-    """The report's table and the paired comparisons (markdown)."""
+def Report(runs: list[AdaptiveSpaceRun], roadmaps: dict[str, dict], command: str) -> str:
+    """The report's table, the trm spaces' roadmaps (``roadmaps``: per robot, its roadmap
+    job's result) and the paired comparisons (markdown)."""
     group = _Groups(runs)
     lines = [
         "| robot | space | condition | runs | actions | coverage | dispersion "
@@ -299,6 +300,17 @@ def Report(runs: list[AdaptiveSpaceRun], command: str) -> str:
         "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|",
         *(_Row(key, rs) for key, rs in group.items()),
     ]
+    if roadmaps:
+        lines += [
+            "",
+            "The trm spaces: "
+            + "; ".join(
+                f"{robot}, {r['vertices']} states and {r['edges']} edges, built in "
+                f"{r['build_seconds']:.0f} s"
+                for robot, r in roadmaps.items()
+            )
+            + ".",
+        ]
     compared = {}
     for robot, space in sorted({(r.robot, r.space) for r in runs}):
         on, off = (
@@ -329,8 +341,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--trm-spacing",
         type=PositiveFloat,
-        default=0.5,
-        help="the trm space: its roadmap's spacing d (fractions of range)",
+        default=0.45,
+        help="the trm space: its roadmap's spacing d (fractions of range; 0.45 grows 285 "
+        "vertices on the iCub's arm unbounded)",
     )
     parser.add_argument(
         "--trm-states",
@@ -341,7 +354,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--seeds", type=PositiveInt, default=10, help="runs per space and condition"
     )
-    parser.add_argument("--actions", type=PositiveInt, default=3000, help="actions per run")
+    parser.add_argument("--actions", type=PositiveInt, default=2000, help="actions per run")
     parser.add_argument("--tests", type=PositiveInt, default=60, help="held-out tests per run")
     parser.add_argument(
         "--radius",
@@ -408,6 +421,7 @@ def main(argv: list[str] | None = None) -> None:
         for condition in CONDITIONS
     ]
     output = pathlib.Path(args.output)
+    built = {}
     if "trm" in args.spaces:  # (the roadmaps first: the trm runs read them)
         roadmaps = [
             Job(
@@ -418,11 +432,12 @@ def main(argv: list[str] | None = None) -> None:
             )
             for robot in args.robots
         ]
-        RunBattery(roadmaps, output, backend=BackendOf(args), description="trm spaces")
+        built = RunBattery(roadmaps, output, backend=BackendOf(args), description="trm spaces")
+        built = {name.removesuffix(f"_{ROADMAP_JOB}"): r for name, r in built.items()}
     results = RunBattery(jobs, output, backend=BackendOf(args), description="adaptive space")
     runs = [AdaptiveSpaceRun(**r) for r in results.values()]
     command = "mobee-drake experiment adaptive-space " + " ".join(argv if argv is not None else [])
-    report = Report(runs, command.strip())
+    report = Report(runs, built, command.strip())
     with OwnedFolder(output, "battery"):
         (output / "report.md").write_text(report + "\n")
     if args.doc:
