@@ -270,3 +270,42 @@ class TestOnTheSupervisor(unittest.TestCase):
         np.testing.assert_array_equal(a.maintenance.chains, b.maintenance.chains)
         self.assertEqual(a.maintenance.changes, b.maintenance.changes)
         self.assertEqual(len(a.maintenance.changes), 12)
+
+
+class TestTheReachLearner(unittest.TestCase):
+    """The reach learner moved onto a reshaped space: its histories and log follow."""
+
+    def test_histories_and_log_follow_their_state_actions(self):
+        """On the square, state 3 pruned: transition 0 -> 1 (0) keeps its number, 2 -> 0 (4)
+        becomes 3; the reach of state 2 (8 + 2 = 10) becomes 4 + 2 = 6; the reach of state 3
+        (11) and 1 -> 3 (3) go. A learner rebuilt from the renumbered log has the same
+        histories."""
+        from mobee_drake.reaching.learner import ReachLearner
+
+        explorer = Explorer(SQUARE)
+        learner = ReachLearner(SQUARE, explorer.transitions.counts, np.zeros((1, 3)))
+        records = {0: (0, 0, 1), 4: (2, 2, 0), 10: (2, 2, 2), 11: (3, 3, 3), 3: (1, 1, 1)}
+        for sa, (s, _, o) in records.items():
+            target = np.array([0.1 * sa, 0.0, 0.0])
+            learner.histories.Record(sa, target, 0.5, float(sa))
+            learner.log.append((0, 0, sa, s, o, 0.5, float(sa), *target))
+        edited, state_index, action_index = EditSpace(SQUARE, drop_states=[3])
+        carried = CarryExplorer(explorer, edited, state_index, action_index)
+        learner.Reshape(edited, state_index, action_index, carried.transitions.counts)
+        self.assertEqual((learner.num_transitions, learner.num_state_actions), (4, 7))
+        moved = {0: 0, 4: 3, 10: 6}
+        for old, new in moved.items():
+            _, rewards = learner.histories.Records(new)
+            np.testing.assert_array_equal(rewards, [float(old)])
+        self.assertEqual(sum(len(learner.histories.Records(sa)[1]) for sa in range(7)), 3)
+        self.assertEqual([entry[2] for entry in learner.log], [0, 3, 6, -1, -1])
+        self.assertEqual([entry[3] for entry in learner.log], [0, 2, 2, -1, 1])
+        rebuilt = ReachLearner(edited, carried.transitions.counts, np.zeros((1, 3)))
+        arrays, data = learner.ToArrays()
+        rebuilt.LoadArrays(arrays, data)
+        for sa in range(7):
+            np.testing.assert_array_equal(
+                rebuilt.histories.Records(sa)[1], learner.histories.Records(sa)[1]
+            )
+        q, v = learner.Values(np.ones(7))
+        self.assertEqual((q.shape, v.shape), ((7,), (3,)))

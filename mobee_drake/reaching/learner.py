@@ -226,11 +226,24 @@ class ReachLearner:
         T), copied: with ``learn_mdp`` the learner's own transitions add to them."""
         self.config = config = config or ReachLearningConfig()
         config.Validate()
+        self.targets = np.asarray(targets, dtype=float)
+        self._SetSpace(space, transition_counts)
+        self.histories = RewardHistories(self.reaching, config.predictor)
+        self.problem_tries = np.zeros(len(self.targets), dtype=int)
+        self.rng = np.random.default_rng(config.seed)
+        self.log: list[tuple] = []
+        self.babbler = (
+            GoalBabbler(self.targets, config.goals)
+            if REACH_STRATEGIES[config.strategy].babbles_goals
+            else None
+        )
+
+    def _SetSpace(self, space: StateActionSpace, transition_counts: np.ndarray) -> None:
+        """The state-action space and the MDP's outcome counts on it (copied)."""
         m, k = space.num_states, space.num_state_actions
         if transition_counts.shape != (k, m):
             raise ValueError(f"transition counts must be ({k}, {m}), got {transition_counts.shape}")
-        self.space, self.targets = space, np.asarray(targets, dtype=float)
-        self.num_transitions = k
+        self.space, self.num_transitions = space, k
         self.model = TransitionCounts(k, m)
         self.model.counts[...] = transition_counts
         # The state of every state-action (transitions, then one reach per state); a reach's row
@@ -243,15 +256,28 @@ class ReachLearner:
         self._rank = np.argsort(self._order)
         self._T_sorted = np.zeros((k + m, m))
         self._RefreshT()
-        self.histories = RewardHistories(self.reaching, config.predictor)
-        self.problem_tries = np.zeros(len(self.targets), dtype=int)
-        self.rng = np.random.default_rng(config.seed)
-        self.log: list[tuple] = []
-        self.babbler = (
-            GoalBabbler(self.targets, config.goals)
-            if REACH_STRATEGIES[config.strategy].babbles_goals
-            else None
-        )
+
+    def Reshape(
+        self,
+        space: StateActionSpace,
+        state_index: np.ndarray,
+        action_index: np.ndarray,
+        transition_counts: np.ndarray,
+    ) -> None:
+        """Moves the learner onto a reshaped ``space`` (ch. 9.4.5; the indices as
+        :func:`~mobee_drake.planning.space_maintenance.EditSpace` returns them), the MDP's
+        counts there being ``transition_counts``. Every state-action that stays (a transition,
+        or the reach of a state that stays) keeps its history under its new number; the log's
+        state-actions and states are renumbered (-1: dropped), so that the histories rebuilt
+        from it (:meth:`LoadArrays`) are these."""
+        reaches = np.where(state_index >= 0, space.num_state_actions + state_index, -1)
+        new_index = np.concatenate([action_index, reaches])
+        self._SetSpace(space, transition_counts)
+        self.histories = self.histories.Moved(new_index, self.reaching)
+        self.log = [
+            (t, problem, int(new_index[sa]), int(state_index[s]), int(state_index[o]), *rest)
+            for t, problem, sa, s, o, *rest in self.log
+        ]
 
     @property
     def num_state_actions(self) -> int:
@@ -467,7 +493,8 @@ class ReachLearner:
                 *map(float, row[7:]),
             )
             self.log.append(entry)
-            self.histories.Record(entry[2], np.array(entry[7:]), entry[5], entry[6])
+            if entry[2] >= 0:  # (-1: a state-action a reshaped space dropped)
+                self.histories.Record(entry[2], np.array(entry[7:]), entry[5], entry[6])
         self.problem_tries[...] = arrays["problem_tries"]
         if self.config.learn_mdp:
             self.model.counts[...] = arrays["transition_counts"]

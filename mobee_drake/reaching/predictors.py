@@ -188,6 +188,18 @@ class RewardHistories:
         twin._rewards = list(self._rewards)
         return twin
 
+    def Moved(self, new_index: np.ndarray, reaching: np.ndarray) -> "RewardHistories":
+        """The histories renumbered for a reshaped space (ch. 9.4.5): state-action i's goes to
+        ``new_index[i]`` (-1: dropped with its state-action); the new space's state-actions
+        are ``reaching`` (a reach or not), those no old one moved to start empty."""
+        moved = RewardHistories(reaching, self.predictor)
+        for old, new in enumerate(new_index):
+            if new >= 0:
+                moved._targets[new] = self._targets[old]
+                moved._estimates[new] = self._estimates[old]
+                moved._rewards[new] = self._rewards[old]
+        return moved
+
     def History(self, state_action: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(targets, estimates, rewards) of one state-action, oldest first."""
         return (
