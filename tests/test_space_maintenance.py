@@ -161,6 +161,22 @@ class TestTheRules(unittest.TestCase):
         self.assertEqual(reshaped.rewards[shortcut], Explorer(reshaped.space).rewards[shortcut])
         self.assertFalse(maintenance.chains.any())  # (it became an action: counted afresh)
 
+    def test_a_favoured_state_is_developed(self):
+        """The learner favours state 0: states grow halfway to its neighbours 1 and 2, at
+        (0.25, 0.5) and (0.5, 0.25), each joined both ways to the states within a side of it
+        (0 and its own neighbour, and each other), the rest as it was."""
+        maintenance = Maintenance(MaintenanceConfig(rules=["develop"]), 4)
+        edit = maintenance.Plan(Explorer(SQUARE), 3, 10, favoured=[0])
+        np.testing.assert_allclose(edit.space.centres[4:], [[0.25, 0.5], [0.5, 0.25]])
+        pairs = set(zip(edit.space.action_state.tolist(), edit.space.action_goal.tolist()))
+        new = {(4, 0), (0, 4), (4, 1), (1, 4), (5, 0), (0, 5), (5, 2), (2, 5), (4, 5), (5, 4)}
+        old = set(zip(SQUARE.action_state.tolist(), SQUARE.action_goal.tolist()))
+        self.assertEqual(pairs, old | new)
+        self.assertEqual([c.states for c in maintenance.changes], [(1, 0), (2, 0)])
+        self.assertIsNone(
+            Maintenance(MaintenanceConfig(rules=["develop"]), 4).Plan(Explorer(SQUARE), 3, 10)
+        )  # (nothing favoured, nothing developed)
+
     def test_settings_are_checked(self):
         with self.assertRaisesRegex(ValueError, "unknown rule 'trim'"):
             Maintenance(MaintenanceConfig(rules=["trim"]), 4)

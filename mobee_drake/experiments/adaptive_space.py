@@ -272,7 +272,7 @@ def _Groups(runs: list[AdaptiveSpaceRun]) -> dict[tuple, list[AdaptiveSpaceRun]]
 
 
 def _Row(key: tuple, rs: list[AdaptiveSpaceRun]) -> str:
-    changes = "/".join(f"{np.mean([r.changes[rule] for r in rs]):.0f}" for rule in RULES)
+    changes = "/".join(f"{np.mean([r.changes.get(rule, 0) for r in rs]):.0f}" for rule in RULES)
     return (
         f"| {' | '.join(key)} | {len(rs)} | {np.mean([r.actions for r in rs]):.0f} | "
         f"{100 * np.mean([r.coverage for r in rs]):.1f} % | "
@@ -295,7 +295,7 @@ def Report(runs: list[AdaptiveSpaceRun], roadmaps: dict[str, dict], command: str
     lines = [
         "| robot | space | condition | runs | actions | coverage | dispersion "
         "| prediction error (tests) | state-actions tried | states | state-actions "
-        "| changes (prune/drop/shortcut/grow) | robot s per action | penetrating periods "
+        f"| changes ({'/'.join(RULES)}) | robot s per action | penetrating periods "
         "| wall s per run |",
         "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|",
         *(_Row(key, rs) for key, rs in group.items()),
@@ -368,7 +368,7 @@ def main(argv: list[str] | None = None) -> None:
         "--every", type=PositiveInt, default=defaults.every, help="actions between rounds"
     )
     parser.add_argument(
-        "--rules", nargs="+", choices=RULES, default=list(RULES), help="the maintenance rules"
+        "--rules", nargs="+", choices=RULES, default=defaults.rules, help="the maintenance rules"
     )
     parser.add_argument(
         "--prune-after",

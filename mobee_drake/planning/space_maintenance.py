@@ -23,6 +23,9 @@ The rules (:class:`MaintenanceConfig` holds their parameters):
   it, a new state, joined both ways to every state within that action's length of it: the
   boundary of the reachable region is probed more finely, down to ``min_spacing``, and while the
   space has fewer than ``max_states`` states.
+- ``develop``: the same halfway between each state the learner favours (it names them, e.g. the
+  reach learner's states whose reaches worked best for many targets, ch. 9.4.5) and each of its
+  neighbours: the regions that matter get more states.
 """
 
 import dataclasses as dc
@@ -32,7 +35,9 @@ import numpy as np
 from mobee_drake.planning.explorers import Explorer, MissShares, ObservedOutcomes
 from mobee_drake.planning.state_space import StateActionSpace
 
-RULES = ("prune", "drop", "shortcut", "grow")
+RULES = ("prune", "drop", "shortcut", "grow", "develop")
+# The rules that add states.
+_NEW_STATES = ("grow", "develop")
 
 
 @dc.dataclass
@@ -41,8 +46,9 @@ class MaintenanceConfig:
 
     # Actions between rounds of maintenance (0: never).
     every: int = 100
-    # The rules applied at each round, of prune, drop, shortcut and grow.
-    rules: list[str] = dc.field(default_factory=lambda: list(RULES))
+    # The rules applied at each round, of prune, drop, shortcut, grow and develop (develop
+    # needs a learner that names its favoured states, e.g. the reach learner's best reaches).
+    rules: list[str] = dc.field(default_factory=lambda: ["prune", "drop", "shortcut", "grow"])
     # prune: tries of the actions into a state, none arriving, before the state is dropped.
     prune_after: int = 6
     # drop: tries of a transition, and the share of them that missed, before it is removed.
@@ -82,6 +88,15 @@ class SpaceChange:
     rule: str
     states: tuple[int, ...]
     centre: tuple[float, ...] = ()
+
+
+@dc.dataclass(frozen=True)
+class SpaceEdit:
+    """A reshaped space and where each old state and state-action went (-1: dropped)."""
+
+    space: StateActionSpace
+    state_index: np.ndarray
+    action_index: np.ndarray
 
 
 def EditSpace(
@@ -173,21 +188,24 @@ class Maintenance:
         every = self.config.every
         return every > 0 and actions_done > 0 and actions_done % every == 0
 
-    def Apply(self, explorer: Explorer, state: int, actions_done: int) -> tuple[Explorer, int]:
-        """A round of every enabled rule on ``explorer``'s space, the robot in ``state``:
-        the explorer on the new space and the robot's state there. A state whose every action
-        would go (to pruned states, with nothing grown beside it) keeps those goals."""
+    def Plan(
+        self, explorer: Explorer, state: int, actions_done: int, favoured=()
+    ) -> "SpaceEdit | None":
+        """A round of every enabled rule on ``explorer``'s space, the robot in ``state``, the
+        learner's ``favoured`` states given (for ``develop``): the edit (None: no change),
+        recorded as made (the chain counts follow it). A state whose every action would go (to
+        pruned states, with nothing grown beside it) keeps those goals."""
         space = explorer.space
         pruned = _Prunable(explorer, self.config, state) if "prune" in self.config.rules else []
         while True:
-            changes = self._Changes(explorer, pruned, actions_done)
+            changes = self._Changes(explorer, pruned, actions_done, favoured)
             if not changes:
-                return explorer, state
+                return None
             edited, state_index, action_index = EditSpace(
                 space,
                 drop_states=pruned,
                 drop_actions=[_ActionOf(space, *c.states) for c in changes if c.rule == "drop"],
-                new_centres=[c.centre for c in changes if c.rule == "grow"],
+                new_centres=[c.centre for c in changes if c.rule in _NEW_STATES],
                 new_actions=_NewActions(space, changes),
             )
             kept = np.flatnonzero(state_index >= 0)
@@ -205,11 +223,19 @@ class Maintenance:
         self.chains = _Moved(self.chains, state_index, edited.num_states)
         self._previous = state_index[self._previous] if self._previous >= 0 else -1
         self.changes += changes
-        carried = CarryExplorer(explorer, edited, state_index, action_index)
-        return carried, int(state_index[state])
+        return SpaceEdit(edited, state_index, action_index)
+
+    def Apply(self, explorer: Explorer, state: int, actions_done: int) -> tuple[Explorer, int]:
+        """:meth:`Plan`'s round carried out: the explorer on the new space and the robot's
+        state there (the same explorer and state when nothing changes)."""
+        edit = self.Plan(explorer, state, actions_done)
+        if edit is None:
+            return explorer, state
+        carried = CarryExplorer(explorer, edit.space, edit.state_index, edit.action_index)
+        return carried, int(edit.state_index[state])
 
     def _Changes(
-        self, explorer: Explorer, pruned: list[int], actions_done: int
+        self, explorer: Explorer, pruned: list[int], actions_done: int, favoured=()
     ) -> list[SpaceChange]:
         """Every enabled rule's changes, given the states to prune."""
         config, space, rules = self.config, explorer.space, set(self.config.rules)
@@ -225,8 +251,19 @@ class Maintenance:
             changes += [
                 SpaceChange(actions_done, "shortcut", pair) for pair in self._Shortcuts(space)
             ]
-        if "grow" in rules:
-            changes += _Growth(space, config, pruned, actions_done)
+        if "grow" in rules:  # (from each pruned state to each state with an action into it)
+            pairs = [
+                (u, r) for u in pruned for r in space.action_state[space.action_goal == u]
+                if r not in pruned
+            ]  # fmt: skip
+            changes += _Halfway(space, config, pairs, "grow", actions_done, [])
+        if "develop" in rules:  # (from each favoured state to each of its neighbours)
+            pairs = [
+                (g, f) for f in favoured if f not in pruned
+                for g in space.action_goal[space.Actions(f)] if g not in pruned
+            ]  # fmt: skip
+            grown = [c for c in changes if c.rule == "grow"]
+            changes += _Halfway(space, config, pairs, "develop", actions_done, grown)
         return changes
 
     def ToData(self) -> tuple[np.ndarray, dict]:
@@ -287,29 +324,36 @@ def _Droppable(explorer: Explorer, config: MaintenanceConfig, pruned: list[int])
     return dropped
 
 
-def _Growth(
-    space: StateActionSpace, config: MaintenanceConfig, pruned: list[int], actions_done: int
+def _Halfway(
+    space: StateActionSpace,
+    config: MaintenanceConfig,
+    pairs,
+    rule: str,
+    actions_done: int,
+    earlier: list[SpaceChange],
 ) -> list[SpaceChange]:
-    """New states halfway between each pruned state and the states with an action into it."""
-    centres, grown = space.centres, []
-    for u in pruned:
-        for r in space.action_state[space.action_goal == u]:
-            if r in pruned:
-                continue
-            if config.max_states and space.num_states + len(grown) >= config.max_states:
-                return grown
-            middle = (centres[r] + centres[u]) / 2
-            others = np.vstack([centres, [c.centre for c in grown]]) if grown else centres
-            if np.linalg.norm(others - middle, axis=1).min() >= config.min_spacing:
-                grown.append(SpaceChange(actions_done, "grow", (u, int(r)), tuple(middle.tolist())))
-    return grown
+    """New states halfway along each (far, near) pair of states, as ``rule``'s changes (their
+    states: (far, near)), none nearer than ``min_spacing`` to another state (old, ``earlier``'s
+    or new) and only while the space stays under ``max_states``."""
+    centres, made = space.centres, []
+    for far, near in pairs:
+        placed = earlier + made
+        if config.max_states and space.num_states + len(placed) >= config.max_states:
+            break
+        middle = (centres[near] + centres[far]) / 2
+        others = np.vstack([centres, [c.centre for c in placed]]) if placed else centres
+        if np.linalg.norm(others - middle, axis=1).min() >= config.min_spacing:
+            made.append(
+                SpaceChange(actions_done, rule, (int(far), int(near)), tuple(middle.tolist()))
+            )
+    return made
 
 
 def _NewActions(space: StateActionSpace, changes: list[SpaceChange]) -> list[tuple[int, int]]:
     """The shortcuts, and each new state joined both ways to every state (old or new) within
     the length of the action it grew from."""
     pairs = [c.states for c in changes if c.rule == "shortcut"]
-    grown = [c for c in changes if c.rule == "grow"]
+    grown = [c for c in changes if c.rule in _NEW_STATES]
     centres = np.vstack([space.centres] + [[c.centre] for c in grown])
     for i, change in enumerate(grown):
         new = space.num_states + i
