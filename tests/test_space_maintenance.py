@@ -325,3 +325,47 @@ class TestTheReachLearner(unittest.TestCase):
             )
         q, v = learner.Values(np.ones(7))
         self.assertEqual((q.shape, v.shape), ((7,), (3,)))
+
+    def test_a_round_on_the_reach_learners_space(self):
+        """The learner's MDP (every try into state 3 missed, 6 of them) seen as an explorer's
+        model: state 3 is pruned and the learner moves; its favoured states are those whose
+        reaches earned most over enough targets; a transition chain is shown to the
+        maintenance from the log."""
+        from mobee_drake.reaching.learner import ReachLearner
+        from mobee_drake.reaching.reshaping import (
+            FavouredStates,
+            MaintainReachSpace,
+            ModelView,
+            ObserveTransitions,
+        )
+
+        explorer = Explorer(SQUARE)
+        _Tried(explorer, 3, 1, 3)  # 1 -> 3 stayed in 1
+        _Tried(explorer, 5, 2, 3)  # 2 -> 3 stayed in 2
+        _Tried(explorer, 0, 1, 2)  # 0 -> 1 arrived twice
+        learner = ReachLearner(SQUARE, explorer.transitions.counts, np.zeros((1, 3)))
+        np.testing.assert_array_equal(ModelView(learner).tries, explorer.tries)
+        for state, rewards in ((0, [0.2, 0.4]), (1, [0.9]), (2, [0.1, 0.1])):
+            for reward in rewards:
+                learner.histories.Record(learner.Reach(state), np.zeros(3), 0.0, reward)
+        self.assertEqual(FavouredStates(learner, 2, 2), [0, 2])
+        self.assertEqual(FavouredStates(learner, 5, 1), [1, 0, 2])
+        maintenance = Maintenance(MaintenanceConfig(rules=["prune"]), 4)
+        self.assertTrue(MaintainReachSpace(learner, maintenance, 0, 50, min_records=1))
+        self.assertEqual(learner.space.num_states, 3)
+        np.testing.assert_array_equal(learner.histories.Records(learner.Reach(1))[1], [0.9])
+        self.assertFalse(MaintainReachSpace(learner, maintenance, 0, 100))  # (nothing left)
+        # 1 -> 0 -> 2, each arriving, a reach between them: one chain from 1 to 2.
+        space = learner.space
+        one_zero, zero_two = (
+            int(space.Actions(a)[space.action_goal[space.Actions(a)] == b][0])
+            for a, b in ((1, 0), (0, 2))
+        )
+        learner.log += [
+            (0, 0, one_zero, 1, 0, 0.0, 0.0, 0, 0, 0),
+            (0, 0, learner.Reach(0), 0, 0, 0.0, 0.5, 0, 0, 0),
+            (0, 0, zero_two, 0, 2, 0.0, 0.0, 0, 0, 0),
+        ]
+        ObserveTransitions(learner, maintenance, 0)
+        self.assertEqual(maintenance.chains.sum(), 1)
+        self.assertEqual(maintenance.chains[1, 2], 1)
