@@ -106,3 +106,76 @@ class TestSmokeBattery(unittest.TestCase):
         )
         self.assertIn("icub rank4, prediction error:", report)
         self.assertIn("The trm spaces: icub, 12 states and", report)
+
+
+class TestTheReachLearnersSpace(unittest.TestCase):
+    def setUp(self):
+        self.output = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, self.output)
+
+    def test_the_reaching_smoke_battery(self):
+        """The reaching part: greedy, 2 seeds x 8 problem-tries, fixed and developed every 4:
+        every run reports at its last stage; only the maintained ones grow, by develop."""
+        from mobee_drake.experiments.adaptive_space_reaching import AdaptiveReachRun
+
+        output = self.output / "reaching"
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            adaptive_space.main(
+                ["--part", "reaching", "--mdp", "simultaneous", "--strategies", "greedy",
+                 "--seeds", "2", "--problem-tries", "8", "--stages", "8", "--evaluations", "1",
+                 "--every", "4", "--rules", "develop", "--output", str(output),
+                 "--workers", "2"]
+            )  # fmt: skip
+        runs = [
+            AdaptiveReachRun(**json.loads(path.read_text()))
+            for path in output.glob("runs/reach_*/result.json")
+        ]
+        self.assertEqual(len(runs), 4)
+        for run in runs:
+            with self.subTest(condition=run.condition, seed=run.seed):
+                self.assertEqual(run.stage, 8)
+                self.assertGreater(run.robot_hours, 0)
+                self.assertEqual(run.states > 81, run.condition == "maintained")
+                self.assertEqual(sum(run.changes.values()) > 0, run.condition == "maintained")
+        report = (output / "report.md").read_text()
+        self.assertIn("| greedy | maintained | 2 | 8 |", report)
+        self.assertIn("greedy, summed reward:", report)
+
+    def test_a_reshaping_run_resumes_exactly(self):
+        """A greedy run whose space is developed every 4 problem-tries (its best reach states,
+        one record each enough), killed after 7 tries (checkpoint at 6, after a round) and run
+        again, ends as the run never killed: the same log, space and robot time."""
+        from unittest import mock
+
+        from mobee_drake.experiments.ch8_reaching import RunOne, RunSettings
+        from mobee_drake.planning.space_maintenance import MaintenanceConfig
+        from mobee_drake.reaching.learner import ReachLearner
+
+        settings = RunSettings(
+            strategy="greedy", seed=0, problem_tries=10, stages=[], evaluations=1,
+            checkpoint_every=3, mdp="simultaneous",
+        )  # fmt: skip
+        maintenance = MaintenanceConfig(every=4, rules=["develop"], develop_min_records=1)
+        whole = RunOne(self.output / "whole", self.output, settings, maintenance=maintenance)
+        explore, calls = ReachLearner.Explore, []
+
+        def Dying(learner, robot):
+            calls.append(1)
+            if len(calls) == 8:
+                raise KeyboardInterrupt
+            return explore(learner, robot)
+
+        checkpoints = []
+        with mock.patch.object(ReachLearner, "Explore", Dying):
+            with self.assertRaises(KeyboardInterrupt):
+                RunOne(
+                    self.output / "killed", self.output, settings,
+                    progress=checkpoints.append, maintenance=maintenance,
+                )  # fmt: skip
+        self.assertEqual(checkpoints[-1], 6)
+        resumed = RunOne(self.output / "killed", self.output, settings, maintenance=maintenance)
+        self.assertGreater(whole["space"]["changes"]["develop"], 0)
+        self.assertGreater(whole["space"]["states"], 81)
+        self.assertEqual(resumed["space"], whole["space"])
+        self.assertEqual(resumed["log"], whole["log"])
+        self.assertAlmostEqual(resumed["simulated_seconds"], whole["simulated_seconds"])

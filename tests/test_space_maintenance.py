@@ -351,7 +351,7 @@ class TestTheReachLearner(unittest.TestCase):
         self.assertEqual(FavouredStates(learner, 2, 2), [0, 2])
         self.assertEqual(FavouredStates(learner, 5, 1), [1, 0, 2])
         maintenance = Maintenance(MaintenanceConfig(rules=["prune"]), 4)
-        self.assertTrue(MaintainReachSpace(learner, maintenance, 0, 50, min_records=1))
+        self.assertTrue(MaintainReachSpace(learner, maintenance, 0, 50))
         self.assertEqual(learner.space.num_states, 3)
         np.testing.assert_array_equal(learner.histories.Records(learner.Reach(1))[1], [0.9])
         self.assertFalse(MaintainReachSpace(learner, maintenance, 0, 100))  # (nothing left)

@@ -44,6 +44,8 @@ import pathlib
 import numpy as np
 
 from mobee_drake.atomic_files import CurrentGeneration
+from mobee_drake.experiments import adaptive_space_reaching as reaching
+from mobee_drake.experiments.adaptive_space_reaching import STRATEGIES, MaintainedMinusFixed
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
@@ -56,7 +58,6 @@ from mobee_drake.experiments.ch7_model_learning import RIGHT_ARM, ExploreJob, St
 from mobee_drake.experiments.ch8_reaching import ReachScenario
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
-from mobee_drake.experiments.statistics import ComparePaired, Holm
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel, ObservedOutcomes
@@ -311,94 +312,112 @@ def Report(runs: list[AdaptiveSpaceRun], roadmaps: dict[str, dict], command: str
             )
             + ".",
         ]
-    compared = {}
-    for robot, space in sorted({(r.robot, r.space) for r in runs}):
-        on, off = (
-            group.get((robot, space, "maintained"), []),
-            group.get((robot, space, "fixed"), []),
-        )
-        seeds = sorted({r.seed for r in on} & {r.seed for r in off})
-        if len(seeds) < 2:
-            continue
-        on, off = ([r for r in rs if r.seed in seeds] for rs in (on, off))
-        for name, f in _MEASURES.items():
-            compared[f"{robot} {space}, {name}"] = ComparePaired(
-                [f(r) for r in on], [f(r) for r in off], [0] * len(seeds)
-            )
-    if compared:
-        adjusted = Holm([c.t_p for c in compared.values()])
-        lines += ["", f"Maintained minus fixed, paired by seed (Holm over the {len(compared)}):"]
-        lines += [""] + [f"- {n}: {c.Text(p)}" for (n, c), p in zip(compared.items(), adjusted)]
+    lines += MaintainedMinusFixed(group, sorted({(r.robot, r.space) for r in runs}), _MEASURES)
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
 
 
-def main(argv: list[str] | None = None) -> None:
+def _Parser() -> CommandParser:
     parser = CommandParser(
         prog="mobee-drake experiment adaptive-space", description=__doc__.split("\n\n")[0]
     )
-    parser.add_argument("--robots", nargs="+", choices=("icub", "katana"), default=["icub"])
-    parser.add_argument("--spaces", nargs="+", choices=SPACES, default=list(SPACES))
     parser.add_argument(
+        "--part",
+        choices=("exploration", "reaching"),
+        default="exploration",
+        help="the curious agent of ch. 7 (this module) or the reach learner of ch. 8 "
+        "(mobee_drake.experiments.adaptive_space_reaching)",
+    )
+    parser.add_argument("--seeds", type=PositiveInt, default=10, help="runs per setting")
+    exploration = parser.add_argument_group("exploration (ch. 7)")
+    exploration.add_argument("--robots", nargs="+", choices=("icub", "katana"), default=["icub"])
+    exploration.add_argument("--spaces", nargs="+", choices=SPACES, default=list(SPACES))
+    exploration.add_argument(
         "--trm-spacing",
         type=PositiveFloat,
         default=0.45,
         help="the trm space: its roadmap's spacing d (fractions of range; 0.45 grows 285 "
         "vertices on the iCub's arm unbounded)",
     )
-    parser.add_argument(
+    exploration.add_argument(
         "--trm-states",
         type=PositiveInt,
         default=256,
         help="the trm space: at most this many states (the rank-4 lattice's number, by default)",
     )
-    parser.add_argument(
-        "--seeds", type=PositiveInt, default=10, help="runs per space and condition"
-    )
-    parser.add_argument("--actions", type=PositiveInt, default=2000, help="actions per run")
-    parser.add_argument("--tests", type=PositiveInt, default=60, help="held-out tests per run")
-    parser.add_argument(
+    exploration.add_argument("--actions", type=PositiveInt, default=2000, help="per run")
+    exploration.add_argument("--tests", type=PositiveInt, default=60, help="held-out, per run")
+    exploration.add_argument(
         "--radius",
         type=PositiveFloat,
         default=0.25,
         help="coverage: a valid configuration this near (fractions of range) an arrived-in "
         "state's centre counts as covered",
     )
-    defaults = MaintenanceConfig()
-    parser.add_argument(
-        "--every", type=PositiveInt, default=defaults.every, help="actions between rounds"
+    reaching = parser.add_argument_group("reaching (ch. 8)")
+    reaching.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))
+    reaching.add_argument("--problem-tries", type=PositiveInt, default=1600, help="per run")
+    reaching.add_argument(
+        "--stages", type=PositiveInt, nargs="+", default=[100, 400, 1600], help="evaluated at"
     )
-    parser.add_argument(
-        "--rules", nargs="+", choices=RULES, default=defaults.rules, help="the maintenance rules"
+    reaching.add_argument("--evaluations", type=PositiveInt, default=5, help="per stage")
+    reaching.add_argument(
+        "--mdp",
+        choices=("continued", "simultaneous"),
+        default="continued",
+        help="the MDP learned first and further with the reaches, or only with them",
     )
-    parser.add_argument(
+    maintenance = parser.add_argument_group("maintenance")
+    maintenance.add_argument(
+        "--every",
+        type=PositiveInt,
+        default=MaintenanceConfig().every,
+        help="actions (exploration) or problem-tries (reaching) between rounds",
+    )
+    maintenance.add_argument(
+        "--rules",
+        nargs="+",
+        choices=RULES,
+        help=f"the rules (exploration: {' '.join(MaintenanceConfig().rules)}; reaching: all)",
+    )
+    maintenance.add_argument(
         "--prune-after",
         type=PositiveInt,
-        default=defaults.prune_after,
+        default=MaintenanceConfig().prune_after,
         help="tries into a state, none arriving, before it is pruned",
     )
-    parser.add_argument(
+    maintenance.add_argument(
         "--max-states",
         type=PositiveInt,
         default=None,
         help="the space grows while it has fewer states than this (default: no limit)",
     )
-    parser.add_argument("--output", default="results/adaptive_space", help="the battery folder")
     parser.add_argument(
-        "--doc", help="a doc whose generated block 'adaptive-space' gets the report"
+        "--output", help="the battery folder (results/adaptive_space[_reaching] by default)"
+    )
+    parser.add_argument(
+        "--doc",
+        help="a doc whose generated block 'adaptive-space' ('adaptive-space-reaching') gets "
+        "the report",
     )
     AddBackendArguments(parser)
-    args = parser.parse_args(argv)
-    if args.doc:
-        try:
-            GeneratedTable(args.doc, "adaptive-space")
-        except (OSError, ValueError) as error:
-            parser.error(str(error))
-    maintenance = MaintenanceConfig(
-        every=args.every,
-        rules=list(args.rules),
-        prune_after=args.prune_after,
-        max_states=args.max_states or 0,
-    )
+    return parser
+
+
+def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, command):
+    """Runs the exploration part's battery; its report."""
+    built = {}
+    if "trm" in args.spaces:  # (the roadmaps first: the trm runs read them)
+        roadmaps = [
+            Job(
+                f"{robot}_{ROADMAP_JOB}",
+                RoadmapJob,
+                dict(robot=robot, spacing=args.trm_spacing, max_vertices=args.trm_states),
+                total=args.trm_states,
+            )
+            for robot in args.robots
+        ]
+        built = RunBattery(roadmaps, output, backend=BackendOf(args), description="trm spaces")
+        built = {name.removesuffix(f"_{ROADMAP_JOB}"): r for name, r in built.items()}
     jobs = [
         Job(
             f"{robot}_{space}_{condition}_seed{seed}",
@@ -420,28 +439,46 @@ def main(argv: list[str] | None = None) -> None:
         for space in args.spaces
         for condition in CONDITIONS
     ]
-    output = pathlib.Path(args.output)
-    built = {}
-    if "trm" in args.spaces:  # (the roadmaps first: the trm runs read them)
-        roadmaps = [
-            Job(
-                f"{robot}_{ROADMAP_JOB}",
-                RoadmapJob,
-                dict(robot=robot, spacing=args.trm_spacing, max_vertices=args.trm_states),
-                total=args.trm_states,
-            )
-            for robot in args.robots
-        ]
-        built = RunBattery(roadmaps, output, backend=BackendOf(args), description="trm spaces")
-        built = {name.removesuffix(f"_{ROADMAP_JOB}"): r for name, r in built.items()}
     results = RunBattery(jobs, output, backend=BackendOf(args), description="adaptive space")
-    runs = [AdaptiveSpaceRun(**r) for r in results.values()]
-    command = "mobee-drake experiment adaptive-space " + " ".join(argv if argv is not None else [])
-    report = Report(runs, built, command.strip())
+    return Report([AdaptiveSpaceRun(**r) for r in results.values()], built, command)
+
+
+def _ReachingReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, command):
+    """Runs the reaching part's battery; its report."""
+    jobs = reaching.Jobs(args, maintenance)
+    results = RunBattery(jobs, output, backend=BackendOf(args), description="adaptive reaching")
+    runs = [reaching.AdaptiveReachRun(**r) for n, r in results.items() if n.startswith("reach_")]
+    return reaching.Report(runs, command)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = _Parser()
+    args = parser.parse_args(argv)
+    exploring = args.part == "exploration"
+    block = "adaptive-space" if exploring else "adaptive-space-reaching"
+    if args.doc:
+        try:
+            GeneratedTable(args.doc, block)
+        except (OSError, ValueError) as error:
+            parser.error(str(error))
+    rules = args.rules or (MaintenanceConfig().rules if exploring else list(RULES))
+    maintenance = MaintenanceConfig(
+        every=args.every,
+        rules=list(rules),
+        prune_after=args.prune_after,
+        max_states=args.max_states or 0,
+    )
+    output = pathlib.Path(
+        args.output
+        or ("results/adaptive_space" if exploring else "results/adaptive_space_reaching")
+    )
+    command = ("mobee-drake experiment adaptive-space " + " ".join(argv or [])).strip()
+    run = _ExplorationReport if exploring else _ReachingReport
+    report = run(args, maintenance, output, command)
     with OwnedFolder(output, "battery"):
         (output / "report.md").write_text(report + "\n")
     if args.doc:
-        WriteGeneratedTable(args.doc, "adaptive-space", command.strip(), report)
+        WriteGeneratedTable(args.doc, block, command, report)
     print(report)
 
 

@@ -71,6 +71,7 @@ from mobee_drake.experiments.battery import (
 from mobee_drake.experiments.exploration import ExplorationScenario, Explore
 from mobee_drake.mobee.params import Dissertation
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig, LoadAgentModel
+from mobee_drake.planning.space_maintenance import MaintenanceConfig
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import ExploringAgent
 from mobee_drake.reaching.learner import (
@@ -80,6 +81,7 @@ from mobee_drake.reaching.learner import (
 from mobee_drake.reaching.predictors import (
     PredictorConfig,
 )
+from mobee_drake.reaching.reshaping import ReachSpaceKeeper
 from mobee_drake.reaching.robot import SimulatedRobot
 from mobee_drake.reaching.targets import LoadTargetGrid, TargetGrid
 from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS, IcubConfig
@@ -89,7 +91,9 @@ from mobee_drake.station.executor import ReachForcing, StateActionAttractor
 RIGHT_ARM = list(RIGHT_SHOULDER_ELBOW_JOINTS)
 SOURCE_STAGES = (100, 200, 400, 800, 1600, 3200, 6400)
 # Where the MDP comes from: learned first and fixed (ch. 8), or with the reaches (ch. 9.4.1).
-MDPS = ("learned_first", "simultaneous")
+# The MDP: learned first and kept (ch. 8), learned with the reaches from the optimistic
+# initialisation (ch. 9.4.1), or learned first and learned further with the reaches.
+MDPS = ("learned_first", "simultaneous", "continued")
 LEVELS = [0.25, 0.5, 0.75]
 AGENT = "right_arm"
 # Robot hours of the source's five runs per strategy (ch. 8.4).
@@ -240,6 +244,8 @@ class ReachRun:
         barrier_periods: Periods the safety barrier acted (None: a run from before it was
             counted).
         mdp: ``--mdp simultaneous``: the MDP learned with the reaches (see ``_LearnedMdp``).
+        space: A space that reshaped itself: its size at the end and its changes by rule
+            (:meth:`~mobee_drake.reaching.reshaping.ReachSpaceKeeper.Summary`).
     """
 
     settings: RunSettings
@@ -252,6 +258,7 @@ class ReachRun:
     num_states: int
     barrier_periods: int | None = None
     mdp: dict | None = None
+    space: dict | None = None
 
     @property
     def strategy(self) -> str:
@@ -320,17 +327,25 @@ def ReachRobot(
 
 
 def _Checkpoint(
-    folder: pathlib.Path, robot: SimulatedRobot, learner: ReachLearner, data: dict
+    folder: pathlib.Path,
+    robot: SimulatedRobot,
+    learner: ReachLearner,
+    data: dict,
+    keeper: ReachSpaceKeeper | None = None,
 ) -> None:
-    """Saves the simulation, the learner and ``data`` (evaluations, wall time) as the newest
-    generation of ``folder``."""
+    """Saves the simulation, the learner (and the ``keeper``'s space) and ``data``
+    (evaluations, wall time) as the newest generation of ``folder``."""
 
     def Write(staging: pathlib.Path) -> None:
         (staging / "simulation").mkdir()
         robot.Save(staging / "simulation")
         arrays, learner_data = learner.ToArrays()
+        saved = dict(learner=learner_data, **data)
+        if keeper is not None:
+            space_arrays, saved["maintenance"] = keeper.ToArrays(learner)
+            arrays.update(space_arrays)
         np.savez(staging / "learner.npz", **arrays)
-        (staging / "learner.json").write_text(StrictJson(dict(learner=learner_data, **data)))
+        (staging / "learner.json").write_text(StrictJson(saved))
 
     WriteGeneration(folder, Write)
 
@@ -355,7 +370,7 @@ def _NewLearner(settings: RunSettings, mdp_dir: pathlib.Path):
             predictor=PredictorConfig(
                 settings.predictor, distance_unit=settings.distance_unit, eq81=settings.eq81
             ),
-            learn_mdp=simultaneous,
+            learn_mdp=settings.mdp != "learned_first",
             tie_break=settings.tie_break,
             plateau_rule=settings.plateau_rule,
             evaluation_history=settings.evaluation_history,
@@ -384,13 +399,19 @@ def RunOne(
     meshcat=None,
     progress=None,
     should_stop=None,
+    maintenance: MaintenanceConfig | None = None,
 ) -> dict:
     """One run of the battery (resumes from ``run_dir/checkpoint``); returns its result. With
     ``meshcat``, the run is shown there in real time; ``progress(n)``, if given, is told the
     problem-tries done at every checkpoint; ``should_stop()``, if given, is asked after every
-    problem-try, and when True the run saves its checkpoint and raises JobStopped."""
+    problem-try, and when True the run saves its checkpoint and raises JobStopped. With
+    ``maintenance``, the learner's space reshapes itself (ch. 9.4.5,
+    :class:`~mobee_drake.reaching.reshaping.ReachSpaceKeeper`)."""
     run_dir.mkdir(parents=True, exist_ok=True)
     model, learner, grid = _NewLearner(settings, mdp_dir)
+    keeper = None
+    if maintenance is not None:
+        keeper = ReachSpaceKeeper(maintenance, learner.space.num_states)
     robot = ReachRobot(
         model.space,
         grid.radius,
@@ -404,7 +425,10 @@ def RunOne(
     generation = CurrentGeneration(checkpoint)
     if generation is not None:
         saved = json.loads((generation / "learner.json").read_text())
-        learner.LoadArrays(np.load(generation / "learner.npz"), saved.pop("learner"))
+        arrays = np.load(generation / "learner.npz")
+        if keeper is not None:
+            keeper.Restore(learner, robot, arrays, saved.pop("maintenance"))
+        learner.LoadArrays(arrays, saved.pop("learner"))
         robot.Load(generation / "simulation")
         data = saved
         if data["target"] is not None:
@@ -414,7 +438,7 @@ def RunOne(
     def Save():
         data["wall_seconds"] = time.perf_counter() - started
         data["target"] = None if robot.target is None else robot.target.tolist()
-        _Checkpoint(checkpoint, robot, learner, data)
+        _Checkpoint(checkpoint, robot, learner, data, keeper)
         if progress is not None:
             progress(int(learner.problem_tries.sum()))
 
@@ -428,7 +452,10 @@ def RunOne(
             Save()
         if done >= settings.problem_tries:
             break
+        since = len(learner.log)
         learner.Explore(robot)
+        if keeper is not None:
+            keeper.AfterTry(learner, robot, done + 1, since)
         if (done + 1) % settings.checkpoint_every == 0:
             Save()
         if should_stop is not None and should_stop():
@@ -437,7 +464,9 @@ def RunOne(
     Save()
     arrays, _ = learner.ToArrays()
     extra = {}
-    if settings.mdp == "simultaneous":
+    if keeper is not None:  # (the MDP's space changed: its summary instead)
+        extra["space"] = keeper.Summary(learner)
+    elif settings.mdp == "simultaneous":
         extra = dict(mdp=_LearnedMdp(run_dir, learner, model))
     safety = robot.Safety()
     result = ReachRun(

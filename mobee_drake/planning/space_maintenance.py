@@ -56,6 +56,10 @@ class MaintenanceConfig:
     drop_miss_share: float = 0.8
     # shortcut: chains of two arriving actions from one state to a third before the shortcut.
     shortcut_after: int = 5
+    # develop: the learner's favoured states developed per round, and the records a state
+    # needs to be favoured (the reach learner: its reach's recorded targets).
+    develop_top: int = 3
+    develop_min_records: int = 5
     # A new state is at least this far (fractions of range) from every other.
     min_spacing: float = 0.05
     # The space grows while it has fewer states than this (0: no limit).
@@ -68,11 +72,13 @@ class MaintenanceConfig:
         for name in ("every", "max_states"):
             if getattr(self, name) < 0:
                 errors.append(f"{name} must be >= 0, got {getattr(self, name)}")
-        for name in ("prune_after", "drop_after", "shortcut_after"):
+        for name in ("prune_after", "drop_after", "shortcut_after", "develop_top"):
             if getattr(self, name) < 1:
                 errors.append(f"{name} must be >= 1, got {getattr(self, name)}")
         if not 0 < self.drop_miss_share <= 1:
             errors.append(f"drop_miss_share must be in (0, 1], got {self.drop_miss_share}")
+        if self.develop_min_records < 0:
+            errors.append(f"develop_min_records must be >= 0, got {self.develop_min_records}")
         if not self.min_spacing > 0:
             errors.append(f"min_spacing must be > 0, got {self.min_spacing}")
         return errors

@@ -3,10 +3,11 @@
 A round of :class:`~mobee_drake.planning.space_maintenance.Maintenance` reads the learner's MDP
 as an explorer's model (its outcome counts; the tries of each transition are the outcomes it
 observed), and the states the learner favours: "certain states, from which reach actions worked
-well to a wide range of target locations" (ch. 9.4.5), here the ``top`` states whose reaches
-have the highest mean reward over at least ``min_records`` recorded targets. The edit moves the
-MDP's counts (:func:`~mobee_drake.planning.space_maintenance.CarryExplorer`) and the learner
-(:meth:`~mobee_drake.reaching.learner.ReachLearner.Reshape`) onto the new space.
+well to a wide range of target locations" (ch. 9.4.5), here the ``develop_top`` states whose
+reaches have the highest mean reward over at least ``develop_min_records`` recorded targets.
+The edit moves the MDP's counts (:func:`~mobee_drake.planning.space_maintenance.CarryExplorer`)
+and the learner (:meth:`~mobee_drake.reaching.learner.ReachLearner.Reshape`) onto the new
+space.
 
 New transitions start with Alg. 6's optimistic counts; with ``learn_mdp`` (ch. 9.4.1) the
 learner's own transitions then teach the model what they do, without it they keep that prior.
@@ -15,7 +16,13 @@ learner's own transitions then teach the model what they do, without it they kee
 import numpy as np
 
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig, ObservedOutcomes
-from mobee_drake.planning.space_maintenance import CarryExplorer, Maintenance
+from mobee_drake.planning.space_maintenance import (
+    RULES,
+    CarryExplorer,
+    Maintenance,
+    MaintenanceConfig,
+)
+from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.reaching.learner import ReachLearner
 
 
@@ -40,18 +47,15 @@ def FavouredStates(learner: ReachLearner, top: int, min_records: int) -> list[in
 
 
 def MaintainReachSpace(
-    learner: ReachLearner,
-    maintenance: Maintenance,
-    state: int,
-    done: int,
-    *,
-    top: int = 3,
-    min_records: int = 5,
+    learner: ReachLearner, maintenance: Maintenance, state: int, done: int
 ) -> bool:
     """A round of ``maintenance`` on the learner's space, the robot in ``state`` after ``done``
-    problem-tries; whether the space changed (then the learner is on the new one)."""
+    problem-tries (its favoured states by the config's ``develop_top`` and
+    ``develop_min_records``); whether the space changed (then the learner is on the new
+    one)."""
+    config = maintenance.config
     view = ModelView(learner)
-    favoured = FavouredStates(learner, top, min_records)
+    favoured = FavouredStates(learner, config.develop_top, config.develop_min_records)
     edit = maintenance.Plan(view, state, done, favoured)
     if edit is None:
         return False
@@ -66,3 +70,60 @@ def ObserveTransitions(learner: ReachLearner, maintenance: Maintenance, since: i
     for _, _, sa, state, outcome, *_ in learner.log[since:]:
         if 0 <= sa < learner.num_transitions:
             maintenance.Observe(learner.space, state, sa, outcome)
+
+
+class ReachSpaceKeeper:
+    """A reach learner's space maintained through a run: a round of ``config``'s rules every
+    ``config.every`` problem-tries (here problem-tries, not actions), and the run's checkpoint
+    part (the space, the chain counts, the changes). The robot acts on the learner's space: a
+    :class:`~mobee_drake.reaching.robot.SimulatedRobot`'s ``space`` follows it."""
+
+    def __init__(self, config: MaintenanceConfig, num_states: int):
+        self.maintenance = Maintenance(config, num_states)
+
+    def AfterTry(self, learner: ReachLearner, robot, done: int, since: int) -> None:
+        """After a problem-try (``done`` of them now; its actions logged from entry
+        ``since``)."""
+        ObserveTransitions(learner, self.maintenance, since)
+        if self.maintenance.Due(done):
+            state = robot.State()
+            if MaintainReachSpace(learner, self.maintenance, state, done):
+                robot.space = learner.space
+
+    def ToArrays(self, learner: ReachLearner) -> tuple[dict[str, np.ndarray], dict]:
+        """The checkpoint's part: the learner's space and MDP counts, and the maintenance."""
+        chains, data = self.maintenance.ToData()
+        space = learner.space
+        arrays = dict(
+            space_centres=space.centres,
+            space_action_state=space.action_state,
+            space_action_goal=space.action_goal,
+            space_counts=learner.model.counts,
+            maintenance_chains=chains,
+        )
+        return arrays, data
+
+    def Restore(self, learner: ReachLearner, robot, arrays, data: dict) -> None:
+        """Puts a fresh ``learner`` (before its LoadArrays) and ``robot`` on the saved space."""
+        space = StateActionSpace(
+            np.asarray(arrays["space_centres"]),
+            np.asarray(arrays["space_action_state"]),
+            np.asarray(arrays["space_action_goal"]),
+        )
+        nothing = np.full(learner.space.num_states, -1), np.full(learner.num_transitions, -1)
+        learner.Reshape(space, *nothing, np.asarray(arrays["space_counts"]))  # (fresh: no history)
+        robot.space = learner.space
+        self.maintenance = Maintenance.FromData(
+            self.maintenance.config, arrays["maintenance_chains"], data
+        )
+
+    def Summary(self, learner: ReachLearner) -> dict:
+        """The space at the end: states, state-actions (transitions) and changes by rule."""
+        changes = {rule: 0 for rule in RULES}
+        for change in self.maintenance.changes:
+            changes[change.rule] += 1
+        return dict(
+            states=learner.space.num_states,
+            transitions=learner.num_transitions,
+            changes=changes,
+        )

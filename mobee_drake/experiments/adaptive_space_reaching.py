@@ -1,0 +1,180 @@
+"""Experiment, ch. 8 part: the reach learner on a fixed and on a self-reshaping space (ch. 9.4.5;
+docs/adaptive_space.md).
+
+Each strategy of ch. 8 learns to reach on the rank-3 lattice for ``--problem-tries``
+problem-tries, on the space as it is (``fixed``) and on the same space maintained by the rules of
+:mod:`mobee_drake.planning.space_maintenance` (``maintained``, a round every ``--every``
+problem-tries; the learner's favoured states, its best reaches, are developed), ``--seeds`` runs
+of each, paired by seed. In both conditions the MDP is learned first (5 tries of every
+state-action, as ch. 8) and learned further with the reaches (``continued``, ch. 9.4.1): a new
+transition starts with Alg. 6's optimistic counts and is learned like the rest, so the two
+conditions differ by the maintenance only. With ``--mdp simultaneous`` no MDP is learned first
+(the smoke run's setting).
+
+Per run, at the last stage: the evaluations' summed reward (ch. 8.3.3, with the -10 of every
+failed transition and without), the robot's simulated hours, the space's size and its changes,
+and the penetrating periods. Maintained minus fixed is compared paired by seed, Holm-corrected
+over the strategies and the two measures (reward with penalties, robot hours).
+"""
+
+import collections
+import dataclasses as dc
+
+import numpy as np
+
+from mobee_drake.experiments.battery import Job, RunFolder, StopRequested
+from mobee_drake.experiments.ch8_figures import EvaluationSum
+from mobee_drake.experiments.ch8_reaching import MdpJob, MdpName, ReachRun, RunOne, RunSettings
+from mobee_drake.experiments.statistics import ComparePaired, Holm, RunMeans
+from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
+
+STRATEGIES = ("greedy", "intrinsic", "random")
+CONDITIONS = ("fixed", "maintained")
+MDP_TRIES = 5
+
+
+@dc.dataclass
+class AdaptiveReachRun:
+    """One reach-learning run: a strategy, fixed or maintained, a seed (see the module)."""
+
+    strategy: str
+    condition: str
+    seed: int
+    stage: int
+    reward: float
+    reward_without_penalties: float
+    robot_hours: float
+    states: int
+    transitions: int
+    changes: dict[str, int]
+    penetrating_steps: int
+    wall_seconds: float
+
+
+def AdaptiveReachJob(
+    run: RunFolder, *, strategy: str, condition: str, seed: int, problem_tries: int,
+    stages: list[int], evaluations: int, mdp: str, maintenance: MaintenanceConfig,
+) -> dict:  # fmt: skip
+    """The battery job: one run (see the module)."""
+    settings = RunSettings(
+        strategy=strategy,
+        seed=seed,
+        problem_tries=problem_tries,
+        stages=stages,
+        evaluations=evaluations,
+        checkpoint_every=50,
+        mdp=mdp,
+    )
+    result = ReachRun.FromJson(
+        RunOne(
+            run.path,
+            run.path.parent / MdpName(MDP_TRIES) / "model",
+            settings,
+            progress=run.Progress,
+            should_stop=StopRequested,
+            maintenance=maintenance if condition == "maintained" else None,
+        )
+    )
+    stage = max(result.evaluations)
+    sums = [
+        RunMeans([[EvaluationSum(e, penalties) for e in result.evaluations[stage]]])[0]
+        for penalties in (True, False)
+    ]
+    space = result.space or dict(
+        states=result.num_states, transitions=result.num_transitions, changes={}
+    )
+    return dc.asdict(
+        AdaptiveReachRun(
+            strategy=strategy,
+            condition=condition,
+            seed=seed,
+            stage=stage,
+            reward=float(sums[0]),
+            reward_without_penalties=float(sums[1]),
+            robot_hours=result.simulated_seconds / 3600,
+            states=space["states"],
+            transitions=space["transitions"],
+            changes={rule: space["changes"].get(rule, 0) for rule in RULES},
+            penetrating_steps=result.penetrating_steps,
+            wall_seconds=result.wall_seconds,
+        )
+    )
+
+
+def Jobs(args, maintenance: MaintenanceConfig) -> list[Job]:
+    """The battery's jobs: the MDP learned first (unless ``--mdp simultaneous``), then every
+    strategy's runs."""
+    jobs = []
+    if args.mdp != "simultaneous":
+        jobs.append(Job(MdpName(MDP_TRIES), MdpJob, dict(min_tries=MDP_TRIES)))
+    stages = sorted({*args.stages, args.problem_tries})
+    jobs += [
+        Job(
+            f"reach_{strategy}_{condition}_seed{seed}",
+            AdaptiveReachJob,
+            dict(
+                strategy=strategy,
+                condition=condition,
+                seed=seed,
+                problem_tries=args.problem_tries,
+                stages=stages,
+                evaluations=args.evaluations,
+                mdp=args.mdp,
+                maintenance=maintenance,
+            ),
+            total=args.problem_tries,
+        )
+        for seed in range(args.seeds)
+        for strategy in args.strategies
+        for condition in CONDITIONS
+    ]
+    return jobs
+
+
+def MaintainedMinusFixed(group: dict, keys: list[tuple], measures: dict) -> list[str]:
+    """Report lines: for each key (``group``'s keys are a key and a condition), maintained
+    minus fixed on each of ``measures`` (run -> value), paired by seed, Holm over them all."""
+    compared = {}
+    for key in keys:
+        on, off = group.get((*key, "maintained"), []), group.get((*key, "fixed"), [])
+        seeds = sorted({r.seed for r in on} & {r.seed for r in off})
+        if len(seeds) < 2:
+            continue
+        on, off = ([r for r in rs if r.seed in seeds] for rs in (on, off))
+        for name, f in measures.items():
+            compared[f"{' '.join(key)}, {name}"] = ComparePaired(
+                [f(r) for r in on], [f(r) for r in off], [0] * len(seeds)
+            )
+    if not compared:
+        return []
+    adjusted = Holm([c.t_p for c in compared.values()])
+    lines = ["", f"Maintained minus fixed, paired by seed (Holm over the {len(compared)}):", ""]
+    return lines + [f"- {n}: {c.Text(p)}" for (n, c), p in zip(compared.items(), adjusted)]
+
+
+def Report(runs: list[AdaptiveReachRun], command: str) -> str:
+    """The report's table and the paired comparisons (markdown)."""
+    group = collections.defaultdict(list)
+    for r in sorted(runs, key=lambda r: r.seed):
+        group[(r.strategy, r.condition)].append(r)
+    lines = [
+        "| strategy | condition | runs | problem-tries | summed reward | without the -10s "
+        f"| robot hours | states | transitions | changes ({'/'.join(RULES)}) "
+        "| penetrating periods | wall s per run |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|",
+    ]
+    for (strategy, condition), rs in sorted(group.items()):
+        changes = "/".join(f"{np.mean([r.changes.get(c, 0) for r in rs]):.0f}" for c in RULES)
+        lines.append(
+            f"| {strategy} | {condition} | {len(rs)} | {rs[0].stage} | "
+            f"{np.mean([r.reward for r in rs]):.2f} | "
+            f"{np.mean([r.reward_without_penalties for r in rs]):.2f} | "
+            f"{np.mean([r.robot_hours for r in rs]):.2f} | "
+            f"{np.mean([r.states for r in rs]):.0f} | "
+            f"{np.mean([r.transitions for r in rs]):.0f} | {changes} | "
+            f"{sum(r.penetrating_steps for r in rs)} | "
+            f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
+        )
+    measures = {"summed reward": lambda r: r.reward, "robot hours": lambda r: r.robot_hours}
+    lines += MaintainedMinusFixed(group, sorted({(r.strategy,) for r in runs}), measures)
+    return "\n".join(lines) + f"\n\nCommand: `{command}`."
