@@ -4,10 +4,11 @@ The source's future work: states found unreachable could be pruned and the inter
 built up, shortcuts made between frequently linked far-apart states and often infeasible
 transitions removed, "all of this ... facilitated by intrinsic motivation": an addition is
 interesting (its model starts optimistic, as every state-action's does, Alg. 6) until it is
-predictable. Each rule below reads only the agent's learned model and what it has done; a round
-of maintenance (:func:`Maintain`) applies every enabled rule at once, and
-:func:`CarryExplorer` moves the learned model onto the new space: nothing learned about a state
-or state-action that stays is lost, and new ones start as the agent's first ones did.
+predictable. Each rule below reads only the agent's learned model and what it has done (and,
+for ``develop``, the states its learner favours); a round of maintenance
+(:meth:`Maintenance.Plan`) applies every enabled rule at once, and :func:`CarryExplorer` moves
+the learned model onto the new space (:meth:`Maintenance.Apply` does both): nothing learned
+about a state-action that stays is lost, and new ones start as the agent's first ones did.
 
 The rules (:class:`MaintenanceConfig` holds their parameters):
 
@@ -67,8 +68,11 @@ class MaintenanceConfig:
 
     def Errors(self) -> list[str]:
         """What is wrong with the settings that their types cannot say (empty: nothing)."""
-        errors = [f"unknown rule '{r}'; the rules are {', '.join(RULES)}" for r in self.rules]
-        errors = [e for e, r in zip(errors, self.rules) if r not in RULES]
+        errors = [
+            f"unknown rule '{r}'; the rules are {', '.join(RULES)}"
+            for r in self.rules
+            if r not in RULES
+        ]
         for name in ("every", "max_states"):
             if getattr(self, name) < 0:
                 errors.append(f"{name} must be >= 0, got {getattr(self, name)}")
@@ -88,7 +92,8 @@ class MaintenanceConfig:
 class SpaceChange:
     """One change of a round, in the indices of the space before the round: a ``rule``'s dropped
     state, dropped or added action (``states``: its state and goal) or new state (``centre``,
-    and ``states``: the pruned state and the state it grew from)."""
+    and ``states``: the pruned state, or the favoured state's neighbour, and the state it grew
+    from)."""
 
     actions_done: int
     rule: str
@@ -222,7 +227,10 @@ class Maintenance:
             if not len(stranded):
                 break
             goals = space.action_goal[np.isin(space.action_state, stranded)]
-            pruned = [u for u in pruned if u not in goals]
+            kept_pruned = [u for u in pruned if u not in goals]
+            if len(kept_pruned) == len(pruned):
+                break  # (no pruning strands them: nothing more to keep)
+            pruned = kept_pruned
         for change in changes:
             if change.rule == "shortcut":  # (an action now: no chain to count)
                 self.chains[change.states] = 0
