@@ -369,3 +369,21 @@ class TestTheReachLearner(unittest.TestCase):
         ObserveTransitions(learner, maintenance, 0)
         self.assertEqual(maintenance.chains.sum(), 1)
         self.assertEqual(maintenance.chains[1, 2], 1)
+
+
+class TestGrowthNeverReturns(unittest.TestCase):
+    def test_no_state_grows_back_where_one_was_pruned(self):
+        """A line 0 - 0.5 - 1: 0.5 is pruned and states grow at 0.25 and 0.75 (joined to each
+        other, 0.5 apart). When 0.75 is pruned too, growth goes halfway to 1 (0.875) but not
+        halfway to 0.25, which is where 0.5 was pruned."""
+        explorer = Explorer(FromGraph([[0.0], [0.5], [1.0]], [(0, 1), (1, 2)]))
+        maintenance = Maintenance(MaintenanceConfig(rules=["prune", "grow"], prune_after=1), 3)
+        for sa in (0, 3):  # 0 -> 0.5 and 1 -> 0.5, each missed once
+            _Tried(explorer, sa, explorer.space.action_state[sa], 1)
+        explorer, _ = maintenance.Apply(explorer, 0, 1)
+        np.testing.assert_allclose(explorer.space.centres[:, 0], [0.0, 1.0, 0.25, 0.75])
+        space = explorer.space
+        for sa in np.flatnonzero(space.action_goal == 3):  # every try into 0.75 missed
+            _Tried(explorer, sa, space.action_state[sa], 1)
+        explorer, _ = maintenance.Apply(explorer, 0, 2)
+        np.testing.assert_allclose(explorer.space.centres[:, 0], [0.0, 1.0, 0.25, 0.875])

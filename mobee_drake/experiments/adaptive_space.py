@@ -42,9 +42,11 @@ import json
 import pathlib
 
 import numpy as np
+from pydrake.geometry import Meshcat
 
-from mobee_drake.atomic_files import CurrentGeneration
+from mobee_drake.atomic_files import CurrentGeneration, WriteTextAtomically
 from mobee_drake.experiments import adaptive_space_reaching as reaching
+from mobee_drake.experiments.adaptive_space_figures import Figure, History, ShowSpace
 from mobee_drake.experiments.adaptive_space_reaching import STRATEGIES, MaintainedMinusFixed
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
 from mobee_drake.experiments.battery import (
@@ -58,11 +60,13 @@ from mobee_drake.experiments.ch7_model_learning import RIGHT_ARM, ExploreJob, St
 from mobee_drake.experiments.ch8_reaching import ReachScenario
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
+from mobee_drake.experiments.plots import SaveFigure
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel, ObservedOutcomes
 from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
-from mobee_drake.planning.supervisor import ExploringAgent
+from mobee_drake.planning.state_space import Lattice
+from mobee_drake.planning.supervisor import ExploringAgent, RoadmapStateSpace
 from mobee_drake.reaching.robot import SimulatedRobot
 from mobee_drake.robots.icub import IcubConfig
 from mobee_drake.robots.zero_position import ZeroPositionConfig
@@ -403,6 +407,50 @@ def _Parser() -> CommandParser:
     return parser
 
 
+def _InitialCentres(arm: Arm, robot: str, space: str, output: pathlib.Path) -> np.ndarray:
+    """The centres a run's space began with (fractions of range)."""
+    if space in LATTICES:
+        return Lattice(LATTICES[space], len(arm.joints)).centres
+    model = KinematicModel(arm.robot, list(arm.objects))
+    folder = output / "runs" / f"{robot}_{ROADMAP_JOB}" / "roadmap"
+    return RoadmapStateSpace(
+        str(folder), list(arm.joints), list(model.joints), model.lower, model.upper
+    ).centres
+
+
+def SpaceHistories(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> dict[str, list]:
+    """Per robot, the history of its first seed's maintained run on each space."""
+    arms, histories = Arms(), collections.defaultdict(list)
+    for (robot, space, condition), rs in _Groups(runs).items():
+        if condition != "maintained":
+            continue
+        run = output / "runs" / f"{robot}_{space}_maintained_seed{rs[0].seed}" / "model"
+        final = LoadAgentModel(str(run), AGENT, ExplorerConfig()).space.centres
+        initial = _InitialCentres(arms[robot], robot, space, output)
+        histories[robot].append(History(f"{robot}, {space}", arms[robot], initial, final))
+    return dict(histories)
+
+
+def WriteSpaceFigures(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> list[str]:
+    """``adaptive_space.png`` and, per robot, ``adaptive_space_<robot>.html`` (Meshcat) in
+    ``output``: the spaces of the first seed's maintained runs; their names."""
+    histories = SpaceHistories(runs, output)
+    if not histories:
+        return []
+    written = ["adaptive_space.png"]
+    SaveFigure(Figure([h for hs in histories.values() for h in hs]), output / written[0])
+    arms = Arms()
+    for robot, robot_histories in histories.items():
+        meshcat = Meshcat()
+        model = KinematicModel(arms[robot].robot, list(arms[robot].objects), meshcat=meshcat)
+        model.Publish(model.home)
+        for history in robot_histories:
+            ShowSpace(meshcat, history, f"spaces/{history.title.split(', ')[1]}")
+        written.append(f"adaptive_space_{robot}.html")
+        WriteTextAtomically(output / written[-1], meshcat.StaticHtml())
+    return written
+
+
 def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, command):
     """Runs the exploration part's battery; its report."""
     built = {}
@@ -440,7 +488,13 @@ def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Pat
         for condition in CONDITIONS
     ]
     results = RunBattery(jobs, output, backend=BackendOf(args), description="adaptive space")
-    return Report([AdaptiveSpaceRun(**r) for r in results.values()], built, command)
+    runs = [AdaptiveSpaceRun(**r) for r in results.values()]
+    with OwnedFolder(output, "battery"):
+        figures = WriteSpaceFigures(runs, output)
+    report = Report(runs, built, command)
+    if figures:
+        report += f"\n\nFigures (the first seed's maintained runs): {', '.join(figures)}."
+    return report
 
 
 def _ReachingReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, command):

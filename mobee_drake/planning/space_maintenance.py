@@ -22,8 +22,8 @@ The rules (:class:`MaintenanceConfig` holds their parameters):
   an action from the first straight to the third is added.
 - ``grow``: halfway between a state pruned in this round and each state that had an action into
   it, a new state, joined both ways to every state within that action's length of it: the
-  boundary of the reachable region is probed more finely, down to ``min_spacing``, and while the
-  space has fewer than ``max_states`` states.
+  boundary of the reachable region is probed more finely, down to ``min_spacing``, never back
+  where a state was pruned, and while the space has fewer than ``max_states`` states.
 - ``develop``: the same halfway between each state the learner favours (it names them, e.g. the
   reach learner's states whose reaches worked best for many targets, ch. 9.4.5) and each of its
   neighbours: the regions that matter get more states.
@@ -91,9 +91,9 @@ class MaintenanceConfig:
 @dc.dataclass(frozen=True)
 class SpaceChange:
     """One change of a round, in the indices of the space before the round: a ``rule``'s dropped
-    state, dropped or added action (``states``: its state and goal) or new state (``centre``,
-    and ``states``: the pruned state, or the favoured state's neighbour, and the state it grew
-    from)."""
+    state (and its ``centre``), dropped or added action (``states``: its state and goal) or new
+    state (``centre``, and ``states``: the pruned state, or the favoured state's neighbour, and
+    the state it grew from)."""
 
     actions_done: int
     rule: str
@@ -253,7 +253,10 @@ class Maintenance:
     ) -> list[SpaceChange]:
         """Every enabled rule's changes, given the states to prune."""
         config, space, rules = self.config, explorer.space, set(self.config.rules)
-        changes = [SpaceChange(actions_done, "prune", (s,)) for s in pruned]
+        changes = [
+            SpaceChange(actions_done, "prune", (s,), tuple(space.centres[s].tolist()))
+            for s in pruned
+        ]
         if "drop" in rules:
             changes += [
                 SpaceChange(
@@ -270,14 +273,16 @@ class Maintenance:
                 (u, r) for u in pruned for r in space.action_state[space.action_goal == u]
                 if r not in pruned
             ]  # fmt: skip
-            changes += _Halfway(space, config, pairs, "grow", actions_done, [])
+            changes += _Halfway(space, config, pairs, "grow", actions_done, [], self._Pruned())
         if "develop" in rules:  # (from each favoured state to each of its neighbours)
             pairs = [
                 (g, f) for f in favoured if f not in pruned
                 for g in space.action_goal[space.Actions(f)] if g not in pruned
             ]  # fmt: skip
             grown = [c for c in changes if c.rule == "grow"]
-            changes += _Halfway(space, config, pairs, "develop", actions_done, grown)
+            changes += _Halfway(
+                space, config, pairs, "develop", actions_done, grown, self._Pruned()
+            )
         return changes
 
     def ToData(self) -> tuple[np.ndarray, dict]:
@@ -296,6 +301,11 @@ class Maintenance:
             for c in data["changes"]
         ]
         return maintenance
+
+    def _Pruned(self) -> np.ndarray:
+        """(p, d): the centres of the states pruned in earlier rounds (no new state goes
+        back there)."""
+        return np.array([c.centre for c in self.changes if c.rule == "prune" and c.centre])
 
     def _Shortcuts(self, space: StateActionSpace) -> list[tuple[int, int]]:
         linked = set(zip(space.action_state.tolist(), space.action_goal.tolist()))
@@ -345,11 +355,15 @@ def _Halfway(
     rule: str,
     actions_done: int,
     earlier: list[SpaceChange],
+    pruned_before: np.ndarray,
 ) -> list[SpaceChange]:
     """New states halfway along each (far, near) pair of states, as ``rule``'s changes (their
     states: (far, near)), none nearer than ``min_spacing`` to another state (old, ``earlier``'s
-    or new) and only while the space stays under ``max_states``."""
+    or new) or to a state pruned in an earlier round (``pruned_before``), and only while the
+    space stays under ``max_states``."""
     centres, made = space.centres, []
+    if len(pruned_before):
+        centres = np.vstack([centres, pruned_before])
     for far, near in pairs:
         placed = earlier + made
         if config.max_states and space.num_states + len(placed) >= config.max_states:
