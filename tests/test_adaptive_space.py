@@ -10,8 +10,10 @@ import tempfile
 import unittest
 
 import numpy as np
+from test_figures import FigureTest
 
 from mobee_drake.experiments import adaptive_space
+from mobee_drake.experiments.adaptive_space_figures import Figure
 from mobee_drake.planning.explorers import Explorer
 from mobee_drake.planning.state_space import Lattice
 
@@ -63,7 +65,7 @@ class TestConfigurationRoadmap(unittest.TestCase):
         self.assertGreaterEqual(gaps[np.triu_indices(12, 1)].min(), 0.3)
 
 
-class TestSmokeBattery(unittest.TestCase):
+class TestSmokeBattery(FigureTest):
     def setUp(self):
         self.output = pathlib.Path(tempfile.mkdtemp()) / "adaptive"
         self.addCleanup(shutil.rmtree, self.output.parent)
@@ -88,7 +90,7 @@ class TestSmokeBattery(unittest.TestCase):
         self.assertEqual(roadmap["vertices"], 12)
         unchanged = [r for r in runs if r.space == "trm" and not sum(r.changes.values())]
         self.assertTrue(unchanged and all(r.states == 12 for r in unchanged))
-        runs = [r for r in runs if r.space == "rank4"]
+        everything, runs = runs, [r for r in runs if r.space == "rank4"]
         for run in runs:
             with self.subTest(condition=run.condition, seed=run.seed):
                 self.assertEqual(run.actions, 40)
@@ -106,6 +108,17 @@ class TestSmokeBattery(unittest.TestCase):
         )
         self.assertIn("icub rank4, prediction error:", report)
         self.assertIn("The trm spaces: icub, 12 states and", report)
+        # The figures of the first seed's maintained runs: each state of the initial space is
+        # kept or removed, each of the final space kept or added.
+        histories = adaptive_space.SpaceHistories(everything, self.output)["icub"]
+        self.assertEqual([h.title for h in histories], ["icub, rank4", "icub, trm"])
+        rank4 = [r for r in runs if r.condition == "maintained" and r.seed == 0][0]
+        self.assertEqual(len(histories[0].kept) + len(histories[0].removed), 256)
+        self.assertEqual(len(histories[0].kept) + len(histories[0].added), rank4.states)
+        self.assertReadable(Figure(histories), "adaptive space")
+        for name in ("adaptive_space.png", "adaptive_space_icub.html"):
+            self.assertTrue((self.output / name).is_file(), name)
+        self.assertIn("Figures (the first seed's maintained runs)", report)
 
 
 class TestTheReachLearnersSpace(unittest.TestCase):

@@ -46,7 +46,12 @@ from pydrake.geometry import Meshcat
 
 from mobee_drake.atomic_files import CurrentGeneration, WriteTextAtomically
 from mobee_drake.experiments import adaptive_space_reaching as reaching
-from mobee_drake.experiments.adaptive_space_figures import Figure, History, ShowSpace
+from mobee_drake.experiments.adaptive_space_figures import (
+    Figure,
+    History,
+    ShowObjects,
+    ShowSpace,
+)
 from mobee_drake.experiments.adaptive_space_reaching import STRATEGIES, MaintainedMinusFixed
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
 from mobee_drake.experiments.battery import (
@@ -444,8 +449,14 @@ def WriteSpaceFigures(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> lis
         meshcat = Meshcat()
         model = KinematicModel(arms[robot].robot, list(arms[robot].objects), meshcat=meshcat)
         model.Publish(model.home)
-        for history in robot_histories:
-            ShowSpace(meshcat, history, f"spaces/{history.title.split(', ')[1]}")
+        ShowObjects(meshcat, arms[robot].objects)
+        for k, history in enumerate(robot_histories):  # (the first shown; the rest in the tree)
+            path = f"spaces/{history.title.split(', ')[1]}"
+            ShowSpace(meshcat, history, path)
+            meshcat.SetProperty(path, "visible", k == 0)
+        points = np.vstack([h.kept for h in robot_histories])
+        centre = points.mean(axis=0)
+        meshcat.SetCameraPose(centre + [-0.9, 0.5, 0.45], centre)
         written.append(f"adaptive_space_{robot}.html")
         WriteTextAtomically(output / written[-1], meshcat.StaticHtml())
     return written

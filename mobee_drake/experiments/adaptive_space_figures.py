@@ -15,9 +15,10 @@ from pydrake.perception import BaseField, Fields, PointCloud
 
 from mobee_drake.experiments.plots import Legend
 from mobee_drake.ngik.kinematic_model import KinematicModel
+from mobee_drake.world.live_world import MakeShape, ObjectPose
 
 # The colours of the kept, removed and added states.
-KEPT, REMOVED, ADDED = "tab:blue", "tab:red", "tab:orange"
+KEPT, REMOVED, ADDED = "tab:blue", "tab:red", "tab:green"
 
 
 @dc.dataclass
@@ -93,7 +94,7 @@ def Figure(histories: list[SpaceHistory]):
 def ShowSpace(meshcat: Meshcat, history: SpaceHistory, path: str) -> None:
     """Draws a space's kept, removed and added states as point clouds under ``path``."""
     colours = {"kept": Rgba(0.12, 0.47, 0.71, 1), "removed": Rgba(0.84, 0.15, 0.16, 1)}
-    colours["added"] = Rgba(1.0, 0.5, 0.05, 1)
+    colours["added"] = Rgba(0.17, 0.63, 0.17, 1)
     for name, points in (
         ("kept", history.kept), ("removed", history.removed), ("added", history.added),
     ):  # fmt: skip
@@ -101,3 +102,10 @@ def ShowSpace(meshcat: Meshcat, history: SpaceHistory, path: str) -> None:
             cloud = PointCloud(len(points), Fields(BaseField.kXYZs))
             cloud.mutable_xyzs()[:] = points.T
             meshcat.SetObject(f"{path}/{name}", cloud, point_size=0.012, rgba=colours[name])
+
+
+def ShowObjects(meshcat: Meshcat, objects, path: str = "objects") -> None:
+    """Draws the world's ``objects`` (SceneObjects), translucent grey, under ``path``."""
+    for obj in objects:
+        meshcat.SetObject(f"{path}/{obj.name}", MakeShape(obj.shape), Rgba(0.5, 0.5, 0.5, 0.5))
+        meshcat.SetTransform(f"{path}/{obj.name}", ObjectPose(obj.position, obj.rpy_deg))
