@@ -421,18 +421,7 @@ def RunOne(
         noise_seed=settings.seed,
     )
     checkpoint = run_dir / "checkpoint"
-    data = dict(evaluations={}, wall_seconds=0.0, target=None)
-    generation = CurrentGeneration(checkpoint)
-    if generation is not None:
-        saved = json.loads((generation / "learner.json").read_text())
-        arrays = np.load(generation / "learner.npz")
-        if keeper is not None:
-            keeper.Restore(learner, robot, arrays, saved.pop("maintenance"))
-        learner.LoadArrays(arrays, saved.pop("learner"))
-        robot.Load(generation / "simulation")
-        data = saved
-        if data["target"] is not None:
-            robot.SetProblem(np.array(data["target"]))
+    data = _Resume(checkpoint, robot, learner, keeper)
     started = time.perf_counter() - data["wall_seconds"]
 
     def Save():
@@ -462,17 +451,39 @@ def RunOne(
             Save()
             raise JobStopped(f"{run_dir.name}: stopped after {done + 1} problem-tries")
     Save()
-    arrays, _ = learner.ToArrays()
     extra = {}
     if keeper is not None:  # (the MDP's space changed: its summary instead)
         extra["space"] = keeper.Summary(learner)
     elif settings.mdp == "simultaneous":
         extra = dict(mdp=_LearnedMdp(run_dir, learner, model))
+    return _Result(settings, learner, robot, data, extra).ToJson()
+
+
+def _Resume(checkpoint: pathlib.Path, robot, learner, keeper) -> dict:
+    """Puts ``robot``, ``learner`` (and the ``keeper``'s space) where the newest generation of
+    ``checkpoint`` left them; the run's data (evaluations, wall time, the problem's target),
+    empty for a new run."""
+    generation = CurrentGeneration(checkpoint)
+    if generation is None:
+        return dict(evaluations={}, wall_seconds=0.0, target=None)
+    saved = json.loads((generation / "learner.json").read_text())
+    arrays = np.load(generation / "learner.npz")
+    if keeper is not None:
+        keeper.Restore(learner, robot, arrays, saved.pop("maintenance"))
+    learner.LoadArrays(arrays, saved.pop("learner"))
+    robot.Load(generation / "simulation")
+    if saved["target"] is not None:
+        robot.SetProblem(np.array(saved["target"]))
+    return saved
+
+
+def _Result(settings: RunSettings, learner, robot, data: dict, extra: dict) -> ReachRun:
+    """A finished run's result."""
     safety = robot.Safety()
-    result = ReachRun(
+    return ReachRun(
         settings=settings,
         evaluations={int(stage): e for stage, e in data["evaluations"].items()},
-        log=arrays["log"].tolist(),
+        log=learner.ToArrays()[0]["log"].tolist(),
         simulated_seconds=robot.simulated_seconds,
         wall_seconds=data["wall_seconds"],
         penetrating_steps=safety.penetrating_steps,
@@ -481,7 +492,6 @@ def RunOne(
         num_states=learner.space.num_states,
         **extra,
     )
-    return result.ToJson()
 
 
 def LoadTrainedLearner(run_dir: str | pathlib.Path) -> tuple[ReachLearner, TargetGrid]:
