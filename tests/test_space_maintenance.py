@@ -207,6 +207,24 @@ class TestARoadmapSpace(unittest.TestCase):
 class TestOnTheSupervisor(unittest.TestCase):
     """The supervisor with the robot's state fixed by the test: a robot that never moves."""
 
+    def test_a_planner_cannot_reshape_its_space(self):
+        """A goal state's number would change with the space: refused, naming the agent."""
+        from mobee_drake.planning.explorers import ExplorerConfig
+        from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
+
+        agent = Agent(
+            name="arm",
+            joints=["a"],
+            space=FromGraph([[0.0], [1.0]], [(0, 1)]),
+            explorer=ExplorerConfig(strategy="planner", goal_state=1),
+            maintenance=MaintenanceConfig(),
+        )
+        with self.assertRaisesRegex(ValueError, "agent 'arm': a space that reshapes itself"):
+            ExplorationSupervisor(
+                agents=[agent], joints=["a"], lower=np.array([-1.0]), upper=np.array([1.0]),
+                home=np.array([0.0]),
+            )  # fmt: skip
+
     def _Dut(self):
         from mobee_drake.planning.explorers import ExplorerConfig
         from mobee_drake.planning.supervisor import ActionTiming, Agent, ExplorationSupervisor

@@ -36,6 +36,7 @@ from mobee_drake.planning.explorers import (
 )
 from mobee_drake.planning.space_maintenance import Maintenance, MaintenanceConfig
 from mobee_drake.planning.state_space import FromGraph, Lattice, StateActionSpace
+from mobee_drake.planning.strategies import STRATEGIES
 from mobee_drake.station.parts import ClientPorts, StationParts
 from mobee_drake.station.settling import ActionTiming
 from mobee_drake.trm.roadmap import TaskRelevantRoadmap
@@ -150,6 +151,12 @@ class ExplorationSupervisor(LeafSystem):
                     f"{agent.space.centres.shape[1]} dimensions for "
                     f"{len(agent.joints)} joints"
                 )
+            if agent.maintenance is not None and STRATEGIES[agent.explorer.strategy].seeks_goal:
+                raise ValueError(
+                    f"agent '{agent.name}': a space that reshapes itself is for exploring "
+                    f"agents; strategy '{agent.explorer.strategy}' heads for a goal state, "
+                    "whose number a round would change"
+                )
             self._columns.append(np.array([joints.index(j) for j in agent.joints]))
         claimed = np.concatenate(self._columns) if self._columns else np.zeros(0, dtype=int)
         if len(set(claimed.tolist())) != len(claimed):
@@ -252,6 +259,7 @@ class ExplorationSupervisor(LeafSystem):
                         state=outcome,
                         actions_done=record.actions_done + 1,
                         arrived=True,
+                        maintenance=maintenance,
                     )
                 else:
                     records[i] = self._Begin(
