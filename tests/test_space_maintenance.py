@@ -405,3 +405,33 @@ class TestGrowthNeverReturns(unittest.TestCase):
             _Tried(explorer, sa, space.action_state[sa], 1)
         explorer, _ = maintenance.Apply(explorer, 0, 2)
         np.testing.assert_allclose(explorer.space.centres[:, 0], [0.0, 1.0, 0.25, 0.875])
+
+
+class TestInAScenario(unittest.TestCase):
+    def test_a_scenario_turns_it_on_and_logs_the_space(self):
+        """The shipped hypercube scenario with `maintenance: {every: 3}` for its agent: the
+        agent's record carries the maintenance and the data log its three columns."""
+        from mobee_drake.scenario import BuildScenario, LoadScenario
+
+        scenario = LoadScenario(
+            "explore_hypercube",
+            [
+                "{attractor: !ExploreAttractor {agents: [{name: right_arm, joints: "
+                "[r_shoulder_pitch, r_shoulder_roll, r_shoulder_yaw, r_elbow], levels: "
+                "[0.25, 0.75], maintenance: {every: 3}}]}}"
+            ],
+        )
+        self.assertEqual(scenario.attractor.agents[0].maintenance.every, 3)
+        station = BuildScenario(scenario)
+        supervisor = station.client
+        names = [name for name, _ in supervisor.DataLogColumns()]
+        self.assertEqual(names[-3:], [f"agent.right_arm.{c}" for c in _MAINTENANCE_COLUMNS])
+        context = supervisor.CreateDefaultContext()
+        supervisor.GetInputPort("robot_state").FixValue(
+            context, np.zeros(2 * len(station.mobee.joints))
+        )
+        supervisor.ExecuteInitializationEvents(context)
+        self.assertEqual(supervisor.Records(context)[0].maintenance.config.every, 3)
+
+
+_MAINTENANCE_COLUMNS = ("states", "state_actions", "space_changes")
