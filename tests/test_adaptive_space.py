@@ -71,13 +71,13 @@ class TestSmokeBattery(FigureTest):
         self.addCleanup(shutil.rmtree, self.output.parent)
 
     def test_the_smoke_battery(self):
-        """2 seeds x 40 actions on the rank-4 lattice and on a roadmap of 12 states, fixed and
+        """2 seeds x 30 actions on the rank-4 lattice and on a roadmap of 12 states, fixed and
         maintained every 10 actions (a state pruned after one try into it): every run reports;
         on the lattice only the maintained ones change their space, and its size in the report
         is what the runs ended with; no penetration."""
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             adaptive_space.main(
-                ["--seeds", "2", "--actions", "40", "--tests", "5", "--every", "10",
+                ["--seeds", "2", "--actions", "30", "--tests", "3", "--every", "10",
                  "--prune-after", "1", "--spaces", "rank4", "trm", "--trm-spacing", "0.6",
                  "--trm-states", "12", "--output", str(self.output), "--workers", "2"]
             )  # fmt: skip
@@ -93,7 +93,7 @@ class TestSmokeBattery(FigureTest):
         everything, runs = runs, [r for r in runs if r.space == "rank4"]
         for run in runs:
             with self.subTest(condition=run.condition, seed=run.seed):
-                self.assertEqual(run.actions, 40)
+                self.assertTrue(30 <= run.actions <= 35)  # (it stops at a chunk's end)
                 self.assertGreater(run.tests, 0)
                 self.assertEqual(run.penetrating_steps, 0)
                 self.assertTrue(0 < run.coverage < 1)
@@ -104,7 +104,7 @@ class TestSmokeBattery(FigureTest):
         maintained = [r for r in runs if r.condition == "maintained"]
         states = np.mean([r.states for r in maintained])
         self.assertRegex(
-            report, rf"\| icub \| rank4 \| maintained \| 2 \| 40 \| .* \| {states:.0f} \|"
+            report, rf"\| icub \| rank4 \| maintained \| 2 \| 3\d \| .* \| {states:.0f} \|"
         )
         self.assertIn("icub rank4, prediction error:", report)
         self.assertIn("The trm spaces: icub, 12 states and", report)
