@@ -1,23 +1,25 @@
 """Experiment: a state-action space that reshapes itself (ch. 9.4.5; docs/adaptive_space.md).
 
-The curious agent of ch. 7 explores the right arm's shoulder and elbow for ``--actions`` actions
-on a fixed space and on the same space maintained by the rules of
+The curious agent of ch. 7 explores an arm (``--robots``: :func:`Arms`, the iCub's right
+shoulder and elbow, the Katana's first four joints among its scenario's obstacles) for
+``--actions`` actions on a fixed space and on the same space maintained by the rules of
 :mod:`mobee_drake.planning.space_maintenance`, ``--seeds`` runs of each, paired by seed (the same
-generator). The spaces (``--spaces``): ch. 7.3's rank-4 lattice at 12.5-87.5 % (256 states; its
-corner states beyond the shoulder's cable constraints are never entered), ch. 7.2's rank-3
-lattice (81 states, all reachable), and ``trm``: a task-relevant roadmap over the valid
-configurations themselves (:mod:`mobee_drake.trm.configuration`; ``--trm-spacing``, at most
-``--trm-states`` states, the rank-4 lattice's number by default), built once by the battery's
-job ``roadmap``, its vertices the states and its edges the actions both ways.
+generator). The spaces (``--spaces``): ch. 7.3's rank-4 lattice at 12.5-87.5 % (256 states; on
+the iCub its corner states beyond the shoulder's cable constraints are never entered), ch. 7.2's
+rank-3 lattice (81 states), and ``trm``: a task-relevant roadmap over the valid configurations
+themselves (:mod:`mobee_drake.trm.configuration`; ``--trm-spacing``, at most ``--trm-states``
+states, the rank-4 lattice's number by default), built once per arm by the battery's job
+``<robot>_roadmap``, its vertices the states and its edges the actions both ways. The ch. 8 part
+(``--part reaching``) is :mod:`mobee_drake.experiments.adaptive_space_reaching`.
 
 Per run, at the end:
 
 - *coverage*: the share of a fixed sample of the arm's valid configurations (within the joint
   limits, every constraint clause satisfied, no collision; ``VALID_SAMPLES`` of them, drawn
   uniformly in fractions of each joint's range) within ``--radius`` (fractions of range; by
-  default the lattices' spacing, within which every point of the range lies of some lattice
-  state) of the centre of a state the robot arrived in: how much of what the arm can do the
-  agent has been near, whatever its space;
+  default the lattices' spacing, within which every point of the range lies of some rank-4
+  lattice state) of the centre of a state the robot arrived in: how much of what the arm can do
+  the agent has been near, whatever its space;
 - *dispersion*: the mean distance (fractions of range) from those valid configurations to the
   nearest centre of a state the robot arrived in (no threshold);
 - *prediction error*: ``--tests`` state-actions of states the robot arrived in, drawn at random,
@@ -29,8 +31,10 @@ Per run, at the end:
 - the space's states and state-actions at the end, its changes by rule, the robot's simulated
   time per action, the wall time and the penetrating periods.
 
-Maintained minus fixed is compared paired by seed, Holm-corrected over the spaces and the three
-measures.
+Maintained minus fixed is compared paired by seed, Holm-corrected over the arms, the spaces and
+the four measures (coverage, dispersion, prediction error, state-actions tried). The report names
+a PNG and, per arm, a Meshcat scene of the first seed's maintained runs
+(:mod:`mobee_drake.experiments.adaptive_space_figures`).
 
 Run: ``mobee-drake experiment adaptive-space [--robots icub katana] [--seeds 10] [--actions 2000]
 [--output results/adaptive_space] [--doc docs/adaptive_space.md]``.
