@@ -153,6 +153,16 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         report = (output / "report.md").read_text()
         self.assertIn("| greedy | maintained | 2 | 8 |", report)
         self.assertIn("greedy, summed reward:", report)
+        # The report of the finished runs alone, a third seed's runs not started.
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            adaptive_space.main(
+                ["--part", "reaching", "--mdp", "simultaneous", "--strategies", "greedy",
+                 "--seeds", "3", "--problem-tries", "8", "--stages", "8", "--evaluations", "1",
+                 "--every", "4", "--rules", "develop", "--output", str(output), "--report-only"]
+            )  # fmt: skip
+        self.assertFalse(list(output.glob("runs/*seed2")))
+        table = (output / "report.md").read_text()
+        self.assertEqual(table.split("Command:")[0], report.split("Command:")[0])
 
     def test_a_reshaping_run_resumes_exactly(self):
         """A greedy run whose space is developed every 4 problem-tries (its best reach states,

@@ -25,6 +25,8 @@ from mobee_drake.experiments import battery, saggriac
 from mobee_drake.experiments.battery import (
     RAY_MISSING,
     BatteryError,
+    BatteryRefused,
+    FinishedResults,
     InProcess,
     Job,
     LocalProcesses,
@@ -79,6 +81,17 @@ class LocalBatteryTest(TemporaryFolder):
         self.assertEqual(len(Calls(calls)), 3)
         RunBattery(Counts(calls, 4), output, backend=InProcess(), progress=False)
         self.assertEqual(sorted(Calls(calls)), ["count0", "count1", "count2", "count3"])
+
+    def test_finished_results_run_nothing_and_refuse_other_arguments(self):
+        output, calls = self.folder / "out", self.folder / "calls"
+        ran = RunBattery(Counts(calls, 2), output, backend=InProcess(), progress=False)
+        before = sorted(str(p.relative_to(output)) for p in output.rglob("*"))
+        self.assertEqual(FinishedResults(Counts(calls, 4), output), ran)
+        self.assertEqual(len(Calls(calls)), 2)  # Nothing ran, and nothing was written:
+        self.assertEqual(sorted(str(p.relative_to(output)) for p in output.rglob("*")), before)
+        other = [Job("count1", Count, dict(x=5, calls=str(calls)))]
+        with self.assertRaisesRegex(BatteryRefused, "count1: .*x"):
+            FinishedResults(other, output)
 
     def test_killed_job_resumes_exactly(self):
         reference = RunBattery(Walks(), self.folder / "ref", backend=InProcess(), progress=False)

@@ -61,6 +61,7 @@ from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, Posi
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
+    FinishedResults,
     Job,
     RunBattery,
     RunFolder,
@@ -412,6 +413,11 @@ def _Parser() -> CommandParser:
         help="a doc whose generated block 'adaptive-space' ('adaptive-space-reaching') gets "
         "the report",
     )
+    parser.add_argument(
+        "--report-only",
+        action="store_true",
+        help="run nothing: the report of the runs in --output that have finished",
+    )
     AddBackendArguments(parser)
     return parser
 
@@ -466,6 +472,15 @@ def WriteSpaceFigures(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> lis
     return written
 
 
+def _Results(args, jobs: list[Job], output: pathlib.Path, description: str) -> dict[str, dict]:
+    """The jobs' results: those missing run first, or with ``--report-only`` the finished ones
+    alone."""
+    if not args.report_only:
+        return RunBattery(jobs, output, backend=BackendOf(args), description=description)
+    with OwnedFolder(output, "battery"):
+        return FinishedResults(jobs, output)
+
+
 def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, command):
     """Runs the exploration part's battery; its report."""
     built = {}
@@ -479,7 +494,7 @@ def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Pat
             )
             for robot in args.robots
         ]
-        built = RunBattery(roadmaps, output, backend=BackendOf(args), description="trm spaces")
+        built = _Results(args, roadmaps, output, "trm spaces")
         built = {name.removesuffix(f"_{ROADMAP_JOB}"): r for name, r in built.items()}
     jobs = [
         Job(
@@ -502,7 +517,7 @@ def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Pat
         for space in args.spaces
         for condition in CONDITIONS
     ]
-    results = RunBattery(jobs, output, backend=BackendOf(args), description="adaptive space")
+    results = _Results(args, jobs, output, "adaptive space")
     runs = [AdaptiveSpaceRun(**r) for r in results.values()]
     with OwnedFolder(output, "battery"):
         figures = WriteSpaceFigures(runs, output)
@@ -515,7 +530,7 @@ def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Pat
 def _ReachingReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, command):
     """Runs the reaching part's battery; its report."""
     jobs = reaching.Jobs(args, maintenance)
-    results = RunBattery(jobs, output, backend=BackendOf(args), description="adaptive reaching")
+    results = _Results(args, jobs, output, "adaptive reaching")
     runs = [reaching.AdaptiveReachRun(**r) for n, r in results.items() if n.startswith("reach_")]
     return reaching.Report(runs, command)
 
@@ -541,6 +556,8 @@ def main(argv: list[str] | None = None) -> None:
         args.output
         or ("results/adaptive_space" if exploring else "results/adaptive_space_reaching")
     )
+    if args.report_only and not any(output.glob("runs/*/result.json")):
+        parser.error(f"--report-only: no finished runs in {output / 'runs'}")
     command = ("mobee-drake experiment adaptive-space " + " ".join(argv or [])).strip()
     run = _ExplorationReport if exploring else _ReachingReport
     report = run(args, maintenance, output, command)

@@ -7,6 +7,8 @@ A battery is a list of jobs (:class:`Job`), each a module-level function called 
 - ``runs/<name>/result.json``: the job's result, checked as strict JSON (a NaN or an infinity
   fails the job, naming it) and written atomically by the runner when the job returns. A job whose
   result file exists is not run again: its stored result is returned (run-if-missing).
+  :func:`FinishedResults` returns the stored results alone, running nothing (a report of part
+  of a battery).
 - ``runs/<name>/job.json``: the job's function and arguments, written before it first runs. A
   battery whose job finds its folder holding a run of other arguments (a result or a checkpoint
   made with other settings) is refused before anything runs, naming what differs, so that a
@@ -542,9 +544,30 @@ def _ArgumentsText(job: Job) -> str:
     return StrictJson(arguments, default=_Plain, sort_keys=True, indent=1)
 
 
+def FinishedResults(jobs: Iterable[Job], output: str | pathlib.Path) -> dict[str, dict]:
+    """The stored results of those of ``jobs`` that have finished in ``output``, keyed by name in
+    job order, running and writing nothing (a report while the battery runs, or of part of it).
+
+    Raises:
+        BatteryRefused: When a finished job's folder holds a run of other arguments, as
+            :func:`RunBattery` would.
+    """
+    jobs, output = list(jobs), pathlib.Path(output).absolute()
+    results = {job.name: _StoredResult(output, job.name) for job in jobs}
+    _RefuseOtherArguments([job for job in jobs if results[job.name] is not None], output)
+    return {name: result for name, result in results.items() if result is not None}
+
+
 def _CheckArguments(jobs: list[Job], output: pathlib.Path) -> None:
     """Records each job's arguments in its folder (``job.json``), or, when the folder holds
     a run of other arguments, refuses the battery naming what differs."""
+    _RefuseOtherArguments(jobs, output)
+    for job in jobs:
+        if not (output / "runs" / job.name / ARGUMENTS).is_file():
+            WriteTextAtomically(output / "runs" / job.name / ARGUMENTS, _ArgumentsText(job))
+
+
+def _RefuseOtherArguments(jobs: list[Job], output: pathlib.Path) -> None:
     mismatches = []
     for job in jobs:
         path, text = output / "runs" / job.name / ARGUMENTS, _ArgumentsText(job)
@@ -563,9 +586,6 @@ def _CheckArguments(jobs: list[Job], output: pathlib.Path) -> None:
             + (f" | and {len(mismatches) - 3} more" if len(mismatches) > 3 else "")
             + "); use another output folder for these settings"
         )
-    for job in jobs:
-        if not (output / "runs" / job.name / ARGUMENTS).is_file():
-            WriteTextAtomically(output / "runs" / job.name / ARGUMENTS, _ArgumentsText(job))
 
 
 def _RunJobs(
