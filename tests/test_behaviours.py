@@ -324,7 +324,7 @@ class TestParallelBehavioursExperiment(FigureTest):
         self.assertLess(mean["on"], mean["off"])
         report = (folder / "report.md").read_text()
         self.assertIn("| on | 2 |", report)
-        self.assertIn("On minus off, paired by seed (2 pairs", report)
+        self.assertIn("On minus off, paired by seed (Holm over the 2):", report)
         self.assertReadable(parallel_behaviours.Figure(runs), "parallel behaviours")
 
 

@@ -1,6 +1,7 @@
 """Run-level statistics of the experiments' reports (issue 23, point 8) against closed forms,
 textbook values, scipy and simulation."""
 
+import collections
 import math
 import unittest
 
@@ -14,6 +15,7 @@ from mobee_drake.experiments.statistics import (
     CompareRuns,
     CompareToZero,
     Holm,
+    PairedBySeed,
     RankBiserialInterval,
     RatioOfMeans,
     RunMeans,
@@ -288,6 +290,26 @@ class TestPairedAndFamilies(unittest.TestCase):
         self.assertLess(c.t_p, stats.ttest_ind(a, b).pvalue)  # pairing removes the seeds' luck
         with self.assertRaisesRegex(ValueError, "more pairs than blocks"):
             ComparePaired(a[:3], b[:3], [0, 1, 2])
+
+    def test_paired_by_seed_matches_seeds_and_corrects_over_every_comparison(self):
+        Run = collections.namedtuple("Run", "seed value")
+        rng = np.random.default_rng(2)
+        control = rng.normal(0, 1, 6)
+        treated = control + 1.0 + rng.normal(0, 0.2, 6)
+        on = [Run(s, v) for s, v in enumerate(treated)]
+        off = [Run(s, v) for s, v in enumerate(control)][::-1]  # (another order: paired by seed)
+        off.append(Run(9, 100.0))  # No pair: left out.
+        measures = {"value": lambda r: r.value, "double": lambda r: 2 * r.value}
+        lines = PairedBySeed(
+            {"arm": (on, off), "alone": (on[:1], off)}, measures, "On minus off"
+        )  # ("alone" has one pair: left out, so the family is the two measures of "arm")
+        self.assertEqual(lines[:3], ["", "On minus off, paired by seed (Holm over the 2):", ""])
+        expected = ComparePaired(treated, control, np.zeros(6))
+        p = Holm([expected.t_p] * 2)[0]
+        self.assertEqual(lines[3], f"- arm, value: {expected.Text(p)}")
+        self.assertTrue(lines[4].startswith(f"- arm, double: {2 * expected.difference:+.2f} "))
+        self.assertEqual(len(lines), 5)
+        self.assertEqual(PairedBySeed({"": (on[:1], off)}, measures, "On minus off"), [])
 
     def test_ratio_of_means_and_its_interval(self):
         a, b = np.array([2.0, 4.0, 6.0, 8.0]), np.array([1.0, 2.0, 3.0, 4.0])

@@ -25,7 +25,7 @@ import numpy as np
 from mobee_drake.experiments.battery import Job, RunFolder, StopRequested
 from mobee_drake.experiments.ch8_figures import EvaluationSum
 from mobee_drake.experiments.ch8_reaching import MdpJob, MdpName, ReachRun, RunOne, RunSettings
-from mobee_drake.experiments.statistics import ComparePaired, Holm, RunMeans
+from mobee_drake.experiments.statistics import PairedBySeed, RunMeans
 from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
 
 STRATEGIES = ("greedy", "intrinsic", "random")
@@ -134,22 +134,11 @@ def Jobs(args, maintenance: MaintenanceConfig) -> list[Job]:
 def MaintainedMinusFixed(group: dict, keys: list[tuple], measures: dict) -> list[str]:
     """Report lines: for each key (``group``'s keys are a key and a condition), maintained
     minus fixed on each of ``measures`` (run -> value), paired by seed, Holm over them all."""
-    compared = {}
-    for key in keys:
-        on, off = group.get((*key, "maintained"), []), group.get((*key, "fixed"), [])
-        seeds = sorted({r.seed for r in on} & {r.seed for r in off})
-        if len(seeds) < 2:
-            continue
-        on, off = ([r for r in rs if r.seed in seeds] for rs in (on, off))
-        for name, f in measures.items():
-            compared[f"{' '.join(key)}, {name}"] = ComparePaired(
-                [f(r) for r in on], [f(r) for r in off], [0] * len(seeds)
-            )
-    if not compared:
-        return []
-    adjusted = Holm([c.t_p for c in compared.values()])
-    lines = ["", f"Maintained minus fixed, paired by seed (Holm over the {len(compared)}):", ""]
-    return lines + [f"- {n}: {c.Text(p)}" for (n, c), p in zip(compared.items(), adjusted)]
+    families = {
+        " ".join(key): (group.get((*key, "maintained"), []), group.get((*key, "fixed"), []))
+        for key in keys
+    }
+    return PairedBySeed(families, measures, "Maintained minus fixed")
 
 
 def Report(runs: list[AdaptiveReachRun], command: str) -> str:

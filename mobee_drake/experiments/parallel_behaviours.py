@@ -37,7 +37,7 @@ from mobee_drake.experiments.battery import (
 )
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.plots import Legend, SaveFigure, plt
-from mobee_drake.experiments.statistics import ComparePaired, FiniteMean, Holm
+from mobee_drake.experiments.statistics import FiniteMean, PairedBySeed
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.scenario import LoadScenario, RunScenario
 
@@ -131,22 +131,11 @@ def Report(runs: list[ParallelRun], command: str) -> str:
             f"{sum(r.penetrating_steps for r in group)} | "
             f"{np.mean([r.wall_seconds for r in group]):.1f} |"
         )
-    seeds = {r.seed for r in by["on"]} & {r.seed for r in by["off"]}
-    pairs = {c: [r for r in by[c] if r.seed in seeds] for c in CONDITIONS}
-    if len(seeds) >= 2:
-        measures = {
-            "palm error at an action's end (deg)": lambda r: r.palm_mean,
-            "share of actions ending facing the ball": lambda r: r.facing,
-        }
-        compared = {
-            name: ComparePaired(
-                [f(r) for r in pairs["on"]], [f(r) for r in pairs["off"]], [0] * len(seeds)
-            )
-            for name, f in measures.items()
-        }
-        adjusted = Holm([c.t_p for c in compared.values()])
-        lines += ["", f"On minus off, paired by seed ({len(seeds)} pairs, Holm over the two):", ""]
-        lines += [f"- {name}: {c.Text(p)}" for (name, c), p in zip(compared.items(), adjusted)]
+    measures = {
+        "palm error at an action's end (deg)": lambda r: r.palm_mean,
+        "share of actions ending facing the ball": lambda r: r.facing,
+    }
+    lines += PairedBySeed({"": (by["on"], by["off"])}, measures, "On minus off")
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
 
 

@@ -440,6 +440,29 @@ def ComparePaired(a, b, blocks) -> PairedComparison:
     )
 
 
+def PairedBySeed(families: dict, measures: dict, heading: str) -> list[str]:
+    """Report lines: for each of ``families`` (a name: the runs with a treatment and the runs
+    without, each run with a ``seed``), treatment minus control on each of ``measures`` (a name:
+    run -> value), paired by seed (:func:`ComparePaired`, one block), Holm over every comparison.
+    A family with fewer than two pairs is left out; no lines when none is left."""
+    compared = {}
+    for family, (treated, control) in families.items():
+        seeds = sorted({r.seed for r in treated} & {r.seed for r in control})
+        if len(seeds) < 2:
+            continue
+        treated, control = (sorted((r for r in rs if r.seed in seeds), key=lambda r: r.seed)
+                            for rs in (treated, control))  # fmt: skip
+        for name, f in measures.items():
+            compared[f"{family}, {name}" if family else name] = ComparePaired(
+                [f(r) for r in treated], [f(r) for r in control], [0] * len(seeds)
+            )
+    if not compared:
+        return []
+    adjusted = Holm([c.t_p for c in compared.values()])
+    lines = ["", f"{heading}, paired by seed (Holm over the {len(compared)}):", ""]
+    return lines + [f"- {name}: {c.Text(p)}" for (name, c), p in zip(compared.items(), adjusted)]
+
+
 def RatioOfMeans(a, b, blocks, resamples: int = BOOTSTRAP_RESAMPLES) -> tuple[float, float, float]:
     """mean(a) / mean(b) of matched runs, with a 95 % percentile bootstrap interval of two
     stages: the blocks (MDPs) resampled, then the pairs within each block drawn (seeded:

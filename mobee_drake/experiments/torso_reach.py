@@ -40,7 +40,7 @@ from mobee_drake.experiments.battery import (
 )
 from mobee_drake.experiments.ch8_reaching import RIGHT_ARM, LoadTrainedLearner, ReachScenario
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
-from mobee_drake.experiments.statistics import ComparePaired, FiniteMean, Holm
+from mobee_drake.experiments.statistics import FiniteMean, PairedBySeed
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.reaching.robot import SimulatedRobot
 from mobee_drake.reaching.targets import TARGET_NAME, TargetObject
@@ -273,21 +273,8 @@ def Report(runs: list[TorsoReachRun], within: float, command: str) -> str:
         "share reached": lambda r: r.Successes(within),
         "robot s per problem": lambda r: r.robot_seconds,
     }
-    compared = {}
-    for targets in TARGET_SETS:
-        on, off = group[(targets, "on")], group[(targets, "off")]
-        seeds = sorted({r.seed for r in on} & {r.seed for r in off})
-        if len(seeds) < 2:
-            continue
-        on, off = ([r for r in rs if r.seed in seeds] for rs in (on, off))
-        for name, f in measures.items():
-            compared[f"{targets} targets, {name}"] = ComparePaired(
-                [f(r) for r in on], [f(r) for r in off], [0] * len(seeds)
-            )
-    if compared:
-        adjusted = Holm([c.t_p for c in compared.values()])
-        lines += ["", f"On minus off, paired by seed (Holm over the {len(compared)}):", ""]
-        lines += [f"- {name}: {c.Text(p)}" for (name, c), p in zip(compared.items(), adjusted)]
+    families = {f"{t} targets": (group[(t, "on")], group[(t, "off")]) for t in TARGET_SETS}
+    lines += PairedBySeed(families, measures, "On minus off")
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
 
 
