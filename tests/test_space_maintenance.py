@@ -45,19 +45,20 @@ class TestEditSpace(unittest.TestCase):
     def test_drop_a_state_add_one_and_actions(self):
         """Drop state 3 of the square, add a state (index 4 before the drop) joined to 1 and
         a shortcut 0 -> 4: the remaining actions, renumbered, sorted by state then goal."""
-        edited, state_index, action_index = EditSpace(
+        edit = EditSpace(
             SQUARE,
             drop_states=[3],
             drop_actions=[1],  # 0 -> 2
             new_centres=[[0.5, 0.75]],
             new_actions=[(4, 1), (1, 4), (0, 4)],
         )
-        np.testing.assert_array_equal(state_index, [0, 1, 2, -1])
+        edited = edit.space
+        np.testing.assert_array_equal(edit.state_index, [0, 1, 2, -1])
         np.testing.assert_allclose(edited.centres, [*SQUARE.centres[:3], [0.5, 0.75]])
         pairs = list(zip(edited.action_state.tolist(), edited.action_goal.tolist()))
         self.assertEqual(pairs, [(0, 1), (0, 3), (1, 0), (1, 3), (2, 0), (3, 1)])
         # 0->1 stays first, 0->2 is dropped, 1->0 third, 1->3 and 2->3 went with state 3 ...
-        np.testing.assert_array_equal(action_index, [0, -1, 2, -1, 4, -1, -1, -1])
+        np.testing.assert_array_equal(edit.action_index, [0, -1, 2, -1, 4, -1, -1, -1])
 
     def test_the_model_is_carried_over(self):
         """Kept state-actions keep counts (columns renumbered), rewards and tries; new ones
@@ -66,10 +67,11 @@ class TestEditSpace(unittest.TestCase):
         _Tried(explorer, 0, 1, 3)
         _Tried(explorer, 4, 2, 2)  # 2 -> 0 missed twice
         explorer.rng.random()
-        edited, state_index, action_index = EditSpace(
+        edit = EditSpace(
             SQUARE, drop_states=[3], new_centres=[[0.5, 0.75]], new_actions=[(4, 1), (1, 4)]
         )
-        carried = CarryExplorer(explorer, edited, state_index, action_index)
+        carried = CarryExplorer(explorer, edit)
+        edited, action_index = edit.space, edit.action_index
         fresh = Explorer(edited)
         for old, new in enumerate(action_index):
             if new < 0:
@@ -323,9 +325,11 @@ class TestTheReachLearner(unittest.TestCase):
             target = np.array([0.1 * sa, 0.0, 0.0])
             learner.histories.Record(sa, target, 0.5, float(sa))
             learner.log.append((0, 0, sa, s, o, 0.5, float(sa), *target))
-        edited, state_index, action_index = EditSpace(SQUARE, drop_states=[3])
-        carried = CarryExplorer(explorer, edited, state_index, action_index)
-        learner.Reshape(edited, state_index, action_index, carried.transitions.counts)
+        edit = EditSpace(SQUARE, drop_states=[3])
+        counts = CarryExplorer(explorer, edit).transitions.counts
+        learner.Reshape(edit, counts)
+        with self.assertRaisesRegex(ValueError, "tried already; Reshape"):
+            learner.PutOnSpace(edit.space, counts)  # (for a fresh learner only)
         self.assertEqual((learner.num_transitions, learner.num_state_actions), (4, 7))
         moved = {0: 0, 4: 3, 10: 6}
         for old, new in moved.items():
@@ -334,7 +338,7 @@ class TestTheReachLearner(unittest.TestCase):
         self.assertEqual(sum(len(learner.histories.Records(sa)[1]) for sa in range(7)), 3)
         self.assertEqual([entry[2] for entry in learner.log], [0, 3, 6, -1, -1])
         self.assertEqual([entry[3] for entry in learner.log], [0, 2, 2, -1, 1])
-        rebuilt = ReachLearner(edited, carried.transitions.counts, np.zeros((1, 3)))
+        rebuilt = ReachLearner(edit.space, counts, np.zeros((1, 3)))
         arrays, data = learner.ToArrays()
         rebuilt.LoadArrays(arrays, data)
         for sa in range(7):

@@ -117,13 +117,13 @@ def EditSpace(
     drop_actions=(),
     new_centres=(),
     new_actions=(),
-) -> tuple[StateActionSpace, np.ndarray, np.ndarray]:
+) -> SpaceEdit:
     """``space`` with ``new_centres`` appended (their indices follow the old states'),
     ``new_actions`` added ((state, goal) pairs over old and new indices), then
     ``drop_actions`` (old state-action indices) and ``drop_states`` (old or new indices, with
-    every action into or out of them) removed. Returns the new space, the new index of each old
-    state and of each old state-action (-1: dropped). States keep their order, new ones last;
-    actions are sorted by state, then goal."""
+    every action into or out of them) removed: the new space, where each old state and
+    state-action went. States keep their order, new ones last; actions are sorted by state,
+    then goal."""
     centres = np.vstack([space.centres, np.reshape(new_centres, (-1, space.centres.shape[1]))])
     total = len(centres)
     kept_states = np.ones(total, dtype=bool)
@@ -151,16 +151,15 @@ def EditSpace(
     states = np.array([s for s, _, _ in kept], dtype=int)
     goals = np.array([g for _, g, _ in kept], dtype=int)
     edited = StateActionSpace(centres[kept_states], states, goals)
-    return edited, state_index[: space.num_states], action_index
+    return SpaceEdit(edited, state_index[: space.num_states], action_index)
 
 
-def CarryExplorer(
-    explorer: Explorer, space: StateActionSpace, state_index: np.ndarray, action_index: np.ndarray
-) -> Explorer:
-    """``explorer``'s model moved onto ``space`` (see :func:`EditSpace` for the indices): each
-    kept state-action keeps its counts, intrinsic reward and tries, its outcomes in kept states
-    (prune drops only states no action arrived in, so no outcome observed is lost); new
-    state-actions start optimistic (Alg. 6's initialisation). The generator carries on."""
+def CarryExplorer(explorer: Explorer, edit: SpaceEdit) -> Explorer:
+    """``explorer``'s model moved onto ``edit``'s space: each kept state-action keeps its
+    counts, intrinsic reward and tries, its outcomes in kept states (prune drops only states no
+    action arrived in, so no outcome observed is lost); new state-actions start optimistic
+    (Alg. 6's initialisation). The generator carries on."""
+    space, state_index, action_index = edit.space, edit.state_index, edit.action_index
     carried = Explorer(space, explorer.config)
     carried.rng = explorer.rng
     old = np.flatnonzero(action_index >= 0)
@@ -212,18 +211,16 @@ class Maintenance:
             changes = self._Changes(explorer, pruned, actions_done, favoured)
             if not changes:
                 return None
-            edited, state_index, action_index = EditSpace(
+            edit = EditSpace(
                 space,
                 drop_states=pruned,
                 drop_actions=[_ActionOf(space, *c.states) for c in changes if c.rule == "drop"],
                 new_centres=[c.centre for c in changes if c.rule in _NEW_STATES],
                 new_actions=_NewActions(space, changes),
             )
-            kept = np.flatnonzero(state_index >= 0)
-            stranded = kept[
-                np.bincount(edited.action_state, minlength=edited.num_states)[state_index[kept]]
-                == 0
-            ]
+            kept = np.flatnonzero(edit.state_index >= 0)
+            actions_out = np.bincount(edit.space.action_state, minlength=edit.space.num_states)
+            stranded = kept[actions_out[edit.state_index[kept]] == 0]
             if not len(stranded):
                 break
             goals = space.action_goal[np.isin(space.action_state, stranded)]
@@ -234,10 +231,10 @@ class Maintenance:
         for change in changes:
             if change.rule == "shortcut":  # (an action now: no chain to count)
                 self.chains[change.states] = 0
-        self.chains = _Moved(self.chains, state_index, edited.num_states)
-        self._previous = state_index[self._previous] if self._previous >= 0 else -1
+        self.chains = _Moved(self.chains, edit.state_index, edit.space.num_states)
+        self._previous = edit.state_index[self._previous] if self._previous >= 0 else -1
         self.changes += changes
-        return SpaceEdit(edited, state_index, action_index)
+        return edit
 
     def Apply(self, explorer: Explorer, state: int, actions_done: int) -> tuple[Explorer, int]:
         """:meth:`Plan`'s round carried out: the explorer on the new space and the robot's
@@ -245,8 +242,7 @@ class Maintenance:
         edit = self.Plan(explorer, state, actions_done)
         if edit is None:
             return explorer, state
-        carried = CarryExplorer(explorer, edit.space, edit.state_index, edit.action_index)
-        return carried, int(edit.state_index[state])
+        return CarryExplorer(explorer, edit), int(edit.state_index[state])
 
     def _Changes(
         self, explorer: Explorer, pruned: list[int], actions_done: int, favoured=()

@@ -259,8 +259,7 @@ class ExplorationSupervisor(LeafSystem):
                         state=outcome,
                         actions_done=record.actions_done + 1,
                         arrived=True,
-                        maintenance=maintenance,
-                    )
+                    )  # (a goal-seeking agent's space is not maintained)
                 else:
                     records[i] = self._Begin(
                         columns, explorer, q, now, record.actions_done + 1, maintenance

@@ -65,6 +65,7 @@ from typing import Protocol
 import numpy as np
 
 from mobee_drake.planning.curiosity import TransitionCounts
+from mobee_drake.planning.space_maintenance import SpaceEdit
 from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.planning.value_iteration import ValueIteration
 from mobee_drake.reaching.goals import GoalBabbler, ReachGoalsConfig
@@ -257,27 +258,31 @@ class ReachLearner:
         self._T_sorted = np.zeros((k + m, m))
         self._RefreshT()
 
-    def Reshape(
-        self,
-        space: StateActionSpace,
-        state_index: np.ndarray,
-        action_index: np.ndarray,
-        transition_counts: np.ndarray,
-    ) -> None:
-        """Moves the learner onto a reshaped ``space`` (ch. 9.4.5; the indices as
-        :func:`~mobee_drake.planning.space_maintenance.EditSpace` returns them), the MDP's
-        counts there being ``transition_counts``. Every state-action that stays (a transition,
-        or the reach of a state that stays) keeps its history under its new number; the log's
+    def Reshape(self, edit: SpaceEdit, transition_counts: np.ndarray) -> None:
+        """Moves the learner onto a reshaped space (ch. 9.4.5, ``edit`` as
+        :func:`~mobee_drake.planning.space_maintenance.EditSpace` gives it), the MDP's counts
+        there being ``transition_counts``. Every state-action that stays (a transition, or the
+        reach of a state that stays) keeps its history under its new number; the log's
         state-actions and states are renumbered (-1: dropped), so that the histories rebuilt
         from it (:meth:`LoadArrays`) are these."""
+        space, state_index = edit.space, edit.state_index
         reaches = np.where(state_index >= 0, space.num_state_actions + state_index, -1)
-        new_index = np.concatenate([action_index, reaches])
+        new_index = np.concatenate([edit.action_index, reaches])
         self._SetSpace(space, transition_counts)
         self.histories = self.histories.Moved(new_index, self.reaching)
         self.log = [
             (t, problem, int(new_index[sa]), int(state_index[s]), int(state_index[o]), *rest)
             for t, problem, sa, s, o, *rest in self.log
         ]
+
+    def PutOnSpace(self, space: StateActionSpace, transition_counts: np.ndarray) -> None:
+        """Puts a learner that has not tried anything yet on ``space`` (a run's reshaped space,
+        before its checkpoint's log is loaded), the MDP's counts there being
+        ``transition_counts``."""
+        if self.log:
+            raise ValueError("PutOnSpace: the learner has tried already; Reshape moves its history")
+        self._SetSpace(space, transition_counts)
+        self.histories = RewardHistories(self.reaching, self.config.predictor)
 
     @property
     def num_state_actions(self) -> int:

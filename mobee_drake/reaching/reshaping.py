@@ -59,8 +59,7 @@ def MaintainReachSpace(
     edit = maintenance.Plan(view, state, done, favoured)
     if edit is None:
         return False
-    carried = CarryExplorer(view, edit.space, edit.state_index, edit.action_index)
-    learner.Reshape(edit.space, edit.state_index, edit.action_index, carried.transitions.counts)
+    learner.Reshape(edit, CarryExplorer(view, edit).transitions.counts)
     return True
 
 
@@ -110,8 +109,7 @@ class ReachSpaceKeeper:
             np.asarray(arrays["space_action_state"]),
             np.asarray(arrays["space_action_goal"]),
         )
-        nothing = np.full(learner.space.num_states, -1), np.full(learner.num_transitions, -1)
-        learner.Reshape(space, *nothing, np.asarray(arrays["space_counts"]))  # (fresh: no history)
+        learner.PutOnSpace(space, np.asarray(arrays["space_counts"]))
         robot.space = learner.space
         self.maintenance = Maintenance.FromData(
             self.maintenance.config, arrays["maintenance_chains"], data
