@@ -143,6 +143,16 @@ class TestEffectSizes(unittest.TestCase):
         low, high = CohensDInterval(6.0, 30, 30)
         self.assertTrue(4.0 < low < 6.0 < high < 8.0)
 
+    def test_d_interval_of_a_huge_effect_in_few_runs(self):
+        """SciPy's noncentral t gives NaN far in its tails (t = -40.8, df = 2, ncp = 23); the
+        bracket widens through them and the bounds still invert the distribution."""
+        d = -40.84691578627283  # (the decisive battery's first report, 2 runs a side)
+        low, high = CohensDInterval(d, 2, 2)
+        self.assertLess(low, d)
+        self.assertLess(d, high)
+        self.assertAlmostEqual(stats.nct.cdf(d, 2, low), 0.975, places=6)  # (scale 1 at 2, 2)
+        self.assertAlmostEqual(stats.nct.cdf(d, 2, high), 0.025, places=6)
+
     def test_d_interval_covers_the_true_effect(self):
         rng = np.random.default_rng(5)
         covered = 0

@@ -143,7 +143,10 @@ def CohensDInterval(d: float, n_a: int, n_b: int, confidence: float = 0.95) -> t
 
     def Bound(quantile: float) -> float:
         def Gap(ncp: float) -> float:
-            return stats.nct.cdf(t, df, ncp) - quantile
+            cdf = stats.nct.cdf(t, df, ncp)
+            if math.isnan(cdf):  # (SciPy's far tails, e.g. t = -40.8, df = 2, ncp = 23: ~0)
+                cdf = 0.0 if ncp > t else 1.0
+            return cdf - quantile
 
         # nct.cdf(t, df, ncp) falls from 1 to 0 as ncp grows; widen until the root is bracketed.
         low, high, width = t - 1.0, t + 1.0, 1.0
