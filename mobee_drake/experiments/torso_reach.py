@@ -278,7 +278,7 @@ def Report(runs: list[TorsoReachRun], within: float, command: str) -> str:
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
 
 
-def main(argv: list[str] | None = None) -> None:
+def _Parser() -> CommandParser:
     parser = CommandParser(
         prog="mobee-drake experiment torso-reach", description=__doc__.split("\n\n")[0]
     )
@@ -329,6 +329,11 @@ def main(argv: list[str] | None = None) -> None:
     )
     parser.add_argument("--block", help="the name of the doc's generated block (see --doc)")
     AddBackendArguments(parser)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = _Parser()
     args = parser.parse_args(argv)
     module = TorsoModule(args.map, args.torso_levels, args.torso_range, args.settle)
     # (The grid's and settling's settings at their defaults stay out of the jobs, so the
