@@ -14,8 +14,10 @@ from test_figures import FigureTest
 
 from mobee_drake.experiments import adaptive_space
 from mobee_drake.experiments.adaptive_space_figures import Figure
+from mobee_drake.experiments.arms import Arms, ReachTargets, ValidConfigurations
 from mobee_drake.planning.explorers import Explorer
 from mobee_drake.planning.state_space import Lattice
+from mobee_drake.reaching.targets import LoadTargetGrid
 
 
 class TestMeasures(unittest.TestCase):
@@ -36,12 +38,40 @@ class TestMeasures(unittest.TestCase):
         """The iCub's sample keeps some draws and drops others (the shoulder's cable
         constraints cut the corners of the range); the Katana has no constraint clauses, but
         its scenario's obstacles drop some draws too. All within [0, 1]."""
-        arms = adaptive_space.Arms()
+        arms = Arms()
         for name in ("icub", "katana"):
             with self.subTest(robot=name):
-                valid = adaptive_space.ValidConfigurations(arms[name], 200, seed=1)
+                valid = ValidConfigurations(arms[name], 200, seed=1)
                 self.assertTrue(20 < len(valid) < 200)
                 self.assertTrue(np.all((valid >= 0) & (valid <= 1)))
+
+
+class TestReachTargets(unittest.TestCase):
+    def test_the_icub_has_the_sources_grid_and_the_katana_one_in_front_of_it(self):
+        """The iCub's targets are its file's; the Katana's are a 3 x 3 x 3 grid of increasing
+        levels, all in front of it (+x, beyond 10 cm), none in its base's column."""
+        arms = Arms()
+        self.assertEqual(ReachTargets(arms["icub"]), LoadTargetGrid())
+        grid = ReachTargets(arms["katana"])
+        self.assertEqual(grid.Centres().shape, (27, 3))
+        for axis in "xyz":
+            self.assertTrue(np.all(np.diff(getattr(grid, axis)) > 0), axis)
+        self.assertGreater(min(grid.x), 0.1)
+
+    def test_the_hand_that_may_touch_the_target_is_the_markers_body_and_beyond(self):
+        """The iCub's hand is its palm's body alone; the Katana's wrist carries its two
+        fingers, which may touch the target with it (so the wrist can come near)."""
+        from mobee_drake.experiments.ch8_reaching import ReachRobot
+
+        for robot, bodies in (
+            ("icub", {"r_hand"}),
+            ("katana", {f"arm_{i}_link" for i in (4, 5, 6)}),
+        ):
+            with self.subTest(robot=robot):
+                reach = ReachRobot(Lattice([0.25, 0.5, 0.75], 4), 0.05, robot=robot)
+                plant, frames = reach.station.plant, reach.station.robot.geometry_frames
+                hand = {plant.get_frame(frames[g]).body().name() for g in reach._hand}
+                self.assertEqual(hand, bodies)
 
 
 class TestConfigurationRoadmap(unittest.TestCase):
@@ -50,11 +80,11 @@ class TestConfigurationRoadmap(unittest.TestCase):
         the limits and the constraints and collides with nothing, its task point is its
         configuration in fractions of range, and no two are nearer than half the spacing."""
         from mobee_drake.ngik.kinematic_model import KinematicModel
-        from mobee_drake.robots.icub import IcubConfig
         from mobee_drake.trm.configuration import BuildConfigurationRoadmap
 
-        robot = IcubConfig(controlled_joints=adaptive_space.RIGHT_ARM)
-        roadmap = BuildConfigurationRoadmap(robot, adaptive_space.RIGHT_ARM, 0.6, 12)
+        arm = Arms()["icub"]
+        robot = arm.robot
+        roadmap = BuildConfigurationRoadmap(robot, list(arm.joints), 0.6, 12)
         self.assertEqual(len(roadmap.q), 12)
         model = KinematicModel(robot)
         for q, y in zip(roadmap.q, roadmap.y):
@@ -127,8 +157,9 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         self.addCleanup(shutil.rmtree, self.output)
 
     def test_the_reaching_smoke_battery(self):
-        """The reaching part: greedy, 2 seeds x 8 problem-tries, fixed and developed every 4:
-        every run reports at its last stage; only the maintained ones grow, by develop."""
+        """The reaching part on both arms: greedy, 2 seeds x 8 problem-tries, fixed and
+        developed every 4: every run reports at its last stage; only the maintained ones grow,
+        by develop."""
         from mobee_drake.experiments.adaptive_space_reaching import AdaptiveReachRun
 
         output = self.output / "reaching"
@@ -137,13 +168,13 @@ class TestTheReachLearnersSpace(unittest.TestCase):
                 ["--part", "reaching", "--mdp", "simultaneous", "--strategies", "greedy",
                  "--seeds", "2", "--problem-tries", "8", "--stages", "8", "--evaluations", "1",
                  "--every", "4", "--rules", "develop", "--output", str(output),
-                 "--workers", "2"]
+                 "--robots", "icub", "katana", "--workers", "2"]
             )  # fmt: skip
         runs = [
             AdaptiveReachRun(**json.loads(path.read_text()))
             for path in output.glob("runs/reach_*/result.json")
         ]
-        self.assertEqual(len(runs), 4)
+        self.assertEqual(sorted(r.robot for r in runs), ["icub"] * 4 + ["katana"] * 4)
         for run in runs:
             with self.subTest(condition=run.condition, seed=run.seed):
                 self.assertEqual(run.stage, 8)
@@ -151,14 +182,16 @@ class TestTheReachLearnersSpace(unittest.TestCase):
                 self.assertEqual(run.states > 81, run.condition == "maintained")
                 self.assertEqual(sum(run.changes.values()) > 0, run.condition == "maintained")
         report = (output / "report.md").read_text()
-        self.assertIn("| greedy | maintained | 2 | 8 |", report)
-        self.assertIn("greedy, summed reward:", report)
+        for robot in ("icub", "katana"):
+            self.assertIn(f"| {robot} | greedy | maintained | 2 | 8 |", report)
+            self.assertIn(f"{robot} greedy, summed reward:", report)
         # The report of the finished runs alone, a third seed's runs not started.
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             adaptive_space.main(
                 ["--part", "reaching", "--mdp", "simultaneous", "--strategies", "greedy",
                  "--seeds", "3", "--problem-tries", "8", "--stages", "8", "--evaluations", "1",
-                 "--every", "4", "--rules", "develop", "--output", str(output), "--report-only"]
+                 "--every", "4", "--rules", "develop", "--output", str(output),
+                 "--robots", "icub", "katana", "--report-only"]
             )  # fmt: skip
         self.assertFalse(list(output.glob("runs/*seed2")))
         table = (output / "report.md").read_text()

@@ -165,6 +165,20 @@ class TestTargets(unittest.TestCase):
                 LoadTargetGrid(path)
 
 
+class TestMdpLearning(unittest.TestCase):
+    def test_it_stops_at_the_tries_or_at_the_cap(self):
+        """Every state-action tried enough, or MDP_ACTIONS_PER_TRY actions per state-action and
+        try asked for, whichever comes first (a state the arm cannot enter never stops it)."""
+        from mobee_drake.experiments.ch8_reaching import MDP_ACTIONS_PER_TRY, _Learned
+
+        explorer = mock.Mock(tries=np.array([5, 7]))
+        self.assertTrue(_Learned(explorer, 5))
+        explorer.tries = np.array([0, 2 * 5 * MDP_ACTIONS_PER_TRY - 1])
+        self.assertFalse(_Learned(explorer, 5))
+        explorer.tries[1] += 1
+        self.assertTrue(_Learned(explorer, 5))
+
+
 class TestBattery(unittest.TestCase):
     """A reduced battery on the kinematic iCub: every strategy, real reaches and evaluations."""
 

@@ -1,7 +1,7 @@
 """Experiment: a state-action space that reshapes itself (ch. 9.4.5; docs/adaptive_space.md).
 
-The curious agent of ch. 7 explores an arm (``--robots``: :func:`Arms`, the iCub's right
-shoulder and elbow, the Katana's first four joints among its scenario's obstacles) for
+The curious agent of ch. 7 explores an arm (``--robots``: :mod:`~mobee_drake.experiments.arms`,
+the iCub's right shoulder and elbow, the Katana's first four joints among its obstacles) for
 ``--actions`` actions on a fixed space and on the same space maintained by the rules of
 :mod:`mobee_drake.planning.space_maintenance`, ``--seeds`` runs of each, paired by seed (the same
 generator). The spaces (``--spaces``): ch. 7.3's rank-4 lattice at 12.5-87.5 % (256 states; on
@@ -15,7 +15,7 @@ states, the rank-4 lattice's number by default), built once per arm by the batte
 Per run, at the end:
 
 - *coverage*: the share of a fixed sample of the arm's valid configurations (within the joint
-  limits, every constraint clause satisfied, no collision; ``VALID_SAMPLES`` of them, drawn
+  limits, every constraint clause satisfied, no collision; ``arms.VALID_SAMPLES`` of them, drawn
   uniformly in fractions of each joint's range) within ``--radius`` (fractions of range; by
   default the lattices' spacing, within which every point of the range lies of some rank-4
   lattice state) of the centre of a state the robot arrived in: how much of what the arm can do
@@ -58,6 +58,7 @@ from mobee_drake.experiments.adaptive_space_figures import (
 )
 from mobee_drake.experiments.adaptive_space_reaching import STRATEGIES, MaintainedMinusFixed
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
+from mobee_drake.experiments.arms import Arm, Arms, ValidConfigurations
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
@@ -66,7 +67,7 @@ from mobee_drake.experiments.battery import (
     RunBattery,
     RunFolder,
 )
-from mobee_drake.experiments.ch7_model_learning import RIGHT_ARM, ExploreJob, Stop
+from mobee_drake.experiments.ch7_model_learning import ExploreJob, Stop
 from mobee_drake.experiments.ch8_reaching import ReachScenario
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
@@ -78,37 +79,8 @@ from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import ExploringAgent, RoadmapStateSpace
 from mobee_drake.reaching.robot import SimulatedRobot
-from mobee_drake.robots.icub import IcubConfig
-from mobee_drake.robots.zero_position import ZeroPositionConfig
-from mobee_drake.scenario import BuildScenario, LoadScenario
+from mobee_drake.scenario import BuildScenario
 from mobee_drake.trm.configuration import BuildConfigurationRoadmap
-
-
-@dc.dataclass(frozen=True)
-class Arm:
-    """A robot's arm the agent explores: the scenario's robot, the agent's joints, the reaching
-    marker of the test robot (its state-action executor's), and the world's objects."""
-
-    robot: object
-    joints: tuple[str, ...]
-    marker: str
-    objects: tuple = ()
-
-
-def Arms() -> dict[str, Arm]:
-    """The arms of ``--robots``: the iCub's right shoulder and elbow (ch. 7), and the Katana's
-    first four joints among the shipped Katana scenario's obstacles (App. B), whose states
-    inside them are never entered."""
-    return {
-        "icub": Arm(IcubConfig(controlled_joints=RIGHT_ARM), tuple(RIGHT_ARM), "r_palm"),
-        "katana": Arm(
-            ZeroPositionConfig(file="katana.xml"),
-            ("arm_0", "arm_1", "arm_2", "arm_3"),
-            "wrist",
-            tuple(LoadScenario("katana").objects),
-        ),
-    }
-
 
 # The lattices compared: their levels (fractions of each joint's range); and "trm", a roadmap
 # over the valid configurations (mobee_drake.trm.configuration), built once per battery.
@@ -117,7 +89,6 @@ SPACES = (*LATTICES, "trm")
 ROADMAP_JOB = "roadmap"
 CONDITIONS = ("fixed", "maintained")
 AGENT = "right_arm"
-VALID_SAMPLES = 2000
 
 
 @dc.dataclass
@@ -141,21 +112,6 @@ class AdaptiveSpaceRun:
     robot_seconds_per_action: float
     wall_seconds: float
     penetrating_steps: int
-
-
-def ValidConfigurations(arm: Arm, count: int = VALID_SAMPLES, seed: int = 0) -> np.ndarray:
-    """(k, joints): valid configurations of ``arm``'s joints (the others at home), as fractions
-    of each joint's range (see the module), from ``count`` uniform draws."""
-    model = KinematicModel(arm.robot, list(arm.objects))
-    columns = [model.JointIndex(j) for j in arm.joints]
-    lower, upper = model.lower[columns], model.upper[columns]
-    valid = []
-    for f in np.random.default_rng(seed).random((count, len(columns))):
-        q = model.home.copy()
-        q[columns] = lower + f * (upper - lower)
-        if model.IsValid(q) and not model.Evaluate(q).collision_pairs:
-            valid.append(f)
-    return np.array(valid).reshape(-1, len(columns))
 
 
 def Nearest(explorer, valid: np.ndarray) -> np.ndarray:
@@ -342,8 +298,14 @@ def _Parser() -> CommandParser:
         "(mobee_drake.experiments.adaptive_space_reaching)",
     )
     parser.add_argument("--seeds", type=PositiveInt, default=10, help="runs per setting")
+    parser.add_argument(
+        "--robots",
+        nargs="+",
+        choices=tuple(Arms()),
+        default=["icub"],
+        help="the arms (mobee_drake.experiments.arms)",
+    )
     exploration = parser.add_argument_group("exploration (ch. 7)")
-    exploration.add_argument("--robots", nargs="+", choices=("icub", "katana"), default=["icub"])
     exploration.add_argument("--spaces", nargs="+", choices=SPACES, default=list(SPACES))
     exploration.add_argument(
         "--trm-spacing",

@@ -1,7 +1,9 @@
 """Experiment, ch. 8 part: the reach learner on a fixed and on a self-reshaping space (ch. 9.4.5;
 docs/adaptive_space.md).
 
-Each strategy of ch. 8 learns to reach on the rank-3 lattice for ``--problem-tries``
+Each strategy of ch. 8 learns to reach with an arm (``--robots``:
+:mod:`~mobee_drake.experiments.arms`, the iCub's right arm and the source's targets, or the
+Katana's first four joints, wrist and targets) on the rank-3 lattice for ``--problem-tries``
 problem-tries, on the space as it is (``fixed``) and on the same space maintained by the rules of
 :mod:`mobee_drake.planning.space_maintenance` (``maintained``, a round every ``--every``
 problem-tries; the learner's favoured states, its best reaches, are developed), ``--seeds`` runs
@@ -14,7 +16,7 @@ conditions differ by the maintenance only. With ``--mdp simultaneous`` no MDP is
 Per run, at the last stage: the evaluations' summed reward (ch. 8.3.3, with the -10 of every
 failed transition and without), the robot's simulated hours, the space's size and its changes,
 and the penetrating periods. Maintained minus fixed is compared paired by seed, Holm-corrected
-over the strategies and the two measures (reward with penalties, robot hours).
+over the robots, the strategies and the two measures (reward with penalties, robot hours).
 """
 
 import collections
@@ -49,13 +51,16 @@ class AdaptiveReachRun:
     changes: dict[str, int]
     penetrating_steps: int
     wall_seconds: float
+    robot: str = "icub"  # (the battery's first runs were the iCub's, without the field)
 
 
 def AdaptiveReachJob(
     run: RunFolder, *, strategy: str, condition: str, seed: int, problem_tries: int,
     stages: list[int], evaluations: int, mdp: str, maintenance: MaintenanceConfig,
+    robot: str = "icub",
 ) -> dict:  # fmt: skip
-    """The battery job: one run (see the module)."""
+    """The battery job: one run on ``robot``, an arm of
+    :func:`~mobee_drake.experiments.arms.Arms` (see the module)."""
     settings = RunSettings(
         strategy=strategy,
         seed=seed,
@@ -68,11 +73,12 @@ def AdaptiveReachJob(
     result = ReachRun.FromJson(
         RunOne(
             run.path,
-            run.path.parent / MdpName(MDP_TRIES) / "model",
+            run.path.parent / MdpName(MDP_TRIES, robot=robot) / "model",
             settings,
             progress=run.Progress,
             should_stop=StopRequested,
             maintenance=maintenance if condition == "maintained" else None,
+            robot=robot,
         )
     )
     stage = max(result.evaluations)
@@ -85,6 +91,7 @@ def AdaptiveReachJob(
     )
     return dc.asdict(
         AdaptiveReachRun(
+            robot=robot,
             strategy=strategy,
             condition=condition,
             seed=seed,
@@ -102,15 +109,24 @@ def AdaptiveReachJob(
 
 
 def Jobs(args, maintenance: MaintenanceConfig) -> list[Job]:
-    """The battery's jobs: the MDP learned first (unless ``--mdp simultaneous``), then every
-    strategy's runs."""
+    """The battery's jobs: per robot, the MDP learned first (unless ``--mdp simultaneous``),
+    then every strategy's runs; the iCub's jobs keep the names and arguments they had before
+    there was a choice of robot."""
     jobs = []
-    if args.mdp != "simultaneous":
-        jobs.append(Job(MdpName(MDP_TRIES), MdpJob, dict(min_tries=MDP_TRIES)))
+    for robot in args.robots:
+        if args.mdp != "simultaneous":
+            mdp = dict(min_tries=MDP_TRIES) | ({} if robot == "icub" else dict(robot=robot))
+            jobs.append(Job(MdpName(MDP_TRIES, robot=robot), MdpJob, mdp))
+        jobs += _RobotJobs(args, maintenance, robot)
+    return jobs
+
+
+def _RobotJobs(args, maintenance: MaintenanceConfig, robot: str) -> list[Job]:
     stages = sorted({*args.stages, args.problem_tries})
-    jobs += [
+    prefix, named = ("reach", {}) if robot == "icub" else (f"reach_{robot}", dict(robot=robot))
+    return [
         Job(
-            f"reach_{strategy}_{condition}_seed{seed}",
+            f"{prefix}_{strategy}_{condition}_seed{seed}",
             AdaptiveReachJob,
             dict(
                 strategy=strategy,
@@ -121,6 +137,7 @@ def Jobs(args, maintenance: MaintenanceConfig) -> list[Job]:
                 evaluations=args.evaluations,
                 mdp=args.mdp,
                 maintenance=maintenance,
+                **named,
             ),
             total=args.problem_tries,
         )
@@ -128,7 +145,6 @@ def Jobs(args, maintenance: MaintenanceConfig) -> list[Job]:
         for strategy in args.strategies
         for condition in CONDITIONS
     ]
-    return jobs
 
 
 def MaintainedMinusFixed(group: dict, keys: list[tuple], measures: dict) -> list[str]:
@@ -145,17 +161,17 @@ def Report(runs: list[AdaptiveReachRun], command: str) -> str:
     """The report's table and the paired comparisons (markdown)."""
     group = collections.defaultdict(list)
     for r in sorted(runs, key=lambda r: r.seed):
-        group[(r.strategy, r.condition)].append(r)
+        group[(r.robot, r.strategy, r.condition)].append(r)
     lines = [
-        "| strategy | condition | runs | problem-tries | summed reward | without the -10s "
+        "| robot | strategy | condition | runs | problem-tries | summed reward | without the -10s "
         f"| robot hours | states | transitions | changes ({'/'.join(RULES)}) "
         "| penetrating periods | wall s per run |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|",
+        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|",
     ]
-    for (strategy, condition), rs in sorted(group.items()):
+    for (robot, strategy, condition), rs in sorted(group.items()):
         changes = "/".join(f"{np.mean([r.changes.get(c, 0) for r in rs]):.0f}" for c in RULES)
         lines.append(
-            f"| {strategy} | {condition} | {len(rs)} | {rs[0].stage} | "
+            f"| {robot} | {strategy} | {condition} | {len(rs)} | {rs[0].stage} | "
             f"{np.mean([r.reward for r in rs]):.2f} | "
             f"{np.mean([r.reward_without_penalties for r in rs]):.2f} | "
             f"{np.mean([r.robot_hours for r in rs]):.2f} | "
@@ -165,5 +181,6 @@ def Report(runs: list[AdaptiveReachRun], command: str) -> str:
             f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
         )
     measures = {"summed reward": lambda r: r.reward, "robot hours": lambda r: r.robot_hours}
-    lines += MaintainedMinusFixed(group, sorted({(r.strategy,) for r in runs}), measures)
+    keys = sorted({(r.robot, r.strategy) for r in runs})
+    lines += MaintainedMinusFixed(group, keys, measures)
     return "\n".join(lines) + f"\n\nCommand: `{command}`."

@@ -60,6 +60,7 @@ from mobee_drake.atomic_files import (
     StrictJson,
     WriteGeneration,
 )
+from mobee_drake.experiments.arms import Arms, ReachTargets
 from mobee_drake.experiments.battery import (
     Backend,
     Job,
@@ -83,8 +84,8 @@ from mobee_drake.reaching.predictors import (
 )
 from mobee_drake.reaching.reshaping import ReachSpaceKeeper
 from mobee_drake.reaching.robot import SimulatedRobot
-from mobee_drake.reaching.targets import LoadTargetGrid, TargetGrid
-from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS, IcubConfig
+from mobee_drake.reaching.targets import TargetGrid
+from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS
 from mobee_drake.scenario import BuildScenario, Scenario
 from mobee_drake.station.executor import ReachForcing, StateActionAttractor
 
@@ -95,14 +96,13 @@ SOURCE_STAGES = (100, 200, 400, 800, 1600, 3200, 6400)
 # initialisation (ch. 9.4.1), or learned first and learned further with the reaches.
 MDPS = ("learned_first", "simultaneous", "continued")
 LEVELS = [0.25, 0.5, 0.75]
+# The MDP's learning stops after this many actions per state-action and try asked for, whatever
+# it has (the iCub's right arm needs about 1.5: 3122 actions for 5 tries of 432).
+MDP_ACTIONS_PER_TRY = 10
 AGENT = "right_arm"
 # Robot hours of the source's five runs per strategy (ch. 8.4).
 SOURCE_HOURS = {"random": 207, "greedy": 109, "intrinsic": 113}
 SOURCE_STRATEGIES = tuple(SOURCE_HOURS)
-
-
-def _Robot() -> IcubConfig:
-    return IcubConfig(controlled_joints=RIGHT_ARM)
 
 
 def TrainMdp(
@@ -112,25 +112,42 @@ def TrainMdp(
     progress=None,
     should_stop=None,
     transition_noise: float = 0.0,
+    robot: str = "icub",
 ):
     """The curious agent's model of the rank-3 lattice, learned once (checkpointed in ``folder``
-    as it learns, resumed from there after a kill) on a robot with ``transition_noise``;
-    ``progress(n)``, if given, is told the actions done as the agent learns."""
-    agent = ExploringAgent(name=AGENT, joints=RIGHT_ARM, levels=LEVELS)
-    scenario = ExplorationScenario([agent], robot=_Robot(), random_seed=seed)
+    as it learns, resumed from there after a kill) on a robot with ``transition_noise``
+    (``robot``: an arm of :func:`~mobee_drake.experiments.arms.Arms`, the iCub's right arm by
+    default); ``progress(n)``, if given, is told the actions done as the agent learns. It stops
+    when every state-action has ``min_tries`` tries, or after :data:`MDP_ACTIONS_PER_TRY` actions
+    per state-action and try (a state the arm cannot enter would otherwise never let it stop; the
+    result's ``min_tries`` says which)."""
+    arm = Arms()[robot]
+    agent = ExploringAgent(name=AGENT, joints=list(arm.joints), levels=LEVELS)
+    scenario = ExplorationScenario([agent], arm.objects, robot=arm.robot, random_seed=seed)
     scenario.attractor.transition_noise = transition_noise
     Explore(
         scenario,
         chunk=5.0,
         checkpoint=folder,
-        stop=lambda records: records[0].explorer.tries.min() >= min_tries,
+        stop=lambda records: _Learned(records[0].explorer, min_tries),
         progress=progress,
         should_stop=should_stop,
     )
     return LoadAgentModel(str(folder), AGENT, ExplorerConfig())
 
 
-def MdpJob(run: RunFolder, min_tries: int, seed: int = 0, transition_noise: float = 0.0) -> dict:
+def _Learned(explorer: Explorer, min_tries: int) -> bool:
+    tries = explorer.tries
+    return tries.min() >= min_tries or tries.sum() >= MDP_ACTIONS_PER_TRY * min_tries * tries.size
+
+
+def MdpJob(
+    run: RunFolder,
+    min_tries: int,
+    seed: int = 0,
+    transition_noise: float = 0.0,
+    robot: str = "icub",
+) -> dict:
     """The battery job that learns the MDP (in ``run.path / "model"``)."""
     model = TrainMdp(
         run.path / "model",
@@ -139,16 +156,21 @@ def MdpJob(run: RunFolder, min_tries: int, seed: int = 0, transition_noise: floa
         progress=run.Progress,
         should_stop=StopRequested,
         transition_noise=transition_noise,
+        robot=robot,
     )
     return dict(min_tries=int(model.tries.min()), actions=int(model.tries.sum()))
 
 
-def MdpName(min_tries: int, seed: int = 0, transition_noise: float = 0.0) -> str:
+def MdpName(
+    min_tries: int, seed: int = 0, transition_noise: float = 0.0, robot: str = "icub"
+) -> str:
     """The battery's job (and folder) of an MDP: ``mdp_tries<t>``, with ``_seed<m>`` and
-    ``_noise<sd>`` for another seed and a stochastic robot."""
+    ``_noise<sd>`` for another seed and a stochastic robot, and ``<robot>_`` before it for
+    another robot than the iCub."""
     seed_part = f"_seed{seed}" if seed else ""
     noise_part = f"_noise{transition_noise:g}" if transition_noise else ""
-    return f"mdp_tries{min_tries}{seed_part}{noise_part}"
+    robot_part = "" if robot == "icub" else f"{robot}_"
+    return f"{robot_part}mdp_tries{min_tries}{seed_part}{noise_part}"
 
 
 @dc.dataclass
@@ -291,13 +313,19 @@ class ReachRun:
         )
 
 
-def ReachScenario(reach_force: float = ReachForcing().force) -> Scenario:
-    """The reach learner's headless kinematic iCub: MoBeE on the right shoulder and elbow,
-    reaching with ``reach_force`` on the palm."""
+def ReachScenario(reach_force: float = ReachForcing().force, robot: str = "icub") -> Scenario:
+    """The reach learner's headless kinematic robot: by default the iCub, MoBeE on the right
+    shoulder and elbow, reaching with ``reach_force`` on the palm (``robot``: an arm of
+    :func:`~mobee_drake.experiments.arms.Arms`, with its objects and reaching marker)."""
+    arm = Arms()[robot]
     scenario = Scenario()
-    scenario.robot = _Robot()
+    scenario.robot = arm.robot
+    scenario.objects = list(arm.objects)
     scenario.attractor = StateActionAttractor()
     scenario.attractor.forcing.force = reach_force
+    scenario.attractor.forcing.marker = arm.marker
+    if robot != "icub":
+        scenario.visualization.trail_marker = ""  # (the default marker is the iCub's)
     scenario.time_step = 0.02
     scenario.mobee = Dissertation()  # (ch. 8 with the source's constants)
     scenario.data_log.enabled = False  # (The battery keeps its own data.)
@@ -311,13 +339,14 @@ def ReachRobot(
     meshcat=None,
     transition_noise: float = 0.0,
     noise_seed: int = 0,
+    robot: str = "icub",
 ) -> SimulatedRobot:
     """The reach learner's robot on the station of :func:`ReachScenario` (shown in real time in
     ``meshcat``, if given), with ``transition_noise`` drawn from ``noise_seed``."""
-    station = BuildScenario(ReachScenario(reach_force), meshcat)
+    station = BuildScenario(ReachScenario(reach_force, robot), meshcat)
     return SimulatedRobot(
         station,
-        RIGHT_ARM,
+        list(Arms()[robot].joints),
         space,
         target_radius,
         realtime=meshcat is not None,
@@ -350,16 +379,17 @@ def _Checkpoint(
     WriteGeneration(folder, Write)
 
 
-def _NewLearner(settings: RunSettings, mdp_dir: pathlib.Path):
+def _NewLearner(settings: RunSettings, mdp_dir: pathlib.Path, robot: str = "icub"):
     """(the MDP's model, a new reach learner on it, the target grid): the model is the
     optimistic initial one of the lattice, learned with the reaches, or the one learned first."""
     simultaneous = settings.mdp == "simultaneous"
+    arm = Arms()[robot]
     model = (
-        Explorer(Lattice(LEVELS, len(RIGHT_ARM)))
+        Explorer(Lattice(LEVELS, len(arm.joints)))
         if simultaneous
         else LoadAgentModel(str(mdp_dir), AGENT, ExplorerConfig())
     )
-    grid = LoadTargetGrid()
+    grid = ReachTargets(arm)
     learner = ReachLearner(
         model.space,
         model.transitions.counts,
@@ -400,15 +430,17 @@ def RunOne(
     progress=None,
     should_stop=None,
     maintenance: MaintenanceConfig | None = None,
+    robot: str = "icub",
 ) -> dict:
     """One run of the battery (resumes from ``run_dir/checkpoint``); returns its result. With
     ``meshcat``, the run is shown there in real time; ``progress(n)``, if given, is told the
     problem-tries done at every checkpoint; ``should_stop()``, if given, is asked after every
     problem-try, and when True the run saves its checkpoint and raises JobStopped. With
     ``maintenance``, the learner's space reshapes itself (ch. 9.4.5,
-    :class:`~mobee_drake.reaching.reshaping.ReachSpaceKeeper`)."""
+    :class:`~mobee_drake.reaching.reshaping.ReachSpaceKeeper`). ``robot``: an arm of
+    :func:`~mobee_drake.experiments.arms.Arms` (its MDP in ``mdp_dir``), the iCub's by default."""
     run_dir.mkdir(parents=True, exist_ok=True)
-    model, learner, grid = _NewLearner(settings, mdp_dir)
+    model, learner, grid = _NewLearner(settings, mdp_dir, robot)
     keeper = None
     if maintenance is not None:
         keeper = ReachSpaceKeeper(maintenance, learner.space.num_states)
@@ -419,6 +451,7 @@ def RunOne(
         meshcat,
         transition_noise=settings.transition_noise,
         noise_seed=settings.seed,
+        robot=robot,
     )
     checkpoint = run_dir / "checkpoint"
     data = _Resume(checkpoint, robot, learner, keeper)

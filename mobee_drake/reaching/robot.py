@@ -2,7 +2,8 @@
 
 The target's role (ch. 8.1 footnote 2: a target is an obstacle until the reach touches it): the
 target sphere is an obstacle of MoBeE's world (``SetProblem``); during a reach, and only then, a
-transient collision filter excludes the pairs of the reaching marker's body (the hand) and the
+transient collision filter excludes the pairs of the hand (the reaching marker's body and every
+body beyond it: the iCub's hand has none, the Katana's wrist carries its fingers) and the
 target, so the palm may touch and enter it while the rest of the arm is still kept out; the
 filter is removed when the reach has ended (settled back at its state's centre). A transition
 therefore must go around the target, and fails when it cannot.
@@ -21,6 +22,16 @@ from mobee_drake.station.checkpoint import ReadCheckpointFiles, WriteCheckpointF
 from mobee_drake.station.executor import StateActionExecutor
 from mobee_drake.station.safety import SafetyReport
 from mobee_drake.station.world_events import MakeSimulator
+
+
+def _BodiesFrom(plant, body) -> set:
+    """The indices of ``body`` and of every body beyond it in the tree (a hand and its fingers)."""
+    outboard = [
+        joint.index()
+        for joint in (plant.get_joint(i) for i in plant.GetJointIndices())
+        if joint.parent_body().index() == body.index()
+    ]
+    return {body.index(), *(plant.GetBodiesKinematicallyAffectedBy(outboard) if outboard else [])}
 
 
 class SimulatedRobot:
@@ -84,10 +95,11 @@ class SimulatedRobot:
         self._scratch = plant.CreateDefaultContext()
         self._shoulder = plant.GetJointByName(joints[0]).frame_on_parent()
         self._shoulder_at_home = self._ShoulderPose(self._home)
+        hand = _BodiesFrom(plant, plant.GetBodyByName(hand))
         self._hand = [
             g
             for g, frame in station.robot.geometry_frames.items()
-            if plant.get_frame(frame).body().name() == hand
+            if plant.get_frame(frame).body().index() in hand
         ]
 
     # The configuration of a state's centre, and the state of the robot's configuration.

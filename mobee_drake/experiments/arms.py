@@ -1,0 +1,103 @@
+"""The arms the experiments beyond the sources run on (issue 38): the iCub's right shoulder and
+elbow (ch. 7-8) and the Katana's first four joints among its shipped scenario's obstacles (App.
+B). Each names its scenario's robot, the joints an agent or the reach learner moves, the marker a
+reach forces toward its target (ch. 8.2), the world's objects and the reach targets (ch. 8.3).
+
+The iCub's targets are the source's grid (``models/reach_targets.yaml``: each axis's 20th, 50th
+and 80th percentiles of the palm's positions more than 10 cm in front of the robot over random
+valid poses). An arm without such a file gets the same rule over its marker's positions at its
+valid configurations (:func:`ReachTargets`), in front meaning along the arm's ``front``: for the
+Katana, the side its home posture reaches to (+x), so that the grid lies beside its base and
+not through the column its arm rises from.
+"""
+
+import dataclasses as dc
+
+import numpy as np
+
+from mobee_drake.ngik.kinematic_model import KinematicModel
+from mobee_drake.reaching.targets import LoadTargetGrid, TargetGrid
+from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS, IcubConfig
+from mobee_drake.robots.zero_position import ZeroPositionConfig
+from mobee_drake.scenario import LoadScenario
+
+# Valid configurations drawn for a measure or a target grid (uniform draws, then filtered).
+VALID_SAMPLES = 2000
+# Ch. 8.3's grid: each axis's levels are these percentiles of the marker's positions.
+TARGET_PERCENTILES = (20, 50, 80)
+TARGET_RADIUS = 0.05  # (m; ch. 8.3's 10 cm spheres)
+FRONT_DISTANCE = 0.1  # (m; the marker's positions this far in front count)
+
+
+@dc.dataclass(frozen=True)
+class Arm:
+    """A robot's arm: the scenario's robot, the moved joints, the reaching marker, the world's
+    objects, and the reach targets' file or, without one, the direction in front of the robot
+    (world frame) for :func:`ReachTargets`'s rule."""
+
+    robot: object
+    joints: tuple[str, ...]
+    marker: str
+    objects: tuple = ()
+    targets: str = ""
+    front: tuple[float, float, float] = (1.0, 0.0, 0.0)
+
+
+def Arms() -> dict[str, Arm]:
+    """The arms by name: the iCub's right shoulder and elbow (ch. 7-8), and the Katana's first
+    four joints among the shipped Katana scenario's obstacles, whose states inside them are
+    never entered, reaching with its wrist."""
+    joints = tuple(RIGHT_SHOULDER_ELBOW_JOINTS)
+    return {
+        "icub": Arm(
+            IcubConfig(controlled_joints=list(joints)),
+            joints,
+            "r_palm",
+            targets="package://mobee_drake/reach_targets.yaml",
+        ),
+        "katana": Arm(
+            ZeroPositionConfig(file="katana.xml"),
+            ("arm_0", "arm_1", "arm_2", "arm_3"),
+            "wrist",
+            tuple(LoadScenario("katana").objects),
+        ),
+    }
+
+
+def ValidConfigurations(arm: Arm, count: int = VALID_SAMPLES, seed: int = 0) -> np.ndarray:
+    """(k, joints): valid configurations of ``arm``'s joints (the others at home: within the
+    limits, every constraint clause satisfied, no collision, objects included), as fractions of
+    each joint's range, from ``count`` uniform draws."""
+    model = KinematicModel(arm.robot, list(arm.objects))
+    columns = [model.JointIndex(j) for j in arm.joints]
+    lower, upper = model.lower[columns], model.upper[columns]
+    valid = []
+    for f in np.random.default_rng(seed).random((count, len(columns))):
+        q = model.home.copy()
+        q[columns] = lower + f * (upper - lower)
+        if model.IsValid(q) and not model.Evaluate(q).collision_pairs:
+            valid.append(f)
+    return np.array(valid).reshape(-1, len(columns))
+
+
+def ReachTargets(arm: Arm) -> TargetGrid:
+    """The arm's reach targets: its file's grid, or the 3 x 3 x 3 grid of each axis's
+    :data:`TARGET_PERCENTILES` of the marker's positions (rounded to 1 cm) at the arm's valid
+    configurations (:func:`ValidConfigurations`, seed 0) that put it more than
+    :data:`FRONT_DISTANCE` along ``front``."""
+    if arm.targets:
+        return LoadTargetGrid(arm.targets)
+    model = KinematicModel(arm.robot, list(arm.objects))
+    columns = [model.JointIndex(j) for j in arm.joints]
+    lower, upper = model.lower[columns], model.upper[columns]
+    marker = model.MarkerIndex(arm.marker)
+    positions = []
+    for f in ValidConfigurations(arm):
+        q = model.home.copy()
+        q[columns] = lower + f * (upper - lower)
+        positions.append(model.Evaluate(q).marker_positions[marker])
+    positions = np.array(positions)
+    positions = positions[positions @ np.asarray(arm.front) > FRONT_DISTANCE]
+    levels = np.round(np.percentile(positions, TARGET_PERCENTILES, axis=0), 2)
+    x, y, z = (levels[:, axis].tolist() for axis in range(3))
+    return TargetGrid(radius=TARGET_RADIUS, x=x, y=y, z=z)
