@@ -58,7 +58,7 @@ from mobee_drake.experiments.adaptive_space_figures import (
 )
 from mobee_drake.experiments.adaptive_space_reaching import STRATEGIES, MaintainedMinusFixed
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
-from mobee_drake.experiments.arms import Arm, Arms, ValidConfigurations
+from mobee_drake.experiments.arms import Arm, Arms, TargetGaps, ValidConfigurations
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
@@ -68,7 +68,7 @@ from mobee_drake.experiments.battery import (
     RunFolder,
 )
 from mobee_drake.experiments.ch7_model_learning import ExploreJob, Stop
-from mobee_drake.experiments.ch8_reaching import ReachScenario
+from mobee_drake.experiments.ch8_reaching import LEVELS, ReachScenario
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
 from mobee_drake.experiments.plots import SaveFigure
@@ -494,7 +494,8 @@ def _ReachingReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, 
     jobs = reaching.Jobs(args, maintenance)
     results = _Results(args, jobs, output, "adaptive reaching")
     runs = [reaching.AdaptiveReachRun(**r) for n, r in results.items() if n.startswith("reach_")]
-    return reaching.Report(runs, command)
+    gaps = {robot: TargetGaps(Arms()[robot], LEVELS) for robot in args.robots}
+    return reaching.Report(runs, command, gaps)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -157,8 +157,10 @@ def MaintainedMinusFixed(group: dict, keys: list[tuple], measures: dict) -> list
     return PairedBySeed(families, measures, "Maintained minus fixed")
 
 
-def Report(runs: list[AdaptiveReachRun], command: str) -> str:
-    """The report's table and the paired comparisons (markdown)."""
+def Report(runs: list[AdaptiveReachRun], command: str, gaps: dict | None = None) -> str:
+    """The report's table, the paired comparisons and, with ``gaps`` (per robot, each
+    target's distance to the nearest state's marker:
+    :func:`~mobee_drake.experiments.arms.TargetGaps`), how near the lattice comes (markdown)."""
     group = collections.defaultdict(list)
     for r in sorted(runs, key=lambda r: r.seed):
         group[(r.robot, r.strategy, r.condition)].append(r)
@@ -183,4 +185,11 @@ def Report(runs: list[AdaptiveReachRun], command: str) -> str:
     measures = {"summed reward": lambda r: r.reward, "robot hours": lambda r: r.robot_hours}
     keys = sorted({(r.robot, r.strategy) for r in runs})
     lines += MaintainedMinusFixed(group, keys, measures)
+    if gaps:
+        near = [
+            f"{robot}, a median {100 * np.median(g):.1f} cm (at most {100 * g.max():.1f} cm)"
+            for robot, g in gaps.items()
+        ]
+        lines += ["", "The lattice's valid states nearest each target put the marker before the "
+                  f"reach: {'; '.join(near)}."]  # fmt: skip
     return "\n".join(lines) + f"\n\nCommand: `{command}`."

@@ -16,6 +16,7 @@ import dataclasses as dc
 import numpy as np
 
 from mobee_drake.ngik.kinematic_model import KinematicModel
+from mobee_drake.planning.state_space import Lattice
 from mobee_drake.reaching.targets import LoadTargetGrid, TargetGrid
 from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS, IcubConfig
 from mobee_drake.robots.zero_position import ZeroPositionConfig
@@ -78,6 +79,25 @@ def ValidConfigurations(arm: Arm, count: int = VALID_SAMPLES, seed: int = 0) -> 
         if model.IsValid(q) and not model.Evaluate(q).collision_pairs:
             valid.append(f)
     return np.array(valid).reshape(-1, len(columns))
+
+
+def TargetGaps(arm: Arm, levels: list[float]) -> np.ndarray:
+    """Per reach target, the distance (m) from it to the nearest marker position of a valid
+    centre of the lattice of ``levels`` on the arm's joints: how near a pre-reach state can put
+    the marker before the reach."""
+    model = KinematicModel(arm.robot, list(arm.objects))
+    columns = [model.JointIndex(j) for j in arm.joints]
+    lower, upper = model.lower[columns], model.upper[columns]
+    marker = model.MarkerIndex(arm.marker)
+    positions = []
+    for centre in Lattice(levels, len(columns)).centres:
+        q = model.home.copy()
+        q[columns] = lower + centre * (upper - lower)
+        pose = model.Evaluate(q)
+        if model.IsValid(q) and not pose.collision_pairs:
+            positions.append(pose.marker_positions[marker])
+    targets = ReachTargets(arm).Centres()
+    return np.linalg.norm(targets[:, None] - np.array(positions)[None], axis=2).min(axis=1)
 
 
 def ReachTargets(arm: Arm) -> TargetGrid:
