@@ -58,7 +58,7 @@ from mobee_drake.experiments.adaptive_space_figures import (
 )
 from mobee_drake.experiments.adaptive_space_reaching import STRATEGIES, MaintainedMinusFixed
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
-from mobee_drake.experiments.arms import Arm, Arms, TargetGaps, ValidConfigurations
+from mobee_drake.experiments.arms import TARGET_RADIUS, Arm, Arms, TargetGaps, ValidConfigurations
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
@@ -68,7 +68,7 @@ from mobee_drake.experiments.battery import (
     RunFolder,
 )
 from mobee_drake.experiments.ch7_model_learning import ExploreJob, Stop
-from mobee_drake.experiments.ch8_reaching import LEVELS, ReachScenario
+from mobee_drake.experiments.ch8_reaching import LEVELS, ReachRobot
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
 from mobee_drake.experiments.plots import SaveFigure
@@ -78,8 +78,6 @@ from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel, Obser
 from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import ExploringAgent, RoadmapStateSpace
-from mobee_drake.reaching.robot import SimulatedRobot
-from mobee_drake.scenario import BuildScenario
 from mobee_drake.trm.configuration import BuildConfigurationRoadmap
 
 # The lattices compared: their levels (fractions of each joint's range); and "trm", a roadmap
@@ -123,32 +121,23 @@ def Nearest(explorer, valid: np.ndarray) -> np.ndarray:
     return np.min(np.linalg.norm(valid[:, None] - arrived[None], axis=2), axis=1)
 
 
-def TestRobot(arm: Arm, space) -> SimulatedRobot:
-    """A fresh robot for the held-out tests: the reach learner's station (its state-action
-    executor) with ``arm``'s robot and objects."""
-    scenario = ReachScenario()
-    scenario.robot, scenario.objects = arm.robot, list(arm.objects)
-    scenario.attractor.forcing.marker = arm.marker
-    scenario.visualization.trail_marker = ""  # (headless)
-    return SimulatedRobot(BuildScenario(scenario), list(arm.joints), space, 0.05)
-
-
-def PredictionError(arm: Arm, explorer, tests: int, seed: int) -> tuple[float, int]:
+def PredictionError(robot: str, explorer, tests: int, seed: int) -> tuple[float, int]:
     """(the mean of one minus the model's probability of each held-out test's outcome, the
-    tests run): see the module."""
+    tests run): see the module. The tests run on a fresh robot of the arm ``robot``, the reach
+    learner's (its state-action executor)."""
     space = explorer.space
     arrived = np.flatnonzero(ObservedOutcomes(explorer).sum(axis=0) > 0)
     candidates = np.flatnonzero(np.isin(space.action_state, arrived))
     rng = np.random.default_rng(seed)
     chosen = rng.choice(candidates, size=min(tests, len(candidates)), replace=False)
-    robot = TestRobot(arm, space)
+    fresh = ReachRobot(space, TARGET_RADIUS, robot=robot)
     T = explorer.transitions.Probabilities()
     errors = []
     for sa in chosen:
         state = int(space.action_state[sa])
-        if robot.Transition(state) != state:
+        if fresh.Transition(state) != state:
             continue  # (the robot could not be put there)
-        outcome = robot.Transition(int(space.action_goal[sa]))
+        outcome = fresh.Transition(int(space.action_goal[sa]))
         errors.append(1.0 - T[sa, outcome])
     return (float(np.mean(errors)) if errors else float("nan")), len(errors)
 
@@ -201,7 +190,7 @@ def AdaptiveSpaceJob(
     changes = collections.Counter(
         c["rule"] for c in saved.get("maintenance", {}).get("changes", [])
     )
-    error, tested = PredictionError(arm, explorer, tests, seed)
+    error, tested = PredictionError(robot, explorer, tests, seed)
     done = explored.actions[0]
     nearest = Nearest(explorer, ValidConfigurations(arm))
     return dc.asdict(
