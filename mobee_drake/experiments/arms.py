@@ -65,39 +65,38 @@ def Arms() -> dict[str, Arm]:
     }
 
 
-def ValidConfigurations(arm: Arm, count: int = VALID_SAMPLES, seed: int = 0) -> np.ndarray:
-    """(k, joints): valid configurations of ``arm``'s joints (the others at home: within the
-    limits, every constraint clause satisfied, no collision, objects included), as fractions of
-    each joint's range, from ``count`` uniform draws."""
+def _Poses(arm: Arm, fractions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """At each configuration of ``fractions`` ((k, joints): fractions of each joint's range,
+    the other joints at home), the arm's marker position ((k, 3), m) and whether it is valid
+    (within the limits, every constraint clause satisfied, no collision, objects included)."""
     model = KinematicModel(arm.robot, list(arm.objects))
     columns = [model.JointIndex(j) for j in arm.joints]
     lower, upper = model.lower[columns], model.upper[columns]
-    valid = []
-    for f in np.random.default_rng(seed).random((count, len(columns))):
+    marker = model.MarkerIndex(arm.marker)
+    positions, valid = [], []
+    for f in fractions:
         q = model.home.copy()
         q[columns] = lower + f * (upper - lower)
-        if model.IsValid(q) and not model.Evaluate(q).collision_pairs:
-            valid.append(f)
-    return np.array(valid).reshape(-1, len(columns))
+        pose = model.Evaluate(q)
+        positions.append(pose.marker_positions[marker])
+        valid.append(model.IsValid(q) and not pose.collision_pairs)
+    return np.reshape(positions, (-1, 3)), np.array(valid, dtype=bool)
+
+
+def ValidConfigurations(arm: Arm, count: int = VALID_SAMPLES, seed: int = 0) -> np.ndarray:
+    """(k, joints): the valid configurations of ``arm``'s joints (see :func:`_Poses`) among
+    ``count`` uniform draws, as fractions of each joint's range."""
+    draws = np.random.default_rng(seed).random((count, len(arm.joints)))
+    return draws[_Poses(arm, draws)[1]]
 
 
 def TargetGaps(arm: Arm, levels: list[float]) -> np.ndarray:
     """Per reach target, the distance (m) from it to the nearest marker position of a valid
     centre of the lattice of ``levels`` on the arm's joints: how near a pre-reach state can put
     the marker before the reach."""
-    model = KinematicModel(arm.robot, list(arm.objects))
-    columns = [model.JointIndex(j) for j in arm.joints]
-    lower, upper = model.lower[columns], model.upper[columns]
-    marker = model.MarkerIndex(arm.marker)
-    positions = []
-    for centre in Lattice(levels, len(columns)).centres:
-        q = model.home.copy()
-        q[columns] = lower + centre * (upper - lower)
-        pose = model.Evaluate(q)
-        if model.IsValid(q) and not pose.collision_pairs:
-            positions.append(pose.marker_positions[marker])
+    positions, valid = _Poses(arm, Lattice(levels, len(arm.joints)).centres)
     targets = ReachTargets(arm).Centres()
-    return np.linalg.norm(targets[:, None] - np.array(positions)[None], axis=2).min(axis=1)
+    return np.linalg.norm(targets[:, None] - positions[valid][None], axis=2).min(axis=1)
 
 
 def ReachTargets(arm: Arm) -> TargetGrid:
@@ -107,16 +106,7 @@ def ReachTargets(arm: Arm) -> TargetGrid:
     :data:`FRONT_DISTANCE` along ``front``."""
     if arm.targets:
         return LoadTargetGrid(arm.targets)
-    model = KinematicModel(arm.robot, list(arm.objects))
-    columns = [model.JointIndex(j) for j in arm.joints]
-    lower, upper = model.lower[columns], model.upper[columns]
-    marker = model.MarkerIndex(arm.marker)
-    positions = []
-    for f in ValidConfigurations(arm):
-        q = model.home.copy()
-        q[columns] = lower + f * (upper - lower)
-        positions.append(model.Evaluate(q).marker_positions[marker])
-    positions = np.array(positions)
+    positions, _ = _Poses(arm, ValidConfigurations(arm))
     positions = positions[positions @ np.asarray(arm.front) > FRONT_DISTANCE]
     levels = np.round(np.percentile(positions, TARGET_PERCENTILES, axis=0), 2)
     x, y, z = (levels[:, axis].tolist() for axis in range(3))
