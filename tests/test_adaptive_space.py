@@ -185,7 +185,7 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         for robot in ("icub", "katana"):
             self.assertIn(f"| {robot} | greedy | maintained | 2 | 8 |", report)
             self.assertIn(f"{robot} greedy, summed reward:", report)
-            self.assertRegex(report, rf"{robot}, a median \d+\.\d cm \(at most \d+\.\d cm\)")
+            self.assertRegex(report, rf"{robot}: targets of radius .* a median \d+\.\d cm")
         # The report of the finished runs alone, a third seed's runs not started.
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             adaptive_space.main(

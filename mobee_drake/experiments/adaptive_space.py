@@ -58,7 +58,14 @@ from mobee_drake.experiments.adaptive_space_figures import (
 )
 from mobee_drake.experiments.adaptive_space_reaching import STRATEGIES, MaintainedMinusFixed
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
-from mobee_drake.experiments.arms import TARGET_RADIUS, Arm, Arms, TargetGaps, ValidConfigurations
+from mobee_drake.experiments.arms import (
+    TARGET_RADIUS,
+    Arm,
+    Arms,
+    ReachTargets,
+    TargetGaps,
+    ValidConfigurations,
+)
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
@@ -483,8 +490,9 @@ def _ReachingReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, 
     jobs = reaching.Jobs(args, maintenance)
     results = _Results(args, jobs, output, "adaptive reaching")
     runs = [reaching.AdaptiveReachRun(**r) for n, r in results.items() if n.startswith("reach_")]
-    gaps = {robot: TargetGaps(Arms()[robot], LEVELS) for robot in args.robots}
-    return reaching.Report(runs, command, gaps)
+    arms = Arms()
+    targets = {r: (ReachTargets(arms[r]), TargetGaps(arms[r], LEVELS)) for r in args.robots}
+    return reaching.Report(runs, command, targets)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -157,10 +157,11 @@ def MaintainedMinusFixed(group: dict, keys: list[tuple], measures: dict) -> list
     return PairedBySeed(families, measures, "Maintained minus fixed")
 
 
-def Report(runs: list[AdaptiveReachRun], command: str, gaps: dict | None = None) -> str:
-    """The report's table, the paired comparisons and, with ``gaps`` (per robot, each
-    target's distance to the nearest state's marker:
-    :func:`~mobee_drake.experiments.arms.TargetGaps`), how near the lattice comes (markdown)."""
+def Report(runs: list[AdaptiveReachRun], command: str, targets: dict | None = None) -> str:
+    """The report's table, the paired comparisons and, with ``targets`` (per robot, its
+    :class:`~mobee_drake.reaching.targets.TargetGrid` and each target's distance to the nearest
+    state's marker, :func:`~mobee_drake.experiments.arms.TargetGaps`), the targets and how near
+    the lattice comes to them (markdown)."""
     group = collections.defaultdict(list)
     for r in sorted(runs, key=lambda r: r.seed):
         group[(r.robot, r.strategy, r.condition)].append(r)
@@ -185,11 +186,11 @@ def Report(runs: list[AdaptiveReachRun], command: str, gaps: dict | None = None)
     measures = {"summed reward": lambda r: r.reward, "robot hours": lambda r: r.robot_hours}
     keys = sorted({(r.robot, r.strategy) for r in runs})
     lines += MaintainedMinusFixed(group, keys, measures)
-    if gaps:
-        near = [
-            f"{robot}, a median {100 * np.median(g):.1f} cm (at most {100 * g.max():.1f} cm)"
-            for robot, g in gaps.items()
-        ]
-        lines += ["", "The lattice's valid states nearest each target put the marker before the "
-                  f"reach: {'; '.join(near)}."]  # fmt: skip
+    for robot, (grid, gaps) in (targets or {}).items():
+        levels = ", ".join(f"{axis} {'/'.join(f'{v:.2f}' for v in getattr(grid, axis))}"
+                           for axis in "xyz")  # fmt: skip
+        lines += ["", f"{robot}: targets of radius {grid.radius:g} m at {levels} m; the "
+                  "lattice's valid state nearest each puts the marker a median "
+                  f"{100 * np.median(gaps):.1f} cm (at most {100 * gaps.max():.1f} cm) from it "
+                  "before the reach."]  # fmt: skip
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
