@@ -86,7 +86,7 @@ class SimulatedRobot:
         self._home = mobee.home
         plant = station.plant
         marker = self.executor.marker_name
-        hand = [m.body_name for m in station.robot.markers if m.name == marker][0]
+        hand_body = [m.body_name for m in station.robot.markers if m.name == marker][0]
         self._marker = mobee.marker_index(marker)
         # The current problem's target (None before the first problem).
         self.target: np.ndarray | None = None
@@ -95,7 +95,7 @@ class SimulatedRobot:
         self._scratch = plant.CreateDefaultContext()
         self._shoulder = plant.GetJointByName(joints[0]).frame_on_parent()
         self._shoulder_at_home = self._ShoulderPose(self._home)
-        hand = _BodiesFrom(plant, plant.GetBodyByName(hand))
+        hand = _BodiesFrom(plant, plant.GetBodyByName(hand_body))
         self._hand = [
             g
             for g, frame in station.robot.geometry_frames.items()
