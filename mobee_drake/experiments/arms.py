@@ -83,11 +83,18 @@ def _Poses(arm: Arm, fractions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.reshape(positions, (-1, 3)), np.array(valid, dtype=bool)
 
 
+def _ValidPoses(arm: Arm, count: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """(the valid configurations among ``count`` uniform draws, as fractions of each joint's
+    range (see :func:`_Poses`); the marker's position at each)."""
+    draws = np.random.default_rng(seed).random((count, len(arm.joints)))
+    positions, valid = _Poses(arm, draws)
+    return draws[valid], positions[valid]
+
+
 def ValidConfigurations(arm: Arm, count: int = VALID_SAMPLES, seed: int = 0) -> np.ndarray:
     """(k, joints): the valid configurations of ``arm``'s joints (see :func:`_Poses`) among
     ``count`` uniform draws, as fractions of each joint's range."""
-    draws = np.random.default_rng(seed).random((count, len(arm.joints)))
-    return draws[_Poses(arm, draws)[1]]
+    return _ValidPoses(arm, count, seed)[0]
 
 
 def TargetGaps(arm: Arm, levels: list[float]) -> np.ndarray:
@@ -106,7 +113,7 @@ def ReachTargets(arm: Arm) -> TargetGrid:
     :data:`FRONT_DISTANCE` along ``front``."""
     if arm.targets:
         return LoadTargetGrid(arm.targets)
-    positions, _ = _Poses(arm, ValidConfigurations(arm))
+    _, positions = _ValidPoses(arm, VALID_SAMPLES, seed=0)
     positions = positions[positions @ np.asarray(arm.front) > FRONT_DISTANCE]
     levels = np.round(np.percentile(positions, TARGET_PERCENTILES, axis=0), 2)
     x, y, z = (levels[:, axis].tolist() for axis in range(3))
