@@ -230,9 +230,21 @@ class TestTheReachLearnersSpace(unittest.TestCase):
                     progress=checkpoints.append, maintenance=maintenance,
                 )  # fmt: skip
         self.assertEqual(checkpoints[-1], 6)
+        # (A copy whose checkpoint predates the count of targets appearing inside the robot.)
+        shutil.copytree(self.output / "killed", self.output / "older")
+        (saved,) = (self.output / "older").glob("checkpoint/g*/learner.json")
+        saved.write_text(json.dumps(json.loads(saved.read_text()) | dict(appearance=None)))
         resumed = RunOne(self.output / "killed", self.output, settings, maintenance=maintenance)
         self.assertGreater(whole["space"]["changes"]["develop"], 0)
         self.assertGreater(whole["space"]["states"], 81)
         self.assertEqual(resumed["space"], whole["space"])
         self.assertEqual(resumed["log"], whole["log"])
         self.assertAlmostEqual(resumed["simulated_seconds"], whole["simulated_seconds"])
+        self.assertEqual(
+            [resumed["appeared_inside"], resumed["other_penetrating_steps"]],
+            [whole["appeared_inside"], whole["other_penetrating_steps"]],
+        )
+        self.assertGreater(whole["appeared_inside"], 0)  # (so the counts' resumption is tested)
+        older = RunOne(self.output / "older", self.output, settings, maintenance=maintenance)
+        self.assertEqual(older["log"], whole["log"])
+        self.assertEqual([older["appeared_inside"], older["other_penetrating_steps"]], [None] * 2)

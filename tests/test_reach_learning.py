@@ -19,6 +19,7 @@ from mobee_drake.behaviours.torso import PostureGrid
 from mobee_drake.experiments.ch8_reaching import LoadTrainedLearner
 from mobee_drake.mobee.fields import FieldPairs
 from mobee_drake.planning.supervisor import ActionTiming
+from mobee_drake.reaching.appearance import AppearanceWatch
 from mobee_drake.reaching.robot import SimulatedRobot
 from mobee_drake.robots.icub import TORSO_JOINTS, IcubConfig
 from mobee_drake.scenario import BuildScenario
@@ -291,14 +292,19 @@ class TestBattery(unittest.TestCase):
         np.testing.assert_allclose(np.linalg.norm(moved, axis=1), 0.1)
         # A target that appears where the palm is is counted as appearing inside the robot, and
         # its problem's penetrating periods are not counted among the others'.
-        watched = torso_reach.AppearanceWatch(robot)
+        # (A watch resumed from its counts goes on counting: the far target's problem is the
+        # resumed watch's, and its transition's penetrations are the other problems'.)
+        watched = AppearanceWatch(robot)
         watched.SetProblem(robot.MarkerPosition())
         robot.Transition(robot.State())  # MoBeE pushes the arm out of the target
+        pushed_out = robot.Safety().penetrating_steps
+        self.assertGreater(pushed_out, 0)
+        watched = AppearanceWatch(robot, dc.replace(watched.counts))
         watched.SetProblem(np.array([1.0, 1.0, 1.0]))
+        watched.SetProblem(robot.MarkerPosition() + [0.0, 0.0, 0.5])
         watched.Close()
-        self.assertEqual(watched.appeared_inside, 1)
-        self.assertGreater(robot.Safety().penetrating_steps, 0)
-        self.assertEqual(watched.other, 0)
+        self.assertEqual(watched.counts.appeared_inside, 1)
+        self.assertEqual(watched.counts.other_penetrating_steps, 0)
         # With --settle the torso comes to rest where the module puts it before the arm acts.
         # The evidence map is made to peak (a record above any reach's reward) where one of the
         # grid's postures would show the target: the torso settles in that posture.

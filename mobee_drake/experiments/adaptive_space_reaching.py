@@ -26,6 +26,7 @@ import numpy as np
 
 from mobee_drake.experiments.battery import Job, RunFolder, StopRequested
 from mobee_drake.experiments.ch8_figures import EvaluationSum
+from mobee_drake.experiments.ch8_measures import PENETRATION_HEADER, PenetrationCell
 from mobee_drake.experiments.ch8_reaching import MdpJob, MdpName, ReachRun, RunOne, RunSettings
 from mobee_drake.experiments.statistics import PairedBySeed, RunMeans
 from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
@@ -52,6 +53,9 @@ class AdaptiveReachRun:
     penetrating_steps: int
     wall_seconds: float
     robot: str = "icub"  # (the battery's first runs were the iCub's, without the field)
+    # (see ReachRun; None: a run from before they were counted)
+    appeared_inside: int | None = None
+    other_penetrating_steps: int | None = None
 
 
 def AdaptiveReachJob(
@@ -103,6 +107,8 @@ def AdaptiveReachJob(
             transitions=space["transitions"],
             changes={rule: space["changes"].get(rule, 0) for rule in RULES},
             penetrating_steps=result.penetrating_steps,
+            appeared_inside=result.appeared_inside,
+            other_penetrating_steps=result.other_penetrating_steps,
             wall_seconds=result.wall_seconds,
         )
     )
@@ -168,7 +174,7 @@ def Report(runs: list[AdaptiveReachRun], command: str, targets: dict | None = No
     lines = [
         "| robot | strategy | condition | runs | problem-tries | summed reward | without the -10s "
         f"| robot hours | states | transitions | changes ({'/'.join(RULES)}) "
-        "| penetrating periods | wall s per run |",
+        f"| {PENETRATION_HEADER} | wall s per run |",
         "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|",
     ]
     for (robot, strategy, condition), rs in sorted(group.items()):
@@ -180,7 +186,7 @@ def Report(runs: list[AdaptiveReachRun], command: str, targets: dict | None = No
             f"{np.mean([r.robot_hours for r in rs]):.2f} | "
             f"{np.mean([r.states for r in rs]):.0f} | "
             f"{np.mean([r.transitions for r in rs]):.0f} | {changes} | "
-            f"{sum(r.penetrating_steps for r in rs)} | "
+            f"{PenetrationCell(rs)} | "
             f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
         )
     measures = {"summed reward": lambda r: r.reward, "robot hours": lambda r: r.robot_hours}

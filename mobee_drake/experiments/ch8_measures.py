@@ -84,3 +84,21 @@ def RobotTimeRatio(by_strategy: dict[str, list[ReachRun]]) -> float:
     """Random's mean robot time over that of greedy and intrinsic (the source: 1.86)."""
     hours = {s: np.mean([r.simulated_seconds for r in by_strategy[s]]) for s in by_strategy}
     return hours["random"] / np.mean([hours["greedy"], hours["intrinsic"]])
+
+
+# A report's column of penetrations (see PenetrationCell).
+PENETRATION_HEADER = (
+    "penetrating periods: all / of problems whose target did not appear inside the robot "
+    "(problems whose target did)"
+)
+
+
+def PenetrationCell(runs) -> str:
+    """The runs' penetrating periods, summed: all of them / those of the problems whose target
+    did not appear inside the robot (the problems whose did); ``-`` where some run did not count
+    them (:mod:`~mobee_drake.reaching.appearance`)."""
+    total = sum(r.penetrating_steps for r in runs)
+    if any(r.appeared_inside is None for r in runs):
+        return f"{total} / - (-)"
+    other = sum(r.other_penetrating_steps for r in runs)
+    return f"{total} / {other} ({sum(r.appeared_inside for r in runs)})"

@@ -75,6 +75,7 @@ from mobee_drake.planning.explorers import Explorer, ExplorerConfig, LoadAgentMo
 from mobee_drake.planning.space_maintenance import MaintenanceConfig
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import ExploringAgent
+from mobee_drake.reaching.appearance import AppearanceCounts, AppearanceWatch
 from mobee_drake.reaching.learner import (
     ReachLearner,
     ReachLearningConfig,
@@ -261,6 +262,11 @@ class ReachRun:
         simulated_seconds: Robot time, evaluations included.
         wall_seconds: Wall time of the run (over its resumptions).
         penetrating_steps: Control periods in which two solids penetrated.
+        appeared_inside: Problems (tries and evaluations) whose target appeared inside the
+            robot (:mod:`~mobee_drake.reaching.appearance`; None: a run from before they were
+            counted).
+        other_penetrating_steps: The penetrating periods of the other problems (None: as
+            ``appeared_inside``).
         num_transitions: The MDP's transition state-actions (the reaches follow them).
         num_states: The MDP's states.
         barrier_periods: Periods the safety barrier acted (None: a run from before it was
@@ -281,6 +287,8 @@ class ReachRun:
     barrier_periods: int | None = None
     mdp: dict | None = None
     space: dict | None = None
+    appeared_inside: int | None = None
+    other_penetrating_steps: int | None = None
 
     @property
     def strategy(self) -> str:
@@ -456,10 +464,14 @@ def RunOne(
     checkpoint = run_dir / "checkpoint"
     data = _Resume(checkpoint, robot, learner, keeper)
     started = time.perf_counter() - data["wall_seconds"]
+    if data["appearance"] is not None:  # (None: resumed from a checkpoint without the counts)
+        robot = AppearanceWatch(robot, AppearanceCounts(**data["appearance"]))
 
     def Save():
         data["wall_seconds"] = time.perf_counter() - started
         data["target"] = None if robot.target is None else robot.target.tolist()
+        if data["appearance"] is not None:
+            data["appearance"] = dc.asdict(robot.counts)
         _Checkpoint(checkpoint, robot, learner, data, keeper)
         if progress is not None:
             progress(int(learner.problem_tries.sum()))
@@ -483,6 +495,8 @@ def RunOne(
         if should_stop is not None and should_stop():
             Save()
             raise JobStopped(f"{run_dir.name}: stopped after {done + 1} problem-tries")
+    if data["appearance"] is not None:
+        robot.Close()
     Save()
     extra = {}
     if keeper is not None:  # (the MDP's space changed: its summary instead)
@@ -494,12 +508,13 @@ def RunOne(
 
 def _Resume(checkpoint: pathlib.Path, robot, learner, keeper) -> dict:
     """Puts ``robot``, ``learner`` (and the ``keeper``'s space) where the newest generation of
-    ``checkpoint`` left them; the run's data (evaluations, wall time, the problem's target),
-    empty for a new run."""
+    ``checkpoint`` left them; the run's data (evaluations, wall time, the problem's target, the
+    :class:`AppearanceWatch`'s counts), empty for a new run."""
     generation = CurrentGeneration(checkpoint)
     if generation is None:
-        return dict(evaluations={}, wall_seconds=0.0, target=None)
+        return dict(evaluations={}, wall_seconds=0.0, target=None, appearance={})
     saved = json.loads((generation / "learner.json").read_text())
+    saved.setdefault("appearance", None)  # (a checkpoint from before the count)
     arrays = np.load(generation / "learner.npz")
     if keeper is not None:
         keeper.Restore(learner, robot, arrays, saved.pop("maintenance"))
@@ -511,8 +526,10 @@ def _Resume(checkpoint: pathlib.Path, robot, learner, keeper) -> dict:
 
 
 def _Result(settings: RunSettings, learner, robot, data: dict, extra: dict) -> ReachRun:
-    """A finished run's result."""
+    """A finished run's result (``robot`` watched for targets appearing inside it, unless the
+    run began before that was counted)."""
     safety = robot.Safety()
+    counts = robot.counts if isinstance(robot, AppearanceWatch) else None
     return ReachRun(
         settings=settings,
         evaluations={int(stage): e for stage, e in data["evaluations"].items()},
@@ -523,6 +540,8 @@ def _Result(settings: RunSettings, learner, robot, data: dict, extra: dict) -> R
         barrier_periods=safety.barrier_periods,
         num_transitions=learner.num_transitions,
         num_states=learner.space.num_states,
+        appeared_inside=None if counts is None else counts.appeared_inside,
+        other_penetrating_steps=None if counts is None else counts.other_penetrating_steps,
         **extra,
     )
 

@@ -19,7 +19,9 @@ from mobee_drake.experiments.ch8_measures import (
     ALIKE_UNTIL,
     COVERAGE_AT,
     FAVOURITES,
+    PENETRATION_HEADER,
     Fingerprints,
+    PenetrationCell,
     RobotTimeRatio,
     RunSums,
     RunTrends,
@@ -237,8 +239,8 @@ def _EffortSection(by_strategy: dict, k: int) -> list[str]:
         "",
         "| strategy | runs | robot hours (all runs) | source's robot hours (5 runs of 6400) "
         "| actions per problem-try | failed transitions per problem-try | timed-out "
-        "problem-tries | wall hours (all runs) | penetrating control periods | periods the "
-        "safety barrier acted |",
+        "problem-tries | wall hours (all runs) | "
+        f"{PENETRATION_HEADER} | periods the safety barrier acted |",
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for strategy in strategies:
@@ -255,7 +257,7 @@ def _EffortSection(by_strategy: dict, k: int) -> list[str]:
             f"| {strategy} | {len(by_strategy[strategy])} | {hours:.1f} | "
             f"{SOURCE_HOURS.get(strategy, '-')} | {actions / tries:.2f} | {failed / tries:.2f} | "
             f"{timeouts} | {sum(r.wall_seconds for r in by_strategy[strategy]) / 3600:.2f} | "
-            f"{sum(r.penetrating_steps for r in by_strategy[strategy])} | "
+            f"{PenetrationCell(by_strategy[strategy])} | "
             f"{_BarrierPeriods(by_strategy[strategy])} |"
         )
 

@@ -42,13 +42,13 @@ from mobee_drake.experiments.ch8_reaching import RIGHT_ARM, LoadTrainedLearner, 
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.statistics import FiniteMean, PairedBySeed
 from mobee_drake.owned_folders import OwnedFolder
+from mobee_drake.reaching.appearance import AppearanceWatch
 from mobee_drake.reaching.robot import SimulatedRobot
 from mobee_drake.reaching.targets import TARGET_NAME, TargetObject
 from mobee_drake.robots.icub import TORSO_JOINTS, IcubConfig
 from mobee_drake.scenario import BuildScenario
 from mobee_drake.station.builder import MakeMobeeStation
 from mobee_drake.station.composition import Behaviour, ComposeBehaviours
-from mobee_drake.station.safety import Penetrations
 from mobee_drake.station.settling import ActionTiming
 
 TARGET_SETS = ("inside", "outside")
@@ -149,29 +149,6 @@ def Beyond(robot: SimulatedRobot, targets: np.ndarray, distance: float) -> np.nd
     return targets + distance * away / np.linalg.norm(away, axis=1, keepdims=True)
 
 
-class AppearanceWatch:
-    """The robot, watched for targets that appear inside it (see TorsoReachRun)."""
-
-    def __init__(self, robot: SimulatedRobot):
-        self.robot, self.appeared_inside, self.other = robot, 0, 0
-        self._inside, self._start = True, 0
-
-    def __getattr__(self, name):  # (the rest of the Robot protocol, unwatched)
-        return getattr(self.robot, name)
-
-    def Close(self) -> None:
-        """Ends the current problem's count."""
-        if not self._inside:
-            self.other += self.robot.Safety().penetrating_steps - self._start
-
-    def SetProblem(self, target: np.ndarray) -> None:
-        self.Close()
-        self.robot.SetProblem(target)
-        self._inside = bool(Penetrations(self.robot.station.diagram, self.robot.context))
-        self.appeared_inside += self._inside
-        self._start = self.robot.Safety().penetrating_steps
-
-
 class SettledTorso:
     """The robot, whose torso settles where the module puts it once a problem's target has
     appeared, before the arm's first action (the arm holds where it is meanwhile): the learner
@@ -235,8 +212,8 @@ def RunOne(
             robot_seconds=(robot.context.get_time() - start) / len(chosen),
             wall_seconds=time.perf_counter() - began,
             penetrating_steps=robot.Safety().penetrating_steps,
-            appeared_inside=watched.appeared_inside,
-            other_penetrating_steps=watched.other,
+            appeared_inside=watched.counts.appeared_inside,
+            other_penetrating_steps=watched.counts.other_penetrating_steps,
         )
     )
 

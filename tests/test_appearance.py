@@ -1,0 +1,61 @@
+"""Tests of the watch for targets that appear inside the robot (reaching/appearance.py), on a
+stand-in robot whose penetrations the test sets; test_reach_learning runs it on the iCub."""
+
+import dataclasses as dc
+import types
+import unittest
+from unittest import mock
+
+from mobee_drake.reaching import appearance
+from mobee_drake.reaching.appearance import AppearanceCounts, AppearanceWatch
+
+
+class _Robot:
+    """Counts penetrating periods as the test says; a target is inside iff it is "inside"."""
+
+    def __init__(self):
+        self.penetrating, self.target = 0, None
+        self.station, self.context = types.SimpleNamespace(diagram=None), None
+
+    def Safety(self):
+        return types.SimpleNamespace(penetrating_steps=self.penetrating)
+
+    def SetProblem(self, target) -> None:
+        self.target = target
+
+    def State(self) -> int:
+        return 7
+
+
+def _Penetrations(robot: _Robot):
+    return lambda diagram, context: (
+        ["the robot: 'r_hand' inside 'target'"] * (robot.target == "inside")
+    )
+
+
+class AppearanceWatchTest(unittest.TestCase):
+    def test_penetrations_split_by_where_the_target_appeared(self):
+        robot = _Robot()
+        with mock.patch.object(appearance, "Penetrations", _Penetrations(robot)):
+            watched = AppearanceWatch(robot)
+            watched.SetProblem("inside")
+            robot.penetrating += 3  # (the arm pushed out of the target: the draw's)
+            watched.SetProblem("outside")
+            robot.penetrating += 5
+            # A checkpoint's counts resume the watch in a new process.
+            watched = AppearanceWatch(robot, AppearanceCounts(**dc.asdict(watched.counts)))
+            robot.penetrating += 2
+            watched.SetProblem("inside")
+            robot.penetrating += 4
+            watched.SetProblem("outside")
+            robot.penetrating += 1
+            watched.Close()
+            watched.Close()  # (closing twice counts once)
+        self.assertEqual(watched.counts.appeared_inside, 2)
+        self.assertEqual(watched.counts.other_penetrating_steps, 5 + 2 + 1)
+        self.assertEqual(robot.target, "outside")
+        self.assertEqual(watched.State(), 7)  # (the rest of the robot, unwatched)
+
+
+if __name__ == "__main__":
+    unittest.main()
