@@ -156,6 +156,18 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         self.output = pathlib.Path(tempfile.mkdtemp())
         self.addCleanup(shutil.rmtree, self.output)
 
+    @staticmethod
+    def _Reaching(output: pathlib.Path, seeds: int, tries: int, *arguments: str) -> None:
+        """The reaching part, greedy, with the MDP learned with the reaches and ``develop`` a
+        round every half run, quietly."""
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            adaptive_space.main(
+                ["--part", "reaching", "--mdp", "simultaneous", "--strategies", "greedy",
+                 "--seeds", str(seeds), "--problem-tries", str(tries), "--stages", str(tries),
+                 "--evaluations", "1", "--every", str(tries // 2), "--rules", "develop",
+                 "--output", str(output), *arguments]
+            )  # fmt: skip
+
     def test_the_reaching_smoke_battery(self):
         """The reaching part on both arms: greedy, 2 seeds x 8 problem-tries, fixed and
         developed every 4: every run reports at its last stage; only the maintained ones grow,
@@ -163,13 +175,8 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         from mobee_drake.experiments.adaptive_space_reaching import AdaptiveReachRun
 
         output = self.output / "reaching"
-        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-            adaptive_space.main(
-                ["--part", "reaching", "--mdp", "simultaneous", "--strategies", "greedy",
-                 "--seeds", "2", "--problem-tries", "8", "--stages", "8", "--evaluations", "1",
-                 "--every", "4", "--rules", "develop", "--output", str(output),
-                 "--robots", "icub", "katana", "--workers", "2"]
-            )  # fmt: skip
+        arms = ["--robots", "icub", "katana", "--reach-spaces", "rank3"]
+        self._Reaching(output, 2, 8, *arms, "--workers", "2")
         runs = [
             AdaptiveReachRun(**json.loads(path.read_text()))
             for path in output.glob("runs/reach_*/result.json")
@@ -183,20 +190,65 @@ class TestTheReachLearnersSpace(unittest.TestCase):
                 self.assertEqual(sum(run.changes.values()) > 0, run.condition == "maintained")
         report = (output / "report.md").read_text()
         for robot in ("icub", "katana"):
-            self.assertIn(f"| {robot} | greedy | maintained | 2 | 8 |", report)
-            self.assertIn(f"{robot} greedy, summed reward:", report)
-            self.assertRegex(report, rf"{robot}: targets of radius .* a median \d+\.\d cm")
+            self.assertIn(f"| {robot} | rank3 | greedy | maintained | 2 | 8 |", report)
+            self.assertIn(f"{robot} rank3 greedy, maintained minus fixed, summed reward:", report)
+            self.assertRegex(report, rf"{robot}: targets of radius .* rank3: a median \d+\.\d cm")
         # The report of the finished runs alone, a third seed's runs not started.
-        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-            adaptive_space.main(
-                ["--part", "reaching", "--mdp", "simultaneous", "--strategies", "greedy",
-                 "--seeds", "3", "--problem-tries", "8", "--stages", "8", "--evaluations", "1",
-                 "--every", "4", "--rules", "develop", "--output", str(output),
-                 "--robots", "icub", "katana", "--report-only"]
-            )  # fmt: skip
+        self._Reaching(output, 3, 8, *arms, "--report-only")
         self.assertFalse(list(output.glob("runs/*seed2")))
         table = (output / "report.md").read_text()
         self.assertEqual(table.split("Command:")[0], report.split("Command:")[0])
+
+    def test_the_reach_learner_on_a_roadmap(self):
+        """The reaching part on the iCub's roadmap space (spacing 1.0: a few states), greedy, one
+        seed: the roadmap is built before the runs; a fixed run keeps its states, a developed one
+        grows; the report gives the space's rows and how near its states come to the targets."""
+        from mobee_drake.experiments.adaptive_space_reaching import AdaptiveReachRun
+
+        output = self.output / "reaching"
+        self._Reaching(
+            output, 1, 6, "--reach-spaces", "trm", "--reach-trm-spacing", "1.0", "--workers", "2"
+        )
+        roadmap = json.loads((output / "runs/icub_roadmap/result.json").read_text())
+        runs = [
+            AdaptiveReachRun(**json.loads(path.read_text()))
+            for path in output.glob("runs/reach_trm_*/result.json")
+        ]
+        self.assertEqual(len(runs), 2)
+        for run in runs:
+            with self.subTest(condition=run.condition, seed=run.seed):
+                self.assertEqual(run.space, "trm")
+                maintained = run.condition == "maintained"
+                self.assertEqual(run.states > roadmap["vertices"], maintained)
+                self.assertEqual(run.states == roadmap["vertices"], not maintained)
+        report = (output / "report.md").read_text()
+        self.assertIn("| icub | trm | greedy | fixed | 1 | 6 |", report)
+        self.assertIn(f"The trm spaces: icub, {roadmap['vertices']} states and", report)
+        self.assertRegex(report, r"icub: targets of .* trm: a median \d+\.\d cm")
+        self.assertNotIn("rank3:", report)
+
+    def test_the_report_compares_the_roadmap_with_the_lattice(self):
+        """Constructed runs: trm's fixed runs reach 1.5 more than the lattice's, seed by seed
+        (0.5 apart from seed to seed), and take 0.25 robot hours less."""
+        from mobee_drake.experiments.adaptive_space_reaching import AdaptiveReachRun, Report
+
+        def Run(space, seed, reward, hours):
+            return AdaptiveReachRun(
+                strategy="greedy", condition="fixed", seed=seed, stage=8, reward=reward,
+                reward_without_penalties=reward, robot_hours=hours, states=81, transitions=351,
+                changes={}, penetrating_steps=0, wall_seconds=1.0, space=space,
+            )  # fmt: skip
+
+        runs = [Run("rank3", k, 20.0 + 0.5 * k, 2.0 + 0.1 * k) for k in range(4)]
+        runs += [Run("trm", k, 21.5 + 0.5 * k + 0.01 * k * k, 1.75 + 0.101 * k) for k in range(4)]
+        report = Report(runs, "test")
+        (reward,) = [line for line in report.splitlines() if "trm minus rank3" in line
+                     and "summed reward" in line]  # fmt: skip
+        (hours,) = [line for line in report.splitlines() if "trm minus rank3" in line
+                    and "robot hours" in line]  # fmt: skip
+        self.assertIn("icub greedy, trm minus rank3 (both fixed), summed reward: +1.5", reward)
+        self.assertIn("robot hours: -0.25", hours)
+        self.assertIn("(Holm over the 2)", report)
 
     def test_a_reshaping_run_resumes_exactly(self):
         """A greedy run whose space is developed every 4 problem-tries (its best reach states,

@@ -49,20 +49,23 @@ import numpy as np
 from pydrake.geometry import Meshcat
 
 from mobee_drake.atomic_files import CurrentGeneration, WriteTextAtomically
-from mobee_drake.experiments import adaptive_space_reaching as reaching
+from mobee_drake.experiments import adaptive_space_reaching as reaching_part
 from mobee_drake.experiments.adaptive_space_figures import (
     Figure,
     History,
     ShowObjects,
     ShowSpace,
 )
-from mobee_drake.experiments.adaptive_space_reaching import STRATEGIES, MaintainedMinusFixed
+from mobee_drake.experiments.adaptive_space_reaching import STRATEGIES
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
 from mobee_drake.experiments.arms import (
     TARGET_RADIUS,
     Arm,
     Arms,
     ReachTargets,
+    RoadmapJob,
+    RoadmapLines,
+    RoadmapSpace,
     TargetGaps,
     ValidConfigurations,
 )
@@ -79,13 +82,13 @@ from mobee_drake.experiments.ch8_reaching import LEVELS, ReachRobot
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
 from mobee_drake.experiments.plots import SaveFigure
+from mobee_drake.experiments.statistics import PairedBySeed
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel, ObservedOutcomes
 from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
 from mobee_drake.planning.state_space import Lattice
-from mobee_drake.planning.supervisor import ExploringAgent, RoadmapStateSpace
-from mobee_drake.trm.configuration import BuildConfigurationRoadmap
+from mobee_drake.planning.supervisor import ExploringAgent
 
 # The lattices compared: their levels (fractions of each joint's range); and "trm", a roadmap
 # over the valid configurations (mobee_drake.trm.configuration), built once per battery.
@@ -147,20 +150,6 @@ def PredictionError(robot: str, explorer, tests: int, seed: int) -> tuple[float,
         outcome = fresh.Transition(int(space.action_goal[sa]))
         errors.append(1.0 - T[sa, outcome])
     return (float(np.mean(errors)) if errors else float("nan")), len(errors)
-
-
-def RoadmapJob(run: RunFolder, *, robot: str, spacing: float, max_vertices: int) -> dict:
-    """The battery job that builds ``robot``'s "trm" space (its roadmap in ``run.path /
-    "roadmap"``)."""
-    arm = Arms()[robot]
-    roadmap = BuildConfigurationRoadmap(
-        arm.robot, list(arm.joints), spacing, max_vertices, objects=arm.objects,
-        progress=run.Progress,
-    )  # fmt: skip
-    roadmap.Save(run.path / "roadmap")
-    return dict(
-        vertices=len(roadmap.q), edges=len(roadmap.edges), build_seconds=roadmap.build_seconds
-    )
 
 
 def AdaptiveSpaceJob(
@@ -255,6 +244,16 @@ def _Row(key: tuple, rs: list[AdaptiveSpaceRun]) -> str:
     )
 
 
+def MaintainedMinusFixed(group: dict, keys: list[tuple], measures: dict) -> list[str]:
+    """Report lines: for each key (``group``'s keys are a key and a condition), maintained
+    minus fixed on each of ``measures`` (run -> value), paired by seed, Holm over them all."""
+    families = {
+        " ".join(key): (group.get((*key, "maintained"), []), group.get((*key, "fixed"), []))
+        for key in keys
+    }
+    return PairedBySeed(families, measures, "Maintained minus fixed")
+
+
 def Report(runs: list[AdaptiveSpaceRun], roadmaps: dict[str, dict], command: str) -> str:
     """The report's table, the trm spaces' roadmaps (``roadmaps``: per robot, its roadmap
     job's result) and the paired comparisons (markdown)."""
@@ -267,17 +266,7 @@ def Report(runs: list[AdaptiveSpaceRun], roadmaps: dict[str, dict], command: str
         "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|",
         *(_Row(key, rs) for key, rs in group.items()),
     ]
-    if roadmaps:
-        lines += [
-            "",
-            "The trm spaces: "
-            + "; ".join(
-                f"{robot}, {r['vertices']} states and {r['edges']} edges, built in "
-                f"{r['build_seconds']:.0f} s"
-                for robot, r in roadmaps.items()
-            )
-            + ".",
-        ]
+    lines += RoadmapLines(roadmaps)
     lines += MaintainedMinusFixed(group, sorted({(r.robot, r.space) for r in runs}), _MEASURES)
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
 
@@ -328,6 +317,21 @@ def _Parser() -> CommandParser:
     reaching = parser.add_argument_group("reaching (ch. 8)")
     reaching.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))
     reaching.add_argument("--problem-tries", type=PositiveInt, default=1600, help="per run")
+    reaching.add_argument(
+        "--reach-spaces",
+        nargs="+",
+        choices=reaching_part.SPACES,
+        default=list(reaching_part.SPACES),
+        help="the spaces the runs start on: the rank-3 lattice and a roadmap over the valid "
+        f"configurations of at most its {reaching_part.TRM_STATES} states",
+    )
+    reaching.add_argument(
+        "--reach-trm-spacing",
+        type=PositiveFloat,
+        default=0.7,
+        help="the reaching part's trm space: its roadmap's spacing d (fractions of range; 0.7 "
+        "grows 80 vertices on either arm unbounded)",
+    )
     reaching.add_argument(
         "--stages", type=PositiveInt, nargs="+", default=[100, 400, 1600], help="evaluated at"
     )
@@ -384,11 +388,7 @@ def _InitialCentres(arm: Arm, robot: str, space: str, output: pathlib.Path) -> n
     """The centres a run's space began with (fractions of range)."""
     if space in LATTICES:
         return Lattice(LATTICES[space], len(arm.joints)).centres
-    model = KinematicModel(arm.robot, list(arm.objects))
-    folder = output / "runs" / f"{robot}_{ROADMAP_JOB}" / "roadmap"
-    return RoadmapStateSpace(
-        str(folder), list(arm.joints), list(model.joints), model.lower, model.upper
-    ).centres
+    return RoadmapSpace(arm, output / "runs" / f"{robot}_{ROADMAP_JOB}" / "roadmap").centres
 
 
 def SpaceHistories(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> dict[str, list]:
@@ -486,13 +486,32 @@ def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Pat
 
 
 def _ReachingReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, command):
-    """Runs the reaching part's battery; its report."""
-    jobs = reaching.Jobs(args, maintenance)
-    results = _Results(args, jobs, output, "adaptive reaching")
-    runs = [reaching.AdaptiveReachRun(**r) for n, r in results.items() if n.startswith("reach_")]
-    arms = Arms()
-    targets = {r: (ReachTargets(arms[r]), TargetGaps(arms[r], LEVELS)) for r in args.robots}
-    return reaching.Report(runs, command, targets)
+    """Runs the reaching part's battery, stage by stage; its report."""
+    results = {}
+    for description, jobs in reaching_part.Stages(args, maintenance):
+        results.update(_Results(args, jobs, output, description))
+    runs = [
+        reaching_part.AdaptiveReachRun(**r) for n, r in results.items() if n.startswith("reach_")
+    ]
+    suffix = f"_{reaching_part.ROADMAP_JOB}"
+    roadmaps = {n.removesuffix(suffix): r for n, r in results.items() if n.endswith(suffix)}
+    arms, targets = Arms(), {}
+    for robot in args.robots:
+        targets[robot] = (ReachTargets(arms[robot]), {})
+        for space in args.reach_spaces:
+            centres = _ReachCentres(arms[robot], robot, space, output)
+            if centres is not None:
+                targets[robot][1][space] = TargetGaps(arms[robot], centres)
+    return reaching_part.Report(runs, command, targets, roadmaps)
+
+
+def _ReachCentres(arm: Arm, robot: str, space: str, output: pathlib.Path):
+    """The centres the reaching part's ``space`` begins with (fractions of range); None for a
+    roadmap not yet built."""
+    if space == "rank3":
+        return Lattice(LEVELS, len(arm.joints)).centres
+    folder = output / "runs" / f"{robot}_{reaching_part.ROADMAP_JOB}" / "roadmap"
+    return RoadmapSpace(arm, folder).centres if folder.is_dir() else None
 
 
 def main(argv: list[str] | None = None) -> None:

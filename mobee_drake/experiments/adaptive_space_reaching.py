@@ -3,42 +3,62 @@ docs/adaptive_space.md).
 
 Each strategy of ch. 8 learns to reach with an arm (``--robots``:
 :mod:`~mobee_drake.experiments.arms`, the iCub's right arm and the source's targets, or the
-Katana's first four joints, wrist and targets) on the rank-3 lattice for ``--problem-tries``
-problem-tries, on the space as it is (``fixed``) and on the same space maintained by the rules of
+Katana's first four joints, wrist and targets) for ``--problem-tries`` problem-tries, starting
+on a space of ``--reach-spaces``: ch. 8's rank-3 lattice (``rank3``) or a task-relevant roadmap
+over the arm's valid configurations with at most the lattice's 81 states (``trm``, spacing
+``--reach-trm-spacing``, built once per arm by the battery's job ``<robot>_roadmap``). On each,
+the space stays as it is (``fixed``) or is maintained by the rules of
 :mod:`mobee_drake.planning.space_maintenance` (``maintained``, a round every ``--every``
 problem-tries; the learner's favoured states, its best reaches, are developed), ``--seeds`` runs
-of each, paired by seed. In both conditions the MDP is learned first (5 tries of every
-state-action, as ch. 8) and learned further with the reaches (``continued``, ch. 9.4.1): a new
-transition starts with Alg. 6's optimistic counts and is learned like the rest, so the two
-conditions differ by the maintenance only. With ``--mdp simultaneous`` no MDP is learned first
-(the smoke run's setting).
+of each, paired by seed. The MDP of each space is learned first (5 tries of every state-action,
+as ch. 8) and learned further with the reaches (``continued``, ch. 9.4.1): a new transition
+starts with Alg. 6's optimistic counts and is learned like the rest, so fixed and maintained
+differ by the maintenance only. With ``--mdp simultaneous`` no MDP is learned first (the smoke
+runs' setting).
 
 Per run, at the last stage: the evaluations' summed reward (ch. 8.3.3, with the -10 of every
 failed transition and without), the robot's simulated hours, the space's size and its changes,
-and the penetrating periods. Maintained minus fixed is compared paired by seed, Holm-corrected
-over the robots, the strategies and the two measures (reward with penalties, robot hours).
-"""
+and the penetrating periods (:mod:`~mobee_drake.reaching.appearance`'s split). Maintained minus
+fixed on each space, and the roadmap minus the lattice (both fixed), are compared paired by
+seed, Holm-corrected over them all (the robots, spaces, strategies and the two measures: reward
+with penalties, robot hours)."""
 
 import collections
 import dataclasses as dc
 
 import numpy as np
 
+from mobee_drake.experiments.arms import RoadmapJob, RoadmapLines
 from mobee_drake.experiments.battery import Job, RunFolder, StopRequested
 from mobee_drake.experiments.ch8_figures import EvaluationSum
 from mobee_drake.experiments.ch8_measures import PENETRATION_HEADER, PenetrationCell
-from mobee_drake.experiments.ch8_reaching import MdpJob, MdpName, ReachRun, RunOne, RunSettings
+from mobee_drake.experiments.ch8_reaching import (
+    LEVELS,
+    MdpJob,
+    MdpName,
+    ReachRun,
+    RunOne,
+    RunSettings,
+)
 from mobee_drake.experiments.statistics import PairedBySeed, RunMeans
 from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
+from mobee_drake.planning.state_space import Lattice
 
 STRATEGIES = ("greedy", "intrinsic", "random")
 CONDITIONS = ("fixed", "maintained")
 MDP_TRIES = 5
+# The spaces a run starts on: ch. 8's rank-3 lattice, and "trm", a roadmap over the arm's valid
+# configurations with at most the lattice's number of states (built by the battery's job
+# ``<robot>_roadmap``; mobee_drake.trm.configuration).
+SPACES = ("rank3", "trm")
+TRM_STATES = len(Lattice(LEVELS, 4).centres)
+ROADMAP_JOB = "roadmap"
 
 
 @dc.dataclass
 class AdaptiveReachRun:
-    """One reach-learning run: a strategy, fixed or maintained, a seed (see the module)."""
+    """One reach-learning run: an arm, a space, a strategy, fixed or maintained, a seed (see the
+    module)."""
 
     strategy: str
     condition: str
@@ -56,15 +76,16 @@ class AdaptiveReachRun:
     # (see ReachRun; None: a run from before they were counted)
     appeared_inside: int | None = None
     other_penetrating_steps: int | None = None
+    space: str = "rank3"  # (the battery's first runs were the lattice's, without the field)
 
 
 def AdaptiveReachJob(
     run: RunFolder, *, strategy: str, condition: str, seed: int, problem_tries: int,
     stages: list[int], evaluations: int, mdp: str, maintenance: MaintenanceConfig,
-    robot: str = "icub",
+    robot: str = "icub", space: str = "rank3",
 ) -> dict:  # fmt: skip
     """The battery job: one run on ``robot``, an arm of
-    :func:`~mobee_drake.experiments.arms.Arms` (see the module)."""
+    :func:`~mobee_drake.experiments.arms.Arms`, starting on ``space`` (see the module)."""
     settings = RunSettings(
         strategy=strategy,
         seed=seed,
@@ -77,12 +98,15 @@ def AdaptiveReachJob(
     result = ReachRun.FromJson(
         RunOne(
             run.path,
-            run.path.parent / MdpName(MDP_TRIES, robot=robot) / "model",
+            run.path.parent / MdpName(MDP_TRIES, robot=robot, space=space) / "model",
             settings,
             progress=run.Progress,
             should_stop=StopRequested,
             maintenance=maintenance if condition == "maintained" else None,
             robot=robot,
+            roadmap=str(run.path.parent / f"{robot}_{ROADMAP_JOB}" / "roadmap")
+            if space == "trm"
+            else "",
         )
     )
     stage = max(result.evaluations)
@@ -90,12 +114,13 @@ def AdaptiveReachJob(
         RunMeans([[EvaluationSum(e, penalties) for e in result.evaluations[stage]]])[0]
         for penalties in (True, False)
     ]
-    space = result.space or dict(
+    ended = result.space or dict(
         states=result.num_states, transitions=result.num_transitions, changes={}
     )
     return dc.asdict(
         AdaptiveReachRun(
             robot=robot,
+            space=space,
             strategy=strategy,
             condition=condition,
             seed=seed,
@@ -103,9 +128,9 @@ def AdaptiveReachJob(
             reward=float(sums[0]),
             reward_without_penalties=float(sums[1]),
             robot_hours=result.simulated_seconds / 3600,
-            states=space["states"],
-            transitions=space["transitions"],
-            changes={rule: space["changes"].get(rule, 0) for rule in RULES},
+            states=ended["states"],
+            transitions=ended["transitions"],
+            changes={rule: ended["changes"].get(rule, 0) for rule in RULES},
             penetrating_steps=result.penetrating_steps,
             appeared_inside=result.appeared_inside,
             other_penetrating_steps=result.other_penetrating_steps,
@@ -114,22 +139,40 @@ def AdaptiveReachJob(
     )
 
 
-def Jobs(args, maintenance: MaintenanceConfig) -> list[Job]:
-    """The battery's jobs: per robot, the MDP learned first (unless ``--mdp simultaneous``),
-    then every strategy's runs; the iCub's jobs keep the names and arguments they had before
-    there was a choice of robot."""
-    jobs = []
+def Stages(args, maintenance: MaintenanceConfig) -> list[tuple[str, list[Job]]]:
+    """The battery's jobs in the order they must finish, each stage (its description, its
+    jobs) before the next begins: the "trm" spaces' roadmaps, the MDPs learned first on each
+    space (unless ``--mdp simultaneous``), then the runs. The iCub's lattice jobs keep the names
+    and arguments they had before there was a choice of robot or space."""
+    roadmaps, mdps, runs = [], [], []
     for robot in args.robots:
-        if args.mdp != "simultaneous":
-            mdp = dict(min_tries=MDP_TRIES) | ({} if robot == "icub" else dict(robot=robot))
-            jobs.append(Job(MdpName(MDP_TRIES, robot=robot), MdpJob, mdp))
-        jobs += _RobotJobs(args, maintenance, robot)
-    return jobs
+        if "trm" in args.reach_spaces:
+            roadmaps.append(
+                Job(
+                    f"{robot}_{ROADMAP_JOB}",
+                    RoadmapJob,
+                    dict(robot=robot, spacing=args.reach_trm_spacing, max_vertices=TRM_STATES),
+                    total=TRM_STATES,
+                )
+            )
+        for space in args.reach_spaces:
+            if args.mdp != "simultaneous":
+                mdp = dict(min_tries=MDP_TRIES) | ({} if robot == "icub" else dict(robot=robot))
+                if space == "trm":
+                    mdp["roadmap_job"] = f"{robot}_{ROADMAP_JOB}"
+                name = MdpName(MDP_TRIES, robot=robot, space=space)
+                mdps.append(Job(name, MdpJob, mdp))
+            runs += _RunJobs(args, maintenance, robot, space)
+    stages = [("trm spaces", roadmaps), ("the MDPs (actions)", mdps), ("adaptive reaching", runs)]
+    return [(description, jobs) for description, jobs in stages if jobs]
 
 
-def _RobotJobs(args, maintenance: MaintenanceConfig, robot: str) -> list[Job]:
+def _RunJobs(args, maintenance: MaintenanceConfig, robot: str, space: str) -> list[Job]:
     stages = sorted({*args.stages, args.problem_tries})
-    prefix, named = ("reach", {}) if robot == "icub" else (f"reach_{robot}", dict(robot=robot))
+    prefix = "reach" if robot == "icub" else f"reach_{robot}"
+    named = {} if robot == "icub" else dict(robot=robot)
+    if space != "rank3":
+        prefix, named = f"{prefix}_{space}", named | dict(space=space)
     return [
         Job(
             f"{prefix}_{strategy}_{condition}_seed{seed}",
@@ -153,34 +196,30 @@ def _RobotJobs(args, maintenance: MaintenanceConfig, robot: str) -> list[Job]:
     ]
 
 
-def MaintainedMinusFixed(group: dict, keys: list[tuple], measures: dict) -> list[str]:
-    """Report lines: for each key (``group``'s keys are a key and a condition), maintained
-    minus fixed on each of ``measures`` (run -> value), paired by seed, Holm over them all."""
-    families = {
-        " ".join(key): (group.get((*key, "maintained"), []), group.get((*key, "fixed"), []))
-        for key in keys
-    }
-    return PairedBySeed(families, measures, "Maintained minus fixed")
-
-
-def Report(runs: list[AdaptiveReachRun], command: str, targets: dict | None = None) -> str:
-    """The report's table, the paired comparisons and, with ``targets`` (per robot, its
-    :class:`~mobee_drake.reaching.targets.TargetGrid` and each target's distance to the nearest
-    state's marker, :func:`~mobee_drake.experiments.arms.TargetGaps`), the targets and how near
-    the lattice comes to them (markdown)."""
+def Report(
+    runs: list[AdaptiveReachRun],
+    command: str,
+    targets: dict | None = None,
+    roadmaps: dict | None = None,
+) -> str:
+    """The report's table, the "trm" spaces' roadmaps (``roadmaps``: per robot, its roadmap
+    job's result), the paired comparisons and, with ``targets`` (per robot, its
+    :class:`~mobee_drake.reaching.targets.TargetGrid` and, per space, each target's distance to
+    the nearest state's marker, :func:`~mobee_drake.experiments.arms.TargetGaps`), the targets
+    and how near each space comes to them (markdown)."""
     group = collections.defaultdict(list)
     for r in sorted(runs, key=lambda r: r.seed):
-        group[(r.robot, r.strategy, r.condition)].append(r)
+        group[(r.robot, r.space, r.strategy, r.condition)].append(r)
     lines = [
-        "| robot | strategy | condition | runs | problem-tries | summed reward | without the -10s "
-        f"| robot hours | states | transitions | changes ({'/'.join(RULES)}) "
+        "| robot | space | strategy | condition | runs | problem-tries | summed reward | without "
+        f"the -10s | robot hours | states | transitions | changes ({'/'.join(RULES)}) "
         f"| {PENETRATION_HEADER} | wall s per run |",
-        "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|",
+        "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|",
     ]
-    for (robot, strategy, condition), rs in sorted(group.items()):
+    for (robot, space, strategy, condition), rs in sorted(group.items()):
         changes = "/".join(f"{np.mean([r.changes.get(c, 0) for r in rs]):.0f}" for c in RULES)
         lines.append(
-            f"| {robot} | {strategy} | {condition} | {len(rs)} | {rs[0].stage} | "
+            f"| {robot} | {space} | {strategy} | {condition} | {len(rs)} | {rs[0].stage} | "
             f"{np.mean([r.reward for r in rs]):.2f} | "
             f"{np.mean([r.reward_without_penalties for r in rs]):.2f} | "
             f"{np.mean([r.robot_hours for r in rs]):.2f} | "
@@ -190,13 +229,26 @@ def Report(runs: list[AdaptiveReachRun], command: str, targets: dict | None = No
             f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
         )
     measures = {"summed reward": lambda r: r.reward, "robot hours": lambda r: r.robot_hours}
-    keys = sorted({(r.robot, r.strategy) for r in runs})
-    lines += MaintainedMinusFixed(group, keys, measures)
+    families = {
+        f"{robot} {space} {strategy}, maintained minus fixed": (
+            group[(robot, space, strategy, "maintained")], group[(robot, space, strategy, "fixed")]
+        )
+        for robot, space, strategy in sorted({(r.robot, r.space, r.strategy) for r in runs})
+    }  # fmt: skip
+    for robot, strategy in sorted({(r.robot, r.strategy) for r in runs}):
+        families[f"{robot} {strategy}, trm minus rank3 (both fixed)"] = (
+            group[(robot, "trm", strategy, "fixed")], group[(robot, "rank3", strategy, "fixed")]
+        )  # fmt: skip
+    lines += RoadmapLines(roadmaps or {})
+    lines += PairedBySeed(families, measures, "Maintained minus fixed and trm minus rank3")
     for robot, (grid, gaps) in (targets or {}).items():
         levels = ", ".join(f"{axis} {'/'.join(f'{v:.2f}' for v in getattr(grid, axis))}"
                            for axis in "xyz")  # fmt: skip
-        lines += ["", f"{robot}: targets of radius {grid.radius:g} m at {levels} m; the "
-                  "lattice's valid state nearest each puts the marker a median "
-                  f"{100 * np.median(gaps):.1f} cm (at most {100 * gaps.max():.1f} cm) from it "
-                  "before the reach."]  # fmt: skip
+        nearest = "; ".join(
+            f"{space}: a median {100 * np.median(g):.1f} cm (at most {100 * g.max():.1f} cm)"
+            for space, g in gaps.items()
+        )
+        lines += ["", f"{robot}: targets of radius {grid.radius:g} m at {levels} m; the valid "
+                  f"state nearest each puts the marker, before the reach, {nearest} from "
+                  "it."]  # fmt: skip
     return "\n".join(lines) + f"\n\nCommand: `{command}`."

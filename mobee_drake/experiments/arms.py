@@ -12,15 +12,19 @@ not through the column its arm rises from.
 """
 
 import dataclasses as dc
+import pathlib
 
 import numpy as np
 
+from mobee_drake.experiments.battery import RunFolder
 from mobee_drake.ngik.kinematic_model import KinematicModel
-from mobee_drake.planning.state_space import Lattice
+from mobee_drake.planning.state_space import StateActionSpace
+from mobee_drake.planning.supervisor import RoadmapStateSpace
 from mobee_drake.reaching.targets import LoadTargetGrid, TargetGrid
 from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS, IcubConfig
 from mobee_drake.robots.zero_position import ZeroPositionConfig
 from mobee_drake.scenario import LoadScenario
+from mobee_drake.trm.configuration import BuildConfigurationRoadmap
 
 # Valid configurations drawn for a measure or a target grid (uniform draws, then filtered).
 VALID_SAMPLES = 2000
@@ -97,11 +101,11 @@ def ValidConfigurations(arm: Arm, count: int = VALID_SAMPLES, seed: int = 0) -> 
     return _ValidPoses(arm, count, seed)[0]
 
 
-def TargetGaps(arm: Arm, levels: list[float]) -> np.ndarray:
+def TargetGaps(arm: Arm, centres: np.ndarray) -> np.ndarray:
     """Per reach target, the distance (m) from it to the nearest marker position of a valid
-    centre of the lattice of ``levels`` on the arm's joints: how near a pre-reach state can put
-    the marker before the reach."""
-    positions, valid = _Poses(arm, Lattice(levels, len(arm.joints)).centres)
+    one of the states' ``centres`` ((k, joints), fractions of range): how near a pre-reach state
+    can put the marker before the reach."""
+    positions, valid = _Poses(arm, centres)
     targets = ReachTargets(arm).Centres()
     return np.linalg.norm(targets[:, None] - positions[valid][None], axis=2).min(axis=1)
 
@@ -118,3 +122,39 @@ def ReachTargets(arm: Arm) -> TargetGrid:
     levels = np.round(np.percentile(positions, TARGET_PERCENTILES, axis=0), 2)
     x, y, z = (levels[:, axis].tolist() for axis in range(3))
     return TargetGrid(radius=TARGET_RADIUS, x=x, y=y, z=z)
+
+
+def RoadmapJob(run: RunFolder, *, robot: str, spacing: float, max_vertices: int) -> dict:
+    """The battery job that builds a roadmap over ``robot``'s valid configurations
+    (:func:`~mobee_drake.trm.configuration.BuildConfigurationRoadmap`, in ``run.path /
+    "roadmap"``): a "trm" space."""
+    arm = Arms()[robot]
+    roadmap = BuildConfigurationRoadmap(
+        arm.robot, list(arm.joints), spacing, max_vertices, objects=arm.objects,
+        progress=run.Progress,
+    )  # fmt: skip
+    roadmap.Save(run.path / "roadmap")
+    return dict(
+        vertices=len(roadmap.q), edges=len(roadmap.edges), build_seconds=roadmap.build_seconds
+    )
+
+
+def RoadmapLines(roadmaps: dict[str, dict]) -> list[str]:
+    """Report lines on the "trm" spaces (``roadmaps``: per robot, its :func:`RoadmapJob`'s
+    result); none without any."""
+    if not roadmaps:
+        return []
+    built = "; ".join(
+        f"{robot}, {r['vertices']} states and {r['edges']} edges, built in "
+        f"{r['build_seconds']:.0f} s"
+        for robot, r in roadmaps.items()
+    )
+    return ["", f"The trm spaces: {built}."]
+
+
+def RoadmapSpace(arm: Arm, folder: str | pathlib.Path) -> StateActionSpace:
+    """The state-action space of the roadmap saved in ``folder`` over ``arm``'s joints."""
+    model = KinematicModel(arm.robot, list(arm.objects))
+    return RoadmapStateSpace(
+        str(folder), list(arm.joints), list(model.joints), model.lower, model.upper
+    )

@@ -60,7 +60,7 @@ from mobee_drake.atomic_files import (
     StrictJson,
     WriteGeneration,
 )
-from mobee_drake.experiments.arms import Arms, ReachTargets
+from mobee_drake.experiments.arms import Arms, ReachTargets, RoadmapSpace
 from mobee_drake.experiments.battery import (
     Backend,
     Job,
@@ -114,16 +114,18 @@ def TrainMdp(
     should_stop=None,
     transition_noise: float = 0.0,
     robot: str = "icub",
+    roadmap: str = "",
 ):
-    """The curious agent's model of the rank-3 lattice, learned once (checkpointed in ``folder``
-    as it learns, resumed from there after a kill) on a robot with ``transition_noise``
-    (``robot``: an arm of :func:`~mobee_drake.experiments.arms.Arms`, the iCub's right arm by
-    default); ``progress(n)``, if given, is told the actions done as the agent learns. It stops
-    when every state-action has ``min_tries`` tries, or after :data:`MDP_ACTIONS_PER_TRY` actions
-    per state-action and try (a state the arm cannot enter would otherwise never let it stop; the
-    result's ``min_tries`` says which)."""
+    """The curious agent's model of the rank-3 lattice (or of the space of the roadmap saved in
+    ``roadmap``, :func:`~mobee_drake.planning.supervisor.RoadmapStateSpace`), learned once
+    (checkpointed in ``folder`` as it learns, resumed from there after a kill) on a robot with
+    ``transition_noise`` (``robot``: an arm of :func:`~mobee_drake.experiments.arms.Arms`, the
+    iCub's right arm by default); ``progress(n)``, if given, is told the actions done as the
+    agent learns. It stops when every state-action has ``min_tries`` tries, or after
+    :data:`MDP_ACTIONS_PER_TRY` actions per state-action and try (a state the arm cannot enter
+    would otherwise never let it stop; the result's ``min_tries`` says which)."""
     arm = Arms()[robot]
-    agent = ExploringAgent(name=AGENT, joints=list(arm.joints), levels=LEVELS)
+    agent = ExploringAgent(name=AGENT, joints=list(arm.joints), levels=LEVELS, roadmap=roadmap)
     scenario = ExplorationScenario([agent], arm.objects, robot=arm.robot, random_seed=seed)
     scenario.attractor.transition_noise = transition_noise
     Explore(
@@ -148,8 +150,11 @@ def MdpJob(
     seed: int = 0,
     transition_noise: float = 0.0,
     robot: str = "icub",
+    roadmap_job: str = "",
 ) -> dict:
-    """The battery job that learns the MDP (in ``run.path / "model"``)."""
+    """The battery job that learns the MDP (in ``run.path / "model"``), on the space of the
+    roadmap built by the battery's job ``roadmap_job`` (in its folder's ``roadmap``), if given."""
+    roadmap = str(run.path.parent / roadmap_job / "roadmap") if roadmap_job else ""
     model = TrainMdp(
         run.path / "model",
         min_tries,
@@ -158,20 +163,26 @@ def MdpJob(
         should_stop=StopRequested,
         transition_noise=transition_noise,
         robot=robot,
+        roadmap=roadmap,
     )
     return dict(min_tries=int(model.tries.min()), actions=int(model.tries.sum()))
 
 
 def MdpName(
-    min_tries: int, seed: int = 0, transition_noise: float = 0.0, robot: str = "icub"
+    min_tries: int,
+    seed: int = 0,
+    transition_noise: float = 0.0,
+    robot: str = "icub",
+    space: str = "rank3",
 ) -> str:
     """The battery's job (and folder) of an MDP: ``mdp_tries<t>``, with ``_seed<m>`` and
-    ``_noise<sd>`` for another seed and a stochastic robot, and ``<robot>_`` before it for
-    another robot than the iCub."""
+    ``_noise<sd>`` for another seed and a stochastic robot, ``<robot>_`` before it for another
+    robot than the iCub, and ``_<space>`` after it for another space than the rank-3 lattice."""
     seed_part = f"_seed{seed}" if seed else ""
     noise_part = f"_noise{transition_noise:g}" if transition_noise else ""
     robot_part = "" if robot == "icub" else f"{robot}_"
-    return f"{robot_part}mdp_tries{min_tries}{seed_part}{noise_part}"
+    space_part = "" if space == "rank3" else f"_{space}"
+    return f"{robot_part}mdp_tries{min_tries}{seed_part}{noise_part}{space_part}"
 
 
 @dc.dataclass
@@ -387,13 +398,16 @@ def _Checkpoint(
     WriteGeneration(folder, Write)
 
 
-def _NewLearner(settings: RunSettings, mdp_dir: pathlib.Path, robot: str = "icub"):
+def _NewLearner(
+    settings: RunSettings, mdp_dir: pathlib.Path, robot: str = "icub", roadmap: str = ""
+):
     """(the MDP's model, a new reach learner on it, the target grid): the model is the
-    optimistic initial one of the lattice, learned with the reaches, or the one learned first."""
+    optimistic initial one of the lattice (or of the space of the roadmap saved in
+    ``roadmap``), learned with the reaches, or the one learned first (with its own space)."""
     simultaneous = settings.mdp == "simultaneous"
     arm = Arms()[robot]
     model = (
-        Explorer(Lattice(LEVELS, len(arm.joints)))
+        Explorer(RoadmapSpace(arm, roadmap) if roadmap else Lattice(LEVELS, len(arm.joints)))
         if simultaneous
         else LoadAgentModel(str(mdp_dir), AGENT, ExplorerConfig())
     )
@@ -439,6 +453,7 @@ def RunOne(
     should_stop=None,
     maintenance: MaintenanceConfig | None = None,
     robot: str = "icub",
+    roadmap: str = "",
 ) -> dict:
     """One run of the battery (resumes from ``run_dir/checkpoint``); returns its result. With
     ``meshcat``, the run is shown there in real time; ``progress(n)``, if given, is told the
@@ -446,9 +461,11 @@ def RunOne(
     problem-try, and when True the run saves its checkpoint and raises JobStopped. With
     ``maintenance``, the learner's space reshapes itself (ch. 9.4.5,
     :class:`~mobee_drake.reaching.reshaping.ReachSpaceKeeper`). ``robot``: an arm of
-    :func:`~mobee_drake.experiments.arms.Arms` (its MDP in ``mdp_dir``), the iCub's by default."""
+    :func:`~mobee_drake.experiments.arms.Arms` (its MDP in ``mdp_dir``), the iCub's by default.
+    ``roadmap``: with ``mdp="simultaneous"``, a saved roadmap whose space the learner starts on
+    instead of the lattice (an MDP learned first has its own space)."""
     run_dir.mkdir(parents=True, exist_ok=True)
-    model, learner, grid = _NewLearner(settings, mdp_dir, robot)
+    model, learner, grid = _NewLearner(settings, mdp_dir, robot, roadmap)
     keeper = None
     if maintenance is not None:
         keeper = ReachSpaceKeeper(maintenance, learner.space.num_states)
