@@ -56,7 +56,6 @@ from mobee_drake.experiments.adaptive_space_figures import (
     ShowObjects,
     ShowSpace,
 )
-from mobee_drake.experiments.adaptive_space_reaching import STRATEGIES
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
 from mobee_drake.experiments.arms import (
     TARGET_RADIUS,
@@ -271,6 +270,34 @@ def Report(runs: list[AdaptiveSpaceRun], roadmaps: dict[str, dict], command: str
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
 
 
+def _AddMaintenanceArguments(maintenance) -> None:
+    """The maintenance's options (an argument group)."""
+    maintenance.add_argument(
+        "--every",
+        type=PositiveInt,
+        default=MaintenanceConfig().every,
+        help="actions (exploration) or problem-tries (reaching) between rounds",
+    )
+    maintenance.add_argument(
+        "--rules",
+        nargs="+",
+        choices=RULES,
+        help=f"the rules (exploration: {' '.join(MaintenanceConfig().rules)}; reaching: all)",
+    )
+    maintenance.add_argument(
+        "--prune-after",
+        type=PositiveInt,
+        default=MaintenanceConfig().prune_after,
+        help="tries into a state, none arriving, before it is pruned",
+    )
+    maintenance.add_argument(
+        "--max-states",
+        type=PositiveInt,
+        default=None,
+        help="the space grows while it has fewer states than this (default: no limit)",
+    )
+
+
 def _Parser() -> CommandParser:
     parser = CommandParser(
         prog="mobee-drake experiment adaptive-space", description=__doc__.split("\n\n")[0]
@@ -314,59 +341,8 @@ def _Parser() -> CommandParser:
         help="coverage: a valid configuration this near (fractions of range) an arrived-in "
         "state's centre counts as covered",
     )
-    reaching = parser.add_argument_group("reaching (ch. 8)")
-    reaching.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))
-    reaching.add_argument("--problem-tries", type=PositiveInt, default=1600, help="per run")
-    reaching.add_argument(
-        "--reach-spaces",
-        nargs="+",
-        choices=reaching_part.SPACES,
-        default=list(reaching_part.SPACES),
-        help="the spaces the runs start on: the rank-3 lattice and a roadmap over the valid "
-        f"configurations of at most its {reaching_part.TRM_STATES} states",
-    )
-    reaching.add_argument(
-        "--reach-trm-spacing",
-        type=PositiveFloat,
-        default=0.7,
-        help="the reaching part's trm space: its roadmap's spacing d (fractions of range; 0.7 "
-        "grows 80 vertices on either arm unbounded)",
-    )
-    reaching.add_argument(
-        "--stages", type=PositiveInt, nargs="+", default=[100, 400, 1600], help="evaluated at"
-    )
-    reaching.add_argument("--evaluations", type=PositiveInt, default=5, help="per stage")
-    reaching.add_argument(
-        "--mdp",
-        choices=("continued", "simultaneous"),
-        default="continued",
-        help="the MDP learned first and further with the reaches, or only with them",
-    )
-    maintenance = parser.add_argument_group("maintenance")
-    maintenance.add_argument(
-        "--every",
-        type=PositiveInt,
-        default=MaintenanceConfig().every,
-        help="actions (exploration) or problem-tries (reaching) between rounds",
-    )
-    maintenance.add_argument(
-        "--rules",
-        nargs="+",
-        choices=RULES,
-        help=f"the rules (exploration: {' '.join(MaintenanceConfig().rules)}; reaching: all)",
-    )
-    maintenance.add_argument(
-        "--prune-after",
-        type=PositiveInt,
-        default=MaintenanceConfig().prune_after,
-        help="tries into a state, none arriving, before it is pruned",
-    )
-    maintenance.add_argument(
-        "--max-states",
-        type=PositiveInt,
-        default=None,
-        help="the space grows while it has fewer states than this (default: no limit)",
-    )
+    reaching_part.AddArguments(parser.add_argument_group("reaching (ch. 8)"))
+    _AddMaintenanceArguments(parser.add_argument_group("maintenance"))
     parser.add_argument(
         "--output", help="the battery folder (results/adaptive_space[_reaching] by default)"
     )

@@ -28,6 +28,7 @@ import dataclasses as dc
 
 import numpy as np
 
+from mobee_drake.experiments.arguments import PositiveFloat, PositiveInt
 from mobee_drake.experiments.arms import RoadmapJob, RoadmapLines
 from mobee_drake.experiments.battery import Job, RunFolder, StopRequested
 from mobee_drake.experiments.ch8_figures import EvaluationSum
@@ -136,6 +137,37 @@ def AdaptiveReachJob(
             other_penetrating_steps=result.other_penetrating_steps,
             wall_seconds=result.wall_seconds,
         )
+    )
+
+
+def AddArguments(reaching) -> None:
+    """The reaching part's options (an argument group of ``adaptive-space``'s parser)."""
+    reaching.add_argument("--strategies", nargs="+", choices=STRATEGIES, default=list(STRATEGIES))
+    reaching.add_argument("--problem-tries", type=PositiveInt, default=1600, help="per run")
+    reaching.add_argument(
+        "--reach-spaces",
+        nargs="+",
+        choices=SPACES,
+        default=list(SPACES),
+        help="the spaces the runs start on: the rank-3 lattice and a roadmap over the valid "
+        f"configurations of at most its {TRM_STATES} states",
+    )
+    reaching.add_argument(
+        "--reach-trm-spacing",
+        type=PositiveFloat,
+        default=0.7,
+        help="the reaching part's trm space: its roadmap's spacing d (fractions of range; 0.7 "
+        "grows 80 vertices on either arm unbounded)",
+    )
+    reaching.add_argument(
+        "--stages", type=PositiveInt, nargs="+", default=[100, 400, 1600], help="evaluated at"
+    )
+    reaching.add_argument("--evaluations", type=PositiveInt, default=5, help="per stage")
+    reaching.add_argument(
+        "--mdp",
+        choices=("continued", "simultaneous"),
+        default="continued",
+        help="the MDP learned first and further with the reaches, or only with them",
     )
 
 
