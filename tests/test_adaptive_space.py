@@ -95,6 +95,36 @@ class TestConfigurationRoadmap(unittest.TestCase):
         self.assertGreaterEqual(gaps[np.triu_indices(12, 1)].min(), 0.3)
 
 
+class TestSpaceHistory(unittest.TestCase):
+    def test_the_history_follows_the_changes_in_order(self):
+        """Three states; a state grown at 100 actions, the second initial state pruned at 200,
+        another grown at 200, the first grown one pruned at 300 (a drop changes no state): two
+        initial states kept, one removed, one added (the state grown and pruned later is
+        neither), each where the palm is at its centre; a pruned state that is not there is
+        refused."""
+        from mobee_drake.experiments.adaptive_space_figures import History, _MarkerPositions
+
+        arm = Arms()["icub"]
+        initial = np.array([[0.25] * 4, [0.5] * 4, [0.75] * 4])
+        grown = [[0.375] * 4, [0.625] * 4]
+        changes = [
+            dict(actions_done=100, rule="grow", states=[3, 0], centre=grown[0]),
+            dict(actions_done=200, rule="prune", states=[1], centre=[0.5] * 4),
+            dict(actions_done=200, rule="drop", states=[0, 2], centre=[]),
+            dict(actions_done=200, rule="grow", states=[3, 2], centre=grown[1]),
+            dict(actions_done=300, rule="prune", states=[2], centre=grown[0]),
+        ]
+        history = History("icub, test", arm, initial, changes)
+        np.testing.assert_array_equal(history.added_at, [0, 0, 0, 100, 200])
+        np.testing.assert_array_equal(history.pruned_at, [np.inf, 200, np.inf, 300, np.inf])
+        palms = _MarkerPositions(arm, [*initial, *grown])
+        np.testing.assert_array_equal(history.kept, palms[[0, 2]])
+        np.testing.assert_array_equal(history.removed, palms[[1]])
+        np.testing.assert_array_equal(history.added, palms[[4]])
+        with self.assertRaisesRegex(ValueError, r"icub, test: pruned state \[0\.1"):
+            History("icub, test", arm, initial, [dict(changes[1], centre=[0.1] * 4)])
+
+
 class TestSmokeBattery(FigureTest):
     def setUp(self):
         self.output = pathlib.Path(tempfile.mkdtemp()) / "adaptive"

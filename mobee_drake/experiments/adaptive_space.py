@@ -374,15 +374,17 @@ def SpaceHistories(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> dict[s
         if condition != "maintained":
             continue
         run = output / "runs" / f"{robot}_{space}_maintained_seed{rs[0].seed}" / "model"
-        final = LoadAgentModel(str(run), AGENT, ExplorerConfig()).space.centres
+        saved = json.loads(((CurrentGeneration(run) or run) / f"{AGENT}.json").read_text())
+        changes = saved.get("maintenance", {}).get("changes", [])
         initial = _InitialCentres(arms[robot], robot, space, output)
-        histories[robot].append(History(f"{robot}, {space}", arms[robot], initial, final))
+        histories[robot].append(History(f"{robot}, {space}", arms[robot], initial, changes))
     return dict(histories)
 
 
 def WriteSpaceFigures(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> list[str]:
-    """``adaptive_space.png`` and, per robot, ``adaptive_space_<robot>.html`` (Meshcat) in
-    ``output``: the spaces of the first seed's maintained runs; their names."""
+    """``adaptive_space.png`` and, per robot, ``adaptive_space_<robot>.html`` (Meshcat, a
+    recording of the spaces as they changed) in ``output``: the spaces of the first seed's
+    maintained runs; their names."""
     histories = SpaceHistories(runs, output)
     if not histories:
         return []
@@ -394,10 +396,14 @@ def WriteSpaceFigures(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> lis
         model = KinematicModel(arms[robot].robot, list(arms[robot].objects), meshcat=meshcat)
         model.Publish(model.home)
         ShowObjects(meshcat, arms[robot].objects)
-        for k, history in enumerate(robot_histories):  # (the first shown; the rest in the tree)
+        meshcat.StartRecording(frames_per_second=10, set_visualizations_while_recording=False)
+        # (the space that changed most is shown; the rest are in the tree)
+        shown = max(robot_histories, key=lambda h: len(h.removed) + len(h.added))
+        for history in robot_histories:
             path = f"spaces/{history.title.split(', ')[1]}"
             ShowSpace(meshcat, history, path)
-            meshcat.SetProperty(path, "visible", k == 0)
+            meshcat.SetProperty(path, "visible", history is shown)
+        meshcat.PublishRecording()
         points = np.vstack([h.kept for h in robot_histories])
         centre = points.mean(axis=0)
         meshcat.SetCameraPose(centre + [-0.9, 0.5, 0.45], centre)
