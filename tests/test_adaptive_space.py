@@ -223,6 +223,18 @@ class TestTheReachLearnersSpace(unittest.TestCase):
             self.assertIn(f"| {robot} | rank3 | greedy | maintained | 2 | 8 |", report)
             self.assertIn(f"{robot} rank3 greedy, maintained minus fixed, summed reward:", report)
             self.assertRegex(report, rf"{robot}: targets of radius .* rank3: a median \d+\.\d cm")
+        # The figures: the first seed's maintained space as it grew, with the arm's targets.
+        histories = adaptive_space.ReachSpaceHistories(runs, output)
+        for robot in ("icub", "katana"):
+            (history,) = histories[robot]
+            (first,) = [
+                r for r in runs if (r.robot, r.condition, r.seed) == (robot, "maintained", 0)
+            ]
+            self.assertEqual(len(history.kept) + len(history.added), first.states)
+            self.assertEqual(len(history.kept), 81)
+            self.assertEqual(len(history.targets), 27)
+            self.assertTrue((output / f"adaptive_space_reaching_{robot}.html").is_file())
+        self.assertIn("adaptive_space_reaching.png", report)
         # The report of the finished runs alone, a third seed's runs not started.
         self._Reaching(output, 3, 8, *arms, "--report-only")
         self.assertFalse(list(output.glob("runs/*seed2")))

@@ -46,16 +46,10 @@ import json
 import pathlib
 
 import numpy as np
-from pydrake.geometry import Meshcat
 
-from mobee_drake.atomic_files import CurrentGeneration, WriteTextAtomically
+from mobee_drake.atomic_files import CurrentGeneration
 from mobee_drake.experiments import adaptive_space_reaching as reaching_part
-from mobee_drake.experiments.adaptive_space_figures import (
-    Figure,
-    History,
-    ShowObjects,
-    ShowSpace,
-)
+from mobee_drake.experiments.adaptive_space_figures import History, WriteSpaceFigures
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
 from mobee_drake.experiments.arms import (
     TARGET_RADIUS,
@@ -80,9 +74,7 @@ from mobee_drake.experiments.ch7_model_learning import ExploreJob, Stop
 from mobee_drake.experiments.ch8_reaching import LEVELS, ReachRobot
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
-from mobee_drake.experiments.plots import SaveFigure
 from mobee_drake.experiments.statistics import PairedBySeed
-from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel, ObservedOutcomes
 from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
@@ -381,37 +373,6 @@ def SpaceHistories(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> dict[s
     return dict(histories)
 
 
-def WriteSpaceFigures(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> list[str]:
-    """``adaptive_space.png`` and, per robot, ``adaptive_space_<robot>.html`` (Meshcat, a
-    recording of the spaces as they changed) in ``output``: the spaces of the first seed's
-    maintained runs; their names."""
-    histories = SpaceHistories(runs, output)
-    if not histories:
-        return []
-    written = ["adaptive_space.png"]
-    SaveFigure(Figure([h for hs in histories.values() for h in hs]), output / written[0])
-    arms = Arms()
-    for robot, robot_histories in histories.items():
-        meshcat = Meshcat()
-        model = KinematicModel(arms[robot].robot, list(arms[robot].objects), meshcat=meshcat)
-        model.Publish(model.home)
-        ShowObjects(meshcat, arms[robot].objects)
-        meshcat.StartRecording(frames_per_second=10, set_visualizations_while_recording=False)
-        # (the space that changed most is shown; the rest are in the tree)
-        shown = max(robot_histories, key=lambda h: len(h.removed) + len(h.added))
-        for history in robot_histories:
-            path = f"spaces/{history.title.split(', ')[1]}"
-            ShowSpace(meshcat, history, path)
-            meshcat.SetProperty(path, "visible", history is shown)
-        meshcat.PublishRecording()
-        points = np.vstack([h.kept for h in robot_histories])
-        centre = points.mean(axis=0)
-        meshcat.SetCameraPose(centre + [-0.9, 0.5, 0.45], centre)
-        written.append(f"adaptive_space_{robot}.html")
-        WriteTextAtomically(output / written[-1], meshcat.StaticHtml())
-    return written
-
-
 def _Results(args, jobs: list[Job], output: pathlib.Path, description: str) -> dict[str, dict]:
     """The jobs' results: those missing run first, or with ``--report-only`` the finished ones
     alone."""
@@ -460,7 +421,7 @@ def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Pat
     results = _Results(args, jobs, output, "adaptive space")
     runs = [AdaptiveSpaceRun(**r) for r in results.values()]
     with OwnedFolder(output, "battery"):
-        figures = WriteSpaceFigures(runs, output)
+        figures = WriteSpaceFigures(SpaceHistories(runs, output), output, "adaptive_space")
     report = Report(runs, built, command)
     if figures:
         report += f"\n\nFigures (the first seed's maintained runs): {', '.join(figures)}."
@@ -484,7 +445,40 @@ def _ReachingReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, 
             centres = _ReachCentres(arms[robot], robot, space, output)
             if centres is not None:
                 targets[robot][1][space] = TargetGaps(arms[robot], centres)
-    return reaching_part.Report(runs, command, targets, roadmaps)
+    report = reaching_part.Report(runs, command, targets, roadmaps)
+    with OwnedFolder(output, "battery"):
+        histories = ReachSpaceHistories(runs, output)
+        figures = WriteSpaceFigures(histories, output, "adaptive_space_reaching")
+    if figures:
+        report += (
+            "\n\nFigures (each space's first seed's maintained run, of the intrinsic strategy "
+            f"where it ran): {', '.join(figures)}."
+        )
+    return report
+
+
+def ReachSpaceHistories(runs: list, output: pathlib.Path) -> dict[str, list]:
+    """Per robot, the history of each space's first seed's maintained run of the intrinsic
+    strategy (where it ran; of the first strategy else), with the arm's targets."""
+    arms, histories = Arms(), collections.defaultdict(list)
+    maintained = collections.defaultdict(list)
+    for r in runs:
+        if r.condition == "maintained":
+            maintained[(r.robot, r.space)].append(r)
+    for (robot, space), rs in sorted(maintained.items()):
+        strategies = sorted({r.strategy for r in rs})
+        strategy = "intrinsic" if "intrinsic" in strategies else strategies[0]
+        seed = min(r.seed for r in rs if r.strategy == strategy)
+        name = reaching_part.RunName(robot, space, strategy, "maintained", seed)
+        folder = output / "runs" / name / "checkpoint"
+        saved = json.loads((CurrentGeneration(folder) / "learner.json").read_text())
+        initial = _ReachCentres(arms[robot], robot, space, output)
+        title = f"{robot}, {space}, {strategy}"
+        changes = saved["maintenance"]["changes"]
+        histories[robot].append(
+            History(title, arms[robot], initial, changes, ReachTargets(arms[robot]))
+        )
+    return dict(histories)
 
 
 def _ReachCentres(arm: Arm, robot: str, space: str, output: pathlib.Path):

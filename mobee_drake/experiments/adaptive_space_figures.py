@@ -7,26 +7,31 @@ added; the Meshcat scene is a recording of the space as it changed, round by rou
 """
 
 import dataclasses as dc
+import pathlib
 
 import matplotlib.pyplot as plt
 import numpy as np
 from pydrake.geometry import Meshcat, Rgba, Sphere
 from pydrake.math import RigidTransform
 
-from mobee_drake.experiments.plots import Legend
+from mobee_drake.atomic_files import WriteTextAtomically
+from mobee_drake.experiments.arms import Arms
+from mobee_drake.experiments.plots import Legend, SaveFigure
 from mobee_drake.ngik.kinematic_model import KinematicModel
-from mobee_drake.world.live_world import MakeShape, ObjectPose
+from mobee_drake.world.live_world import ROLE_COLORS, MakeShape, ObjectPose
 
 # The colours of the kept, removed and added states.
-KEPT, REMOVED, ADDED = "tab:blue", "tab:red", "tab:green"
+KEPT, REMOVED, ADDED, TARGET = "tab:blue", "tab:red", "tab:purple", "0.35"
 
 
-# The Meshcat recording's pace: actions (100, one round at the default period) per second.
-ACTIONS_PER_SECOND = 100.0
+# The Meshcat recording's pace: the maintenance's steps (actions; the reach learner's
+# problem-tries) per second, one round at the default period.
+STEPS_PER_SECOND = 100.0
 # A state's sphere in the Meshcat scene (m).
 STATE_RADIUS = 0.006
 _RGBA = {"kept": Rgba(0.12, 0.47, 0.71, 1), "removed": Rgba(0.84, 0.15, 0.16, 1)}
-_RGBA["added"] = Rgba(0.17, 0.63, 0.17, 1)
+_RGBA["added"] = Rgba(0.58, 0.40, 0.74, 1)  # (targets are green, as in the viewer)
+_RGBA["target"] = Rgba(*ROLE_COLORS["target"][:3], 0.25)
 
 
 @dc.dataclass
@@ -38,6 +43,9 @@ class SpaceHistory:
     points: np.ndarray  # (s, 3): the initial space's states first, then those added, in order
     added_at: np.ndarray  # (s,): 0 for the initial space's
     pruned_at: np.ndarray  # (s,): inf for a state never pruned
+    # The reach targets (k, 3) and their radius (m), for the reach learner's space.
+    targets: np.ndarray = dc.field(default_factory=lambda: np.zeros((0, 3)))
+    target_radius: float = 0.0
 
     @property
     def kept(self) -> np.ndarray:
@@ -55,10 +63,13 @@ class SpaceHistory:
         return self.points[(self.added_at > 0) & np.isinf(self.pruned_at)]
 
 
-def History(title: str, arm, initial: np.ndarray, changes: list[dict]) -> SpaceHistory:
+def History(
+    title: str, arm, initial: np.ndarray, changes: list[dict], targets=None
+) -> SpaceHistory:
     """The history of a space that began with centres ``initial`` (fractions of ``arm``'s joints'
     ranges) and changed by ``changes`` (a maintenance's, in order: each its ``actions_done``,
-    ``rule`` and, for a pruned or new state, its ``centre``).
+    ``rule`` and, for a pruned or new state, its ``centre``), with the reach learner's
+    ``targets`` (a :class:`~mobee_drake.reaching.targets.TargetGrid`), if given.
 
     Raises:
         ValueError: if a pruned state's centre is none of the space's states then.
@@ -76,9 +87,12 @@ def History(title: str, arm, initial: np.ndarray, changes: list[dict]) -> SpaceH
             centres.append(np.asarray(change["centre"], dtype=float))
             added_at.append(change["actions_done"])
             pruned_at.append(np.inf)
-    return SpaceHistory(
+    history = SpaceHistory(
         title, _MarkerPositions(arm, centres), np.array(added_at), np.array(pruned_at)
     )
+    if targets is not None:
+        history.targets, history.target_radius = targets.Centres(), targets.radius
+    return history
 
 
 def _MarkerPositions(arm, centres) -> np.ndarray:
@@ -113,10 +127,15 @@ def Figure(histories: list[SpaceHistory]):
                 axis.scatter(
                     *history.added[:, [i, j]].T, s=14, color=ADDED, label="added",
                 )  # fmt: skip
+            if len(history.targets):
+                axis.scatter(
+                    *history.targets[:, [i, j]].T, s=40, marker="+", color=TARGET,
+                    label="target centres",
+                )  # fmt: skip
             axis.set(
                 xlabel=f"{'xyz'[i]} [m]",
                 ylabel=f"{'xyz'[j]} [m]",
-                title=f"{history.title}, {name}: {len(history.kept)} kept, "
+                title=f"{history.title}, {name}:\n{len(history.kept)} kept, "
                 f"{len(history.removed)} removed, {len(history.added)} added",
                 aspect="equal",
             )
@@ -127,8 +146,8 @@ def Figure(histories: list[SpaceHistory]):
 
 def ShowSpace(meshcat: Meshcat, history: SpaceHistory, path: str) -> None:
     """Draws a space's states under ``path`` as it changed, in the recording under way (one
-    second per :data:`ACTIONS_PER_SECOND` actions): the initial space's states blue, those added
-    green from when they were added, a pruned state red from when it was pruned; shown live as
+    second per :data:`STEPS_PER_SECOND` steps): the initial space's states blue, those added
+    purple from when they were added, a pruned state red from when it was pruned; shown live as
     at the end."""
     for i, (point, added_at, pruned_at) in enumerate(
         zip(history.points, history.added_at, history.pruned_at)
@@ -138,13 +157,13 @@ def ShowSpace(meshcat: Meshcat, history: SpaceHistory, path: str) -> None:
         meshcat.SetTransform(node, RigidTransform(point))
         meshcat.SetProperty(node, "visible", added_at == 0, 0.0)
         if added_at > 0:
-            meshcat.SetProperty(node, "visible", True, added_at / ACTIONS_PER_SECOND)
+            meshcat.SetProperty(node, "visible", True, added_at / STEPS_PER_SECOND)
         if np.isfinite(pruned_at):
-            meshcat.SetProperty(node, "visible", False, pruned_at / ACTIONS_PER_SECOND)
+            meshcat.SetProperty(node, "visible", False, pruned_at / STEPS_PER_SECOND)
             meshcat.SetObject(f"{node}_pruned", Sphere(STATE_RADIUS), _RGBA["removed"])
             meshcat.SetTransform(f"{node}_pruned", RigidTransform(point))
             meshcat.SetProperty(f"{node}_pruned", "visible", False, 0.0)
-            meshcat.SetProperty(f"{node}_pruned", "visible", True, pruned_at / ACTIONS_PER_SECOND)
+            meshcat.SetProperty(f"{node}_pruned", "visible", True, pruned_at / STEPS_PER_SECOND)
         meshcat.SetProperty(node, "visible", bool(np.isinf(pruned_at)))  # (live: the end)
 
 
@@ -153,3 +172,38 @@ def ShowObjects(meshcat: Meshcat, objects, path: str = "objects") -> None:
     for obj in objects:
         meshcat.SetObject(f"{path}/{obj.name}", MakeShape(obj.shape), Rgba(0.5, 0.5, 0.5, 0.5))
         meshcat.SetTransform(f"{path}/{obj.name}", ObjectPose(obj.position, obj.rpy_deg))
+
+
+def WriteSpaceFigures(
+    histories: dict[str, list[SpaceHistory]], output: pathlib.Path, stem: str
+) -> list[str]:
+    """``<stem>.png`` and, per robot, ``<stem>_<robot>.html`` (Meshcat, with the robot at home,
+    its world's objects and the reach targets: a recording of its spaces as they changed) in
+    ``output``, of ``histories`` (per robot, its spaces' histories, titled "<robot>, <space>" or
+    "<robot>, <space>, <strategy>"); their names."""
+    if not histories:
+        return []
+    written = [f"{stem}.png"]
+    SaveFigure(Figure([h for hs in histories.values() for h in hs]), output / written[0])
+    arms = Arms()
+    for robot, robot_histories in histories.items():
+        meshcat = Meshcat()
+        model = KinematicModel(arms[robot].robot, list(arms[robot].objects), meshcat=meshcat)
+        model.Publish(model.home)
+        ShowObjects(meshcat, arms[robot].objects)
+        meshcat.StartRecording(frames_per_second=10, set_visualizations_while_recording=False)
+        # (the space that changed most is shown; the rest are in the tree)
+        shown = max(robot_histories, key=lambda h: len(h.removed) + len(h.added))
+        for history in robot_histories:
+            path = "spaces/" + "/".join(history.title.split(", ")[1:])
+            ShowSpace(meshcat, history, path)
+            meshcat.SetProperty(path, "visible", history is shown)
+        meshcat.PublishRecording()
+        for k, centre in enumerate(shown.targets):
+            meshcat.SetObject(f"targets/{k}", Sphere(shown.target_radius), _RGBA["target"])
+            meshcat.SetTransform(f"targets/{k}", RigidTransform(centre))
+        centre = np.vstack([h.kept for h in robot_histories]).mean(axis=0)
+        meshcat.SetCameraPose(centre + [-0.9, 0.5, 0.45], centre)
+        written.append(f"{stem}_{robot}.html")
+        WriteTextAtomically(output / written[-1], meshcat.StaticHtml())
+    return written

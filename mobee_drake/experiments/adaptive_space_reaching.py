@@ -199,15 +199,21 @@ def Stages(args, maintenance: MaintenanceConfig) -> list[tuple[str, list[Job]]]:
     return [(description, jobs) for description, jobs in stages if jobs]
 
 
+def RunName(robot: str, space: str, strategy: str, condition: str, seed: int) -> str:
+    """A run's job (and folder) name: the iCub's and the lattice's are left out of it (the
+    battery's first runs were theirs)."""
+    parts = ["reach"] + [robot] * (robot != "icub") + [space] * (space != "rank3")
+    return "_".join([*parts, strategy, condition, f"seed{seed}"])
+
+
 def _RunJobs(args, maintenance: MaintenanceConfig, robot: str, space: str) -> list[Job]:
     stages = sorted({*args.stages, args.problem_tries})
-    prefix = "reach" if robot == "icub" else f"reach_{robot}"
     named = {} if robot == "icub" else dict(robot=robot)
     if space != "rank3":
-        prefix, named = f"{prefix}_{space}", named | dict(space=space)
+        named |= dict(space=space)
     return [
         Job(
-            f"{prefix}_{strategy}_{condition}_seed{seed}",
+            RunName(robot, space, strategy, condition, seed),
             AdaptiveReachJob,
             dict(
                 strategy=strategy,
