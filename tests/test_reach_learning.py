@@ -231,6 +231,37 @@ class TestBattery(unittest.TestCase):
         robot.Transition(goal)
         self.assertTrue(robot.FeltObject())
 
+    def test_a_reach_ends_its_problem_and_takes_the_target_away(self):
+        """A target where the palm is at a neighbour state, clear of the resting arm: the robot
+        settles there beside it, and the reach lets the palm into it and brings it back to the
+        state's centre, inside it. The problem-try is then over and the target gone, so the
+        move after it has nothing to push the palm out of (it took 6 penetrating periods when
+        the target stayed); the next problem's target appears anew."""
+        from mobee_drake.experiments.ch8_reaching import ReachRobot
+        from mobee_drake.reaching.targets import TARGET_NAME
+        from mobee_drake.station.safety import Penetrations
+
+        space = self.model.space
+        robot = ReachRobot(space, 0.05)
+        start = robot.State()
+        neighbour = int(space.action_goal[space.Actions(start)[3]])
+        robot.SetProblem(np.array([1.0, 1.0, 1.0]))  # far away
+        self.assertEqual(robot.Transition(neighbour), neighbour)
+        palm = robot.MarkerPosition()
+        self.assertEqual(robot.Transition(start), start)
+        robot.SetProblem(palm)
+        self.assertFalse(Penetrations(robot.station.diagram, robot.context))
+        self.assertEqual(robot.Transition(neighbour), neighbour)
+        robot.Reach(palm)
+        world = robot.station.world
+        self.assertNotIn(TARGET_NAME, world.Names(robot.context))
+        self.assertIsNone(robot.target)
+        before = robot.Safety().penetrating_steps
+        self.assertEqual(robot.Transition(start), start)
+        self.assertEqual(robot.Safety().penetrating_steps, before)
+        robot.SetProblem(palm)
+        self.assertIn(TARGET_NAME, world.Names(robot.context))
+
     def test_the_learning_frame_follows_the_shoulder(self):
         """With the torso at home a target is where it is; with the torso turned by theta about
         its yaw axis, the learner sees it turned back by theta about that axis (closed form),

@@ -4,9 +4,12 @@ The target's role (ch. 8.1 footnote 2: a target is an obstacle until the reach t
 target sphere is an obstacle of MoBeE's world (``SetProblem``); during a reach, and only then, a
 transient collision filter excludes the pairs of the hand (the reaching marker's body and every
 body beyond it: the iCub's hand has none, the Katana's wrist carries its fingers) and the
-target, so the palm may touch and enter it while the rest of the arm is still kept out; the
-filter is removed when the reach has ended (settled back at its state's centre). A transition
-therefore must go around the target, and fails when it cannot.
+target, so the palm may touch and enter it while the rest of the arm is still kept out. A reach
+ends its problem-try: when it has ended (settled back at its state's centre) the filter and the
+target go, so that nothing the robot does before the next problem (an evaluation's walk to its
+start state) has to push the hand out of a target it was let into; the next problem's target
+appears with ``SetProblem``. A transition therefore must go around the target, and fails when it
+cannot.
 """
 
 import numpy as np
@@ -88,7 +91,7 @@ class SimulatedRobot:
         marker = self.executor.marker_name
         hand_body = [m.body_name for m in station.robot.markers if m.name == marker][0]
         self._marker = mobee.marker_index(marker)
-        # The current problem's target (None before the first problem).
+        # The current problem's target (None before the first problem and after a reach).
         self.target: np.ndarray | None = None
         # The shoulder's frame, and where it stands with every joint at home (a scratch plant
         # context: the station's plant is not simulated).
@@ -162,6 +165,8 @@ class SimulatedRobot:
         self.executor.StartReach(self._executor_context, self._Centre(self.State()), target)
         self._Finish()
         filters.RemoveDeclaration(touch)
+        self.station.world.Remove(self.context, TARGET_NAME)  # (the problem-try is over)
+        self.target = None
         return self.executor.ReachedPosition(self._executor_context)
 
     def FeltObject(self) -> bool:
