@@ -269,6 +269,29 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         self.assertRegex(report, r"icub: targets of .* trm: a median \d+\.\d cm")
         self.assertNotIn("rank3:", report)
 
+    def test_an_mdp_learned_on_a_roadmap_has_its_space(self):
+        """A roadmap of spacing 1.5 (a few states) and the MDP learned on it until every
+        state-action was tried once: the model's states are the roadmap's vertices, its
+        transitions the roadmap's edges both ways."""
+        from mobee_drake.experiments.arms import RoadmapJob, RoadmapSpace
+        from mobee_drake.experiments.battery import RunFolder
+        from mobee_drake.experiments.ch8_reaching import AGENT, MdpJob, MdpName
+        from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
+
+        for name in ("icub_roadmap", "mdp"):
+            (self.output / name).mkdir()
+        built = RoadmapJob(
+            RunFolder(self.output / "icub_roadmap"), robot="icub", spacing=1.5, max_vertices=81
+        )
+        learned = MdpJob(RunFolder(self.output / "mdp"), 1, roadmap_job="icub_roadmap")
+        self.assertEqual(learned["min_tries"], 1)
+        model = LoadAgentModel(str(self.output / "mdp" / "model"), AGENT, ExplorerConfig())
+        space = RoadmapSpace(Arms()["icub"], self.output / "icub_roadmap" / "roadmap")
+        self.assertEqual(len(space.centres), built["vertices"])
+        np.testing.assert_array_equal(model.space.centres, space.centres)
+        self.assertEqual(len(model.space.action_goal), 2 * built["edges"])
+        self.assertEqual(MdpName(5, robot="katana", space="trm"), "katana_mdp_tries5_trm")
+
     def test_the_report_compares_the_roadmap_with_the_lattice(self):
         """Constructed runs: trm's fixed runs reach 1.5 more than the lattice's, seed by seed
         (0.5 apart from seed to seed), and take 0.25 robot hours less."""
