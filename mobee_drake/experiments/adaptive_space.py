@@ -56,7 +56,9 @@ from mobee_drake.experiments.arms import (
     Arm,
     Arms,
     ReachTargets,
+    RoadmapFolder,
     RoadmapJob,
+    RoadmapJobName,
     RoadmapLines,
     RoadmapSpace,
     TargetGaps,
@@ -71,7 +73,7 @@ from mobee_drake.experiments.battery import (
     RunFolder,
 )
 from mobee_drake.experiments.ch7_model_learning import ExploreJob, Stop
-from mobee_drake.experiments.ch8_reaching import LEVELS, ReachRobot
+from mobee_drake.experiments.ch8_reaching import ReachRobot
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
 from mobee_drake.experiments.statistics import PairedBySeed
@@ -81,11 +83,11 @@ from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import ExploringAgent
 
-# The lattices compared: their levels (fractions of each joint's range); and "trm", a roadmap
-# over the valid configurations (mobee_drake.trm.configuration), built once per battery.
+# The lattices compared: their levels (fractions of each joint's range; rank3 is ch. 8's); and
+# "trm", a roadmap over the valid configurations (mobee_drake.trm.configuration), built once per
+# battery.
 LATTICES = {"rank4": [0.125, 0.375, 0.625, 0.875], "rank3": [0.25, 0.5, 0.75]}
 SPACES = (*LATTICES, "trm")
-ROADMAP_JOB = "roadmap"
 CONDITIONS = ("fixed", "maintained")
 AGENT = "right_arm"
 
@@ -157,7 +159,7 @@ def AdaptiveSpaceJob(
     if space in LATTICES:
         agent.levels = LATTICES[space]
     else:
-        agent.roadmap = str(run.path.parent / f"{robot}_{ROADMAP_JOB}" / "roadmap")
+        agent.roadmap = str(RoadmapFolder(run.path.parent, robot))
     explored = ExplorationRun.FromJson(
         ExploreJob(
             run,
@@ -356,7 +358,7 @@ def _InitialCentres(arm: Arm, robot: str, space: str, output: pathlib.Path) -> n
     """The centres a run's space began with (fractions of range)."""
     if space in LATTICES:
         return Lattice(LATTICES[space], len(arm.joints)).centres
-    return RoadmapSpace(arm, output / "runs" / f"{robot}_{ROADMAP_JOB}" / "roadmap").centres
+    return RoadmapSpace(arm, RoadmapFolder(output / "runs", robot)).centres
 
 
 def SpaceHistories(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> dict[str, list]:
@@ -367,7 +369,7 @@ def SpaceHistories(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> dict[s
             continue
         run = output / "runs" / f"{robot}_{space}_maintained_seed{rs[0].seed}" / "model"
         saved = json.loads(((CurrentGeneration(run) or run) / f"{AGENT}.json").read_text())
-        changes = saved.get("maintenance", {}).get("changes", [])
+        changes = saved["maintenance"]["changes"]
         initial = _InitialCentres(arms[robot], robot, space, output)
         histories[robot].append(History(f"{robot}, {space}", arms[robot], initial, changes))
     return dict(histories)
@@ -388,7 +390,7 @@ def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Pat
     if "trm" in args.spaces:  # (the roadmaps first: the trm runs read them)
         roadmaps = [
             Job(
-                f"{robot}_{ROADMAP_JOB}",
+                RoadmapJobName(robot),
                 RoadmapJob,
                 dict(robot=robot, spacing=args.trm_spacing, max_vertices=args.trm_states),
                 total=args.trm_states,
@@ -396,7 +398,7 @@ def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Pat
             for robot in args.robots
         ]
         built = _Results(args, roadmaps, output, "trm spaces")
-        built = {name.removesuffix(f"_{ROADMAP_JOB}"): r for name, r in built.items()}
+        built = {r: built[RoadmapJobName(r)] for r in args.robots if RoadmapJobName(r) in built}
     jobs = [
         Job(
             f"{robot}_{space}_{condition}_seed{seed}",
@@ -436,8 +438,7 @@ def _ReachingReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, 
     runs = [
         reaching_part.AdaptiveReachRun(**r) for n, r in results.items() if n.startswith("reach_")
     ]
-    suffix = f"_{reaching_part.ROADMAP_JOB}"
-    roadmaps = {n.removesuffix(suffix): r for n, r in results.items() if n.endswith(suffix)}
+    roadmaps = {r: results[RoadmapJobName(r)] for r in args.robots if RoadmapJobName(r) in results}
     arms, targets = Arms(), {}
     for robot in args.robots:
         targets[robot] = (ReachTargets(arms[robot]), {})
@@ -482,12 +483,10 @@ def ReachSpaceHistories(runs: list, output: pathlib.Path) -> dict[str, list]:
 
 
 def _ReachCentres(arm: Arm, robot: str, space: str, output: pathlib.Path):
-    """The centres the reaching part's ``space`` begins with (fractions of range); None for a
-    roadmap not yet built."""
-    if space == "rank3":
-        return Lattice(LEVELS, len(arm.joints)).centres
-    folder = output / "runs" / f"{robot}_{reaching_part.ROADMAP_JOB}" / "roadmap"
-    return RoadmapSpace(arm, folder).centres if folder.is_dir() else None
+    """The centres the reaching part's ``space`` begins with (fractions of range; its rank-3
+    lattice is ch. 8's); None for a roadmap not yet built."""
+    built = RoadmapFolder(output / "runs", robot).is_dir()
+    return _InitialCentres(arm, robot, space, output) if space in LATTICES or built else None
 
 
 def main(argv: list[str] | None = None) -> None:

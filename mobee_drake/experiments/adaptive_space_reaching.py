@@ -29,7 +29,7 @@ import dataclasses as dc
 import numpy as np
 
 from mobee_drake.experiments.arguments import PositiveFloat, PositiveInt
-from mobee_drake.experiments.arms import RoadmapJob, RoadmapLines
+from mobee_drake.experiments.arms import RoadmapFolder, RoadmapJob, RoadmapJobName, RoadmapLines
 from mobee_drake.experiments.battery import Job, RunFolder, StopRequested
 from mobee_drake.experiments.ch8_figures import EvaluationSum
 from mobee_drake.experiments.ch8_measures import PENETRATION_HEADER, PenetrationCell
@@ -50,10 +50,9 @@ CONDITIONS = ("fixed", "maintained")
 MDP_TRIES = 5
 # The spaces a run starts on: ch. 8's rank-3 lattice, and "trm", a roadmap over the arm's valid
 # configurations with at most the lattice's number of states (built by the battery's job
-# ``<robot>_roadmap``; mobee_drake.trm.configuration).
+# arms.RoadmapJobName(robot); mobee_drake.trm.configuration).
 SPACES = ("rank3", "trm")
 TRM_STATES = len(Lattice(LEVELS, 4).centres)
-ROADMAP_JOB = "roadmap"
 
 
 @dc.dataclass
@@ -105,9 +104,7 @@ def AdaptiveReachJob(
             should_stop=StopRequested,
             maintenance=maintenance if condition == "maintained" else None,
             robot=robot,
-            roadmap=str(run.path.parent / f"{robot}_{ROADMAP_JOB}" / "roadmap")
-            if space == "trm"
-            else "",
+            roadmap=str(RoadmapFolder(run.path.parent, robot)) if space == "trm" else "",
         )
     )
     stage = max(result.evaluations)
@@ -181,7 +178,7 @@ def Stages(args, maintenance: MaintenanceConfig) -> list[tuple[str, list[Job]]]:
         if "trm" in args.reach_spaces:
             roadmaps.append(
                 Job(
-                    f"{robot}_{ROADMAP_JOB}",
+                    RoadmapJobName(robot),
                     RoadmapJob,
                     dict(robot=robot, spacing=args.reach_trm_spacing, max_vertices=TRM_STATES),
                     total=TRM_STATES,
@@ -191,7 +188,7 @@ def Stages(args, maintenance: MaintenanceConfig) -> list[tuple[str, list[Job]]]:
             if args.mdp != "simultaneous":
                 mdp = dict(min_tries=MDP_TRIES) | ({} if robot == "icub" else dict(robot=robot))
                 if space == "trm":
-                    mdp["roadmap_job"] = f"{robot}_{ROADMAP_JOB}"
+                    mdp["roadmap_job"] = RoadmapJobName(robot)
                 name = MdpName(MDP_TRIES, robot=robot, space=space)
                 mdps.append(Job(name, MdpJob, mdp))
             runs += _RunJobs(args, maintenance, robot, space)

@@ -124,6 +124,16 @@ def ReachTargets(arm: Arm) -> TargetGrid:
     return TargetGrid(radius=TARGET_RADIUS, x=x, y=y, z=z)
 
 
+def RoadmapJobName(robot: str) -> str:
+    """The battery job that builds ``robot``'s roadmap (:func:`RoadmapJob`)."""
+    return f"{robot}_roadmap"
+
+
+def RoadmapFolder(runs: pathlib.Path, robot: str) -> pathlib.Path:
+    """Where the battery whose runs are in ``runs`` keeps ``robot``'s roadmap."""
+    return runs / RoadmapJobName(robot) / "roadmap"
+
+
 def RoadmapJob(run: RunFolder, *, robot: str, spacing: float, max_vertices: int) -> dict:
     """The battery job that builds a roadmap over ``robot``'s valid configurations
     (:func:`~mobee_drake.trm.configuration.BuildConfigurationRoadmap`, in ``run.path /
