@@ -283,7 +283,7 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         built = RoadmapJob(
             RunFolder(self.output / "icub_roadmap"), robot="icub", spacing=1.5, max_vertices=81
         )
-        learned = MdpJob(RunFolder(self.output / "mdp"), 1, roadmap_job="icub_roadmap")
+        learned = MdpJob(RunFolder(self.output / "mdp"), 1, space="trm")
         self.assertEqual(learned["min_tries"], 1)
         model = LoadAgentModel(str(self.output / "mdp" / "model"), AGENT, ExplorerConfig())
         space = RoadmapSpace(Arms()["icub"], self.output / "icub_roadmap" / "roadmap")

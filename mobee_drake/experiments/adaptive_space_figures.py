@@ -22,8 +22,6 @@ from mobee_drake.world.live_world import ROLE_COLORS, MakeShape, ObjectPose
 
 # The colours of the kept, removed and added states.
 KEPT, REMOVED, ADDED, TARGET = "tab:blue", "tab:red", "tab:purple", "0.35"
-
-
 # The Meshcat recording's pace: the maintenance's steps (actions; the reach learner's
 # problem-tries) per second, one round at the default period.
 STEPS_PER_SECOND = 100.0
@@ -37,7 +35,8 @@ _RGBA["target"] = Rgba(*ROLE_COLORS["target"][:3], 0.25)
 @dc.dataclass
 class SpaceHistory:
     """One maintained run's space as it changed: every state it ever had, where the marker is at
-    its centre (m, world), and when (actions done) it was added and pruned."""
+    its centre (m, world), and when (the maintenance's steps done: actions, or the reach
+    learner's problem-tries) it was added and pruned."""
 
     title: str
     points: np.ndarray  # (s, 3): the initial space's states first, then those added, in order
@@ -202,7 +201,7 @@ def WriteSpaceFigures(
         for k, centre in enumerate(shown.targets):
             meshcat.SetObject(f"targets/{k}", Sphere(shown.target_radius), _RGBA["target"])
             meshcat.SetTransform(f"targets/{k}", RigidTransform(centre))
-        centre = np.vstack([h.kept for h in robot_histories]).mean(axis=0)
+        centre = np.vstack([h.points for h in robot_histories]).mean(axis=0)
         meshcat.SetCameraPose(centre + [-0.9, 0.5, 0.45], centre)
         written.append(f"{stem}_{robot}.html")
         WriteTextAtomically(output / written[-1], meshcat.StaticHtml())

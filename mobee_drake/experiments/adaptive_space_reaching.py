@@ -187,8 +187,8 @@ def Stages(args, maintenance: MaintenanceConfig) -> list[tuple[str, list[Job]]]:
         for space in args.reach_spaces:
             if args.mdp != "simultaneous":
                 mdp = dict(min_tries=MDP_TRIES) | ({} if robot == "icub" else dict(robot=robot))
-                if space == "trm":
-                    mdp["roadmap_job"] = RoadmapJobName(robot)
+                if space != "rank3":
+                    mdp["space"] = space
                 name = MdpName(MDP_TRIES, robot=robot, space=space)
                 mdps.append(Job(name, MdpJob, mdp))
             runs += _RunJobs(args, maintenance, robot, space)

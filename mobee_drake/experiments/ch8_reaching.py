@@ -60,7 +60,7 @@ from mobee_drake.atomic_files import (
     StrictJson,
     WriteGeneration,
 )
-from mobee_drake.experiments.arms import Arms, ReachTargets, RoadmapSpace
+from mobee_drake.experiments.arms import Arms, ReachTargets, RoadmapFolder, RoadmapSpace
 from mobee_drake.experiments.battery import (
     Backend,
     Job,
@@ -150,11 +150,12 @@ def MdpJob(
     seed: int = 0,
     transition_noise: float = 0.0,
     robot: str = "icub",
-    roadmap_job: str = "",
+    space: str = "rank3",
 ) -> dict:
-    """The battery job that learns the MDP (in ``run.path / "model"``), on the space of the
-    roadmap built by the battery's job ``roadmap_job`` (in its folder's ``roadmap``), if given."""
-    roadmap = str(run.path.parent / roadmap_job / "roadmap") if roadmap_job else ""
+    """The battery job that learns the MDP (in ``run.path / "model"``) of the rank-3 lattice or,
+    with ``space="trm"``, of the space of the battery's roadmap of ``robot`` (where
+    ``arms.RoadmapFolder`` puts it)."""
+    roadmap = str(RoadmapFolder(run.path.parent, robot)) if space == "trm" else ""
     model = TrainMdp(
         run.path / "model",
         min_tries,
