@@ -1,5 +1,6 @@
 """Tests of the watch for targets that appear inside the robot (reaching/appearance.py), on a
-stand-in robot whose penetrations the test sets; test_reach_learning runs it on the iCub."""
+stand-in robot whose penetrations the test sets (test_reach_learning runs it on the iCub), and
+of the reports' cell of its split."""
 
 import dataclasses as dc
 import types
@@ -55,6 +56,19 @@ class AppearanceWatchTest(unittest.TestCase):
         self.assertEqual(watched.counts.other_penetrating_steps, 5 + 2 + 1)
         self.assertEqual(robot.target, "outside")
         self.assertEqual(watched.State(), 7)  # (the rest of the robot, unwatched)
+
+    def test_a_reports_cell_sums_the_split_or_says_it_is_unknown(self):
+        """Two runs' periods summed: all / the other problems' (problems whose target appeared
+        inside); a run from before the count makes the split unknown."""
+        from mobee_drake.experiments.ch8_measures import PenetrationCell
+
+        def Run(total, other, inside):
+            return types.SimpleNamespace(
+                penetrating_steps=total, other_penetrating_steps=other, appeared_inside=inside
+            )
+
+        self.assertEqual(PenetrationCell([Run(10, 2, 3), Run(5, 0, 1)]), "15 / 2 (4)")
+        self.assertEqual(PenetrationCell([Run(10, 2, 3), Run(5, None, None)]), "15 / - (-)")
 
 
 if __name__ == "__main__":
