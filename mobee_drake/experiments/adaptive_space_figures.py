@@ -167,9 +167,11 @@ def ShowSpace(meshcat: Meshcat, history: SpaceHistory, path: str) -> None:
 
 
 def ShowObjects(meshcat: Meshcat, objects, path: str = "objects") -> None:
-    """Draws the world's ``objects`` (SceneObjects), translucent grey, under ``path``."""
+    """Draws the world's ``objects`` (SceneObjects) under ``path`` in their role's colour, as the
+    viewer does, but translucent (the states behind them stay visible)."""
     for obj in objects:
-        meshcat.SetObject(f"{path}/{obj.name}", MakeShape(obj.shape), Rgba(0.5, 0.5, 0.5, 0.5))
+        rgba = Rgba(*ROLE_COLORS[obj.role][:3], 0.5)
+        meshcat.SetObject(f"{path}/{obj.name}", MakeShape(obj.shape), rgba)
         meshcat.SetTransform(f"{path}/{obj.name}", ObjectPose(obj.position, obj.rpy_deg))
 
 
