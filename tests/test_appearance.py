@@ -56,6 +56,9 @@ class AppearanceWatchTest(unittest.TestCase):
         self.assertEqual(watched.counts.other_penetrating_steps, 5 + 2 + 1)
         self.assertEqual(robot.target, "outside")
         self.assertEqual(watched.State(), 7)  # (the rest of the robot, unwatched)
+        watched.space = "reshaped"  # (a space keeper sets the robot's space through the watch)
+        self.assertEqual(robot.space, "reshaped")
+        self.assertNotIn("space", vars(watched))
 
     def test_a_reports_cell_sums_the_split_or_says_it_is_unknown(self):
         """Two runs' periods summed: all / the other problems' (problems whose target appeared

@@ -323,8 +323,8 @@ class TestBattery(unittest.TestCase):
         np.testing.assert_allclose(np.linalg.norm(moved, axis=1), 0.1)
         # A target that appears where the palm is is counted as appearing inside the robot, and
         # its problem's penetrating periods are not counted among the others'.
-        # (A watch resumed from its counts goes on counting: the far target's problem is the
-        # resumed watch's, and its transition's penetrations are the other problems'.)
+        # (The pushing out is the first problem's; a watch resumed from its counts goes on
+        # counting: the far target's problem is the resumed watch's.)
         watched = AppearanceWatch(robot)
         watched.SetProblem(robot.MarkerPosition())
         robot.Transition(robot.State())  # MoBeE pushes the arm out of the target

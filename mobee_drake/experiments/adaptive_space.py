@@ -57,8 +57,8 @@ from mobee_drake.experiments.arms import (
     Arms,
     ReachTargets,
     RoadmapFolder,
-    RoadmapJob,
     RoadmapJobName,
+    RoadmapJobOf,
     RoadmapLines,
     RoadmapSpace,
     TargetGaps,
@@ -368,11 +368,17 @@ def SpaceHistories(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> dict[s
         if condition != "maintained":
             continue
         run = output / "runs" / f"{robot}_{space}_maintained_seed{rs[0].seed}" / "model"
-        saved = json.loads(((CurrentGeneration(run) or run) / f"{AGENT}.json").read_text())
-        changes = saved["maintenance"]["changes"]
+        changes = _Changes(run, f"{AGENT}.json")
         initial = _InitialCentres(arms[robot], robot, space, output)
         histories[robot].append(History(f"{robot}, {space}", arms[robot], initial, changes))
     return dict(histories)
+
+
+def _Changes(checkpoint: pathlib.Path, name: str) -> list[dict]:
+    """A maintained run's changes of its space: the maintenance's, in the newest generation of
+    its ``checkpoint`` folder (or the folder itself), in the file ``name``."""
+    saved = json.loads(((CurrentGeneration(checkpoint) or checkpoint) / name).read_text())
+    return saved["maintenance"]["changes"]
 
 
 def _Results(args, jobs: list[Job], output: pathlib.Path, description: str) -> dict[str, dict]:
@@ -388,15 +394,7 @@ def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Pat
     """Runs the exploration part's battery; its report."""
     built = {}
     if "trm" in args.spaces:  # (the roadmaps first: the trm runs read them)
-        roadmaps = [
-            Job(
-                RoadmapJobName(robot),
-                RoadmapJob,
-                dict(robot=robot, spacing=args.trm_spacing, max_vertices=args.trm_states),
-                total=args.trm_states,
-            )
-            for robot in args.robots
-        ]
+        roadmaps = [RoadmapJobOf(r, args.trm_spacing, args.trm_states) for r in args.robots]
         built = _Results(args, roadmaps, output, "trm spaces")
         built = {r: built[RoadmapJobName(r)] for r in args.robots if RoadmapJobName(r) in built}
     jobs = [
@@ -471,11 +469,11 @@ def ReachSpaceHistories(runs: list, output: pathlib.Path) -> dict[str, list]:
         strategy = "intrinsic" if "intrinsic" in strategies else strategies[0]
         seed = min(r.seed for r in rs if r.strategy == strategy)
         name = reaching_part.RunName(robot, space, strategy, "maintained", seed)
-        folder = output / "runs" / name / "checkpoint"
-        saved = json.loads((CurrentGeneration(folder) / "learner.json").read_text())
         initial = _ReachCentres(arms[robot], robot, space, output)
+        if initial is None:  # (its roadmap is not there: nothing to draw it from)
+            continue
+        changes = _Changes(output / "runs" / name / "checkpoint", "learner.json")
         title = f"{robot}, {space}, {strategy}"
-        changes = saved["maintenance"]["changes"]
         histories[robot].append(
             History(title, arms[robot], initial, changes, ReachTargets(arms[robot]))
         )

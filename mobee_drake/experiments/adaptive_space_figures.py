@@ -21,14 +21,16 @@ from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.world.live_world import ROLE_COLORS, MakeShape, ObjectPose
 
 # The colours of the kept, removed and added states.
-KEPT, REMOVED, ADDED, TARGET = "tab:blue", "tab:red", "tab:purple", "0.35"
+KEPT, REMOVED, ADDED, TARGET = "tab:blue", "tab:red", "tab:purple", "tab:green"
 # The Meshcat recording's pace: the maintenance's steps (actions; the reach learner's
 # problem-tries) per second, one round at the default period.
 STEPS_PER_SECOND = 100.0
 # A state's sphere in the Meshcat scene (m).
 STATE_RADIUS = 0.006
 _RGBA = {"kept": Rgba(0.12, 0.47, 0.71, 1), "removed": Rgba(0.84, 0.15, 0.16, 1)}
-_RGBA["added"] = Rgba(0.58, 0.40, 0.74, 1)  # (targets are green, as in the viewer)
+_RGBA["added"] = Rgba(0.58, 0.40, 0.74, 1)
+# (the "target" role's colour: in the reach learner's world a target is an obstacle until its
+# reach, but here it is drawn as what it is)
 _RGBA["target"] = Rgba(*ROLE_COLORS["target"][:3], 0.25)
 
 

@@ -29,7 +29,7 @@ import dataclasses as dc
 import numpy as np
 
 from mobee_drake.experiments.arguments import PositiveFloat, PositiveInt
-from mobee_drake.experiments.arms import RoadmapFolder, RoadmapJob, RoadmapJobName, RoadmapLines
+from mobee_drake.experiments.arms import RoadmapFolder, RoadmapJobOf, RoadmapLines
 from mobee_drake.experiments.battery import Job, RunFolder, StopRequested
 from mobee_drake.experiments.ch8_figures import EvaluationSum
 from mobee_drake.experiments.ch8_measures import PENETRATION_HEADER, PenetrationCell
@@ -176,14 +176,7 @@ def Stages(args, maintenance: MaintenanceConfig) -> list[tuple[str, list[Job]]]:
     roadmaps, mdps, runs = [], [], []
     for robot in args.robots:
         if "trm" in args.reach_spaces:
-            roadmaps.append(
-                Job(
-                    RoadmapJobName(robot),
-                    RoadmapJob,
-                    dict(robot=robot, spacing=args.reach_trm_spacing, max_vertices=TRM_STATES),
-                    total=TRM_STATES,
-                )
-            )
+            roadmaps.append(RoadmapJobOf(robot, args.reach_trm_spacing, TRM_STATES))
         for space in args.reach_spaces:
             if args.mdp != "simultaneous":
                 mdp = dict(min_tries=MDP_TRIES) | ({} if robot == "icub" else dict(robot=robot))
@@ -275,7 +268,9 @@ def Report(
             group[(robot, "trm", strategy, "fixed")], group[(robot, "rank3", strategy, "fixed")]
         )  # fmt: skip
     lines += RoadmapLines(roadmaps or {})
-    lines += PairedBySeed(families, measures, "Maintained minus fixed and trm minus rank3")
+    both = {r.space for r in runs} >= {"rank3", "trm"}
+    heading = "Maintained minus fixed" + (" and trm minus rank3" if both else "")
+    lines += PairedBySeed(families, measures, heading)
     for robot, (grid, gaps) in (targets or {}).items():
         levels = ", ".join(f"{axis} {'/'.join(f'{v:.2f}' for v in getattr(grid, axis))}"
                            for axis in "xyz")  # fmt: skip

@@ -16,7 +16,7 @@ import pathlib
 
 import numpy as np
 
-from mobee_drake.experiments.battery import RunFolder
+from mobee_drake.experiments.battery import Job, RunFolder
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.planning.supervisor import RoadmapStateSpace
@@ -132,6 +132,16 @@ def RoadmapJobName(robot: str) -> str:
 def RoadmapFolder(runs: pathlib.Path, robot: str) -> pathlib.Path:
     """Where the battery whose runs are in ``runs`` keeps ``robot``'s roadmap."""
     return runs / RoadmapJobName(robot) / "roadmap"
+
+
+def RoadmapJobOf(robot: str, spacing: float, max_vertices: int) -> Job:
+    """The battery's job that builds ``robot``'s roadmap (:func:`RoadmapJob`)."""
+    return Job(
+        RoadmapJobName(robot),
+        RoadmapJob,
+        dict(robot=robot, spacing=spacing, max_vertices=max_vertices),
+        total=max_vertices,
+    )
 
 
 def RoadmapJob(run: RunFolder, *, robot: str, spacing: float, max_vertices: int) -> dict:

@@ -115,7 +115,9 @@ def TorsoReachRobot(
     torso ``module`` beside the state-action executor."""
     scenario = ReachScenario()
     scenario.robot = IcubConfig(controlled_joints=list(TORSO_JOINTS) + RIGHT_ARM)
-    scenario.objects = [TargetObject(_PARKED, radius)]  # SetProblem moves it
+    # (SetProblem moves it, or adds it again after a reach took it away; the torso module reads
+    # it, and nothing runs between a reach and the next problem here)
+    scenario.objects = [TargetObject(_PARKED, radius)]
     if not torso:
         return SimulatedRobot(BuildScenario(scenario), RIGHT_ARM, learner.space, radius)
     placement = PlaceTorso(

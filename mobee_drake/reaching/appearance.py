@@ -41,6 +41,12 @@ class AppearanceWatch:
     def __getattr__(self, name):  # (the rest of the Robot protocol, unwatched)
         return getattr(self.robot, name)
 
+    def __setattr__(self, name, value):  # (the robot's own are set on it: a reshaped space)
+        if name in ("robot", "counts"):
+            object.__setattr__(self, name, value)
+        else:
+            setattr(self.robot, name, value)
+
     def _Penetrating(self) -> int:
         return self.robot.Safety().penetrating_steps
 

@@ -8,8 +8,8 @@ target, so the palm may touch and enter it while the rest of the arm is still ke
 ends its problem-try: when it has ended (settled back at its state's centre) the filter and the
 target go, so that nothing the robot does before the next problem (an evaluation's walk to its
 start state) has to push the hand out of a target it was let into; the next problem's target
-appears with ``SetProblem``. A transition therefore must go around the target, and fails when it
-cannot.
+appears with ``SetProblem``. (A try that times out keeps its target: no hand was let into it.) A
+transition therefore must go around the target, and fails when it cannot.
 """
 
 import numpy as np
