@@ -215,18 +215,24 @@ class TestBattery(unittest.TestCase):
         robot.Transition(int(self.model.space.action_goal[self.model.space.Actions(state)[0]]))
         self.assertTrue(meshcat.HasPath("/drake/illustration"))
 
-    def test_fields_feel_the_target_in_the_way(self):
-        from mobee_drake.experiments.ch8_reaching import ReachRobot
-
+    def PalmAtNeighbour(self, robot, action: int):
+        """(the robot's state, the goal of its ``action``-th action, where the palm is there):
+        the robot goes there with a target far away and comes back."""
         space = self.model.space
-        robot = ReachRobot(space, 0.05)
         start = robot.State()
-        goal = int(space.action_goal[space.Actions(start)[0]])
+        goal = int(space.action_goal[space.Actions(start)[action]])
         robot.SetProblem(np.array([1.0, 1.0, 1.0]))  # far away
         self.assertEqual(robot.Transition(goal), goal)
         self.assertFalse(robot.FeltObject())
         palm = robot.MarkerPosition()
         self.assertEqual(robot.Transition(start), start)
+        return start, goal, palm
+
+    def test_fields_feel_the_target_in_the_way(self):
+        from mobee_drake.experiments.ch8_reaching import ReachRobot
+
+        robot = ReachRobot(self.model.space, 0.05)
+        start, goal, palm = self.PalmAtNeighbour(robot, 0)
         robot.SetProblem(palm)  # where the palm was at the goal: in the way
         robot.Transition(goal)
         self.assertTrue(robot.FeltObject())
@@ -241,14 +247,8 @@ class TestBattery(unittest.TestCase):
         from mobee_drake.reaching.targets import TARGET_NAME
         from mobee_drake.station.safety import Penetrations
 
-        space = self.model.space
-        robot = ReachRobot(space, 0.05)
-        start = robot.State()
-        neighbour = int(space.action_goal[space.Actions(start)[3]])
-        robot.SetProblem(np.array([1.0, 1.0, 1.0]))  # far away
-        self.assertEqual(robot.Transition(neighbour), neighbour)
-        palm = robot.MarkerPosition()
-        self.assertEqual(robot.Transition(start), start)
+        robot = ReachRobot(self.model.space, 0.05)
+        start, neighbour, palm = self.PalmAtNeighbour(robot, 3)
         robot.SetProblem(palm)
         self.assertFalse(Penetrations(robot.station.diagram, robot.context))
         self.assertEqual(robot.Transition(neighbour), neighbour)
