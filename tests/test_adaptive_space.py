@@ -99,10 +99,13 @@ class TestSpaceHistory(unittest.TestCase):
     def test_the_history_follows_the_changes_in_order(self):
         """Three states; a state grown at 100 actions, the second initial state pruned at 200,
         another grown at 200, the first grown one pruned at 300 (a drop changes no state): two
-        initial states kept, one removed, one added (the state grown and pruned later is
-        neither), each where the palm is at its centre; a pruned state that is not there is
-        refused."""
-        from mobee_drake.experiments.adaptive_space_figures import History, _MarkerPositions
+        initial states kept, two removed (one of them grown first), one added, each where the
+        palm is at its centre; a pruned state that is not there is refused."""
+        from mobee_drake.experiments.adaptive_space_figures import (
+            History,
+            _Counts,
+            _MarkerPositions,
+        )
 
         arm = Arms()["icub"]
         initial = np.array([[0.25] * 4, [0.5] * 4, [0.75] * 4])
@@ -119,8 +122,10 @@ class TestSpaceHistory(unittest.TestCase):
         np.testing.assert_array_equal(history.pruned_at, [np.inf, 200, np.inf, 300, np.inf])
         palms = _MarkerPositions(arm, [*initial, *grown])
         np.testing.assert_array_equal(history.kept, palms[[0, 2]])
-        np.testing.assert_array_equal(history.removed, palms[[1]])
+        np.testing.assert_array_equal(history.removed, palms[[1, 3]])
+        self.assertEqual(history.added_then_removed, 1)
         np.testing.assert_array_equal(history.added, palms[[4]])
+        self.assertEqual(_Counts(history), "2 kept, 2 removed (1 of them added first), 1 added")
         with self.assertRaisesRegex(ValueError, r"icub, test: pruned state \[0\.1"):
             History("icub, test", arm, initial, [dict(changes[1], centre=[0.1] * 4)])
 
@@ -168,12 +173,12 @@ class TestSmokeBattery(FigureTest):
         )
         self.assertIn("icub rank4, prediction error:", report)
         self.assertIn("The trm spaces: icub, 12 states and", report)
-        # The figures of the first seed's maintained runs: each state of the initial space is
-        # kept or removed, each of the final space kept or added.
+        # The figures of the first seed's maintained runs: each state of the final space is kept
+        # or added, and one is removed per prune.
         histories = adaptive_space.SpaceHistories(everything, self.output)["icub"]
         self.assertEqual([h.title for h in histories], ["icub, rank4", "icub, trm"])
         rank4 = [r for r in runs if r.condition == "maintained" and r.seed == 0][0]
-        self.assertEqual(len(histories[0].kept) + len(histories[0].removed), 256)
+        self.assertEqual(len(histories[0].removed), rank4.changes["prune"])
         self.assertEqual(len(histories[0].kept) + len(histories[0].added), rank4.states)
         self.assertReadable(Figure(histories), "adaptive space")
         for name in ("adaptive_space.png", "adaptive_space_icub.html"):
@@ -231,7 +236,10 @@ class TestTheReachLearnersSpace(unittest.TestCase):
                 r for r in runs if (r.robot, r.condition, r.seed) == (robot, "maintained", 0)
             ]
             self.assertEqual(len(history.kept) + len(history.added), first.states)
-            self.assertEqual(len(history.kept), 81)
+            self.assertEqual(
+                len(history.kept), 81 - len(history.removed) + history.added_then_removed
+            )
+            self.assertEqual(len(history.removed), first.changes["prune"])
             self.assertEqual(len(history.targets), 27)
             self.assertTrue((output / f"adaptive_space_reaching_{robot}.html").is_file())
         self.assertIn("adaptive_space_reaching.png", report)

@@ -55,8 +55,13 @@ class SpaceHistory:
 
     @property
     def removed(self) -> np.ndarray:
-        """(r, 3): the initial space's states pruned."""
-        return self.points[(self.added_at == 0) & np.isfinite(self.pruned_at)]
+        """(r, 3): the states pruned, of the initial space or added before (one per prune)."""
+        return self.points[np.isfinite(self.pruned_at)]
+
+    @property
+    def added_then_removed(self) -> int:
+        """How many of :attr:`removed` were added first."""
+        return int(np.sum((self.added_at > 0) & np.isfinite(self.pruned_at)))
 
     @property
     def added(self) -> np.ndarray:
@@ -136,13 +141,23 @@ def Figure(histories: list[SpaceHistory]):
             axis.set(
                 xlabel=f"{'xyz'[i]} [m]",
                 ylabel=f"{'xyz'[j]} [m]",
-                title=f"{history.title}, {name}:\n{len(history.kept)} kept, "
-                f"{len(history.removed)} removed, {len(history.added)} added",
+                title=f"{history.title}, {name}:\n{_Counts(history)}",
                 aspect="equal",
             )
             Legend(axis)
     figure.tight_layout()
     return figure
+
+
+def _Counts(history: SpaceHistory) -> str:
+    """The figure's count of the states kept, removed and added (kept + added: the space at the
+    end; removed: one per prune)."""
+    first = history.added_then_removed
+    return (
+        f"{len(history.kept)} kept, {len(history.removed)} removed"
+        + (f" ({first} of them added first)" if first else "")
+        + f", {len(history.added)} added"
+    )
 
 
 def ShowSpace(meshcat: Meshcat, history: SpaceHistory, path: str) -> None:
