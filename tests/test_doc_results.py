@@ -18,6 +18,10 @@ _CH8_KEPT = re.compile(
     r"--output (?P<folder>docs/results/\S+) ",
     flags=re.MULTILINE,
 )
+# A generated block, in a text whose whitespace is folded.
+_BLOCK = re.compile(r"<!-- generated: ([\w-]+), by .*? -->.*?<!-- end generated: \1 -->")
+# A ratio with its interval, as the prose quotes one: "1.43 [1.40, 1.46]".
+_RATIO = re.compile(r"(\d+\.\d+) \[(\d+\.\d+), (\d+\.\d+)\]")
 
 
 class TestKeptBatteries(unittest.TestCase):
@@ -35,3 +39,15 @@ class TestKeptBatteries(unittest.TestCase):
                 self.assertEqual(
                     GeneratedTable(doc, name).rstrip(), "\n".join(ClaimsTables(results)).rstrip()
                 )
+
+    def test_the_ratios_the_prose_quotes_are_its_generated_blocks(self):
+        """docs/reaching.md's prose quotes random's robot time over the others' from its
+        generated blocks (R times [low, high]); a block written again from new runs fails the
+        prose that still quotes the old figures."""
+        text = " ".join((ROOT / "docs" / "reaching.md").read_text().split())
+        blocks = " ".join(block[0] for block in _BLOCK.finditer(text))
+        quoted = _RATIO.findall(_BLOCK.sub("", text))
+        self.assertTrue(quoted)
+        for ratio, low, high in quoted:
+            with self.subTest(ratio=ratio):
+                self.assertIn(f"{ratio} times [{low}, {high}]", blocks)
