@@ -19,7 +19,7 @@ _CH8_KEPT = re.compile(
     flags=re.MULTILINE,
 )
 # A generated block, in a text whose whitespace is folded.
-_BLOCK = re.compile(r"<!-- generated: ([\w-]+), by .*? -->.*?<!-- end generated: \1 -->")
+_BLOCK = re.compile(r"<!-- generated: ([\w.-]+), by .*? -->.*?<!-- end generated: \1 -->")
 # A ratio with its interval, as the prose quotes one: "1.43 [1.40, 1.46]".
 _RATIO = re.compile(r"(\d+\.\d+) \[(\d+\.\d+), (\d+\.\d+)\]")
 
