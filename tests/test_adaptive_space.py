@@ -355,10 +355,13 @@ class TestTheReachLearnersSpace(unittest.TestCase):
                     progress=checkpoints.append, maintenance=maintenance,
                 )  # fmt: skip
         self.assertEqual(checkpoints[-1], 6)
-        # (A copy whose checkpoint predates the count of targets appearing inside the robot.)
+        # (A copy whose checkpoint predates the count of targets appearing inside the robot and
+        # the evaluations' timing.)
         shutil.copytree(self.output / "killed", self.output / "older")
         (saved,) = (self.output / "older").glob("checkpoint/g*/learner.json")
-        saved.write_text(json.dumps(json.loads(saved.read_text()) | dict(appearance=None)))
+        data = json.loads(saved.read_text()) | dict(appearance=None)
+        del data["evaluation_seconds"]
+        saved.write_text(json.dumps(data))
         resumed = RunOne(self.output / "killed", self.output, settings, maintenance=maintenance)
         self.assertGreater(whole["space"]["changes"]["develop"], 0)
         self.assertGreater(whole["space"]["states"], 81)
@@ -373,3 +376,5 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         older = RunOne(self.output / "older", self.output, settings, maintenance=maintenance)
         self.assertEqual(older["log"], whole["log"])
         self.assertEqual([older["appeared_inside"], older["other_penetrating_steps"]], [None] * 2)
+        self.assertEqual([whole["evaluation_seconds"], resumed["evaluation_seconds"]], [0.0] * 2)
+        self.assertIsNone(older["evaluation_seconds"])

@@ -18,6 +18,8 @@ REWARDS = {
     "intrinsic": {100: 0.2, 800: 0.8, 1600: 0.9},
 }
 HOURS = {"random": 3.0, "greedy": 1.0, "intrinsic": 1.0}
+# Robot time of every run's evaluations (of its HOURS).
+EVALUATION_HOURS = 0.5
 
 
 def _Log(strategy: str, tries: int, rng) -> list[list[float]]:
@@ -56,6 +58,7 @@ def _Run(strategy: str, seed: int, rule: str = "strict", shift: float = 0.0) -> 
         evaluations=evaluations,
         log=_Log(strategy, STAGES[-1], rng),
         simulated_seconds=3600.0 * HOURS[strategy] * (1 + 0.03 * rng.standard_normal()),
+        evaluation_seconds=3600.0 * EVALUATION_HOURS,
         wall_seconds=1.0,
         penetrating_steps=0,
         num_transitions=4,
@@ -86,6 +89,7 @@ class TestClaims(unittest.TestCase):
                 claims.REPRODUCED,  # best from 800 (both sums)
                 claims.REPRODUCED,
                 claims.NOT_REPRODUCED,  # 3 times the robot time, not the source's 1.86
+                claims.NOT_REPRODUCED,  # 5 times without the evaluations
                 claims.REPRODUCED,  # random's failed transitions
                 claims.REPRODUCED,  # greedy's lines
             ],
@@ -123,7 +127,7 @@ class TestClaims(unittest.TestCase):
     def test_a_claim_with_nothing_to_compare_is_not_testable(self):
         alone = [r for r in self.strict if r.strategy == "intrinsic"]
         marks = _Marks(alone)
-        for i in (0, 3, 4, 6, 7, 8):
+        for i in (0, 3, 4, 6, 7, 8, 9):
             self.assertEqual(marks[i, "unit0.03_force300"], claims.NOT_TESTABLE, i)
 
     def test_the_ratio_and_a_missing_stage(self):
@@ -152,6 +156,35 @@ class TestClaims(unittest.TestCase):
             run.evaluations.pop(100)
         marks = _Marks(late)
         self.assertEqual(marks[0, "unit0.03_force300"], claims.NOT_TESTABLE)
+
+    def test_the_ratio_of_the_exploration_alone(self):
+        """The same ratio without each run's evaluation time; runs that did not time their
+        evaluations cannot say it (but still say the ratio with them)."""
+        by = {s: {r.settings.seed: r for r in self.strict if r.settings.strategy == s}
+              for s in REWARDS}  # fmt: skip
+
+        def Exploration(run):
+            return (run.simulated_seconds - run.evaluation_seconds) / 3600
+
+        random = [Exploration(by["random"][k]) for k in range(6)]
+        others = [
+            np.mean([Exploration(by[s][k]) for s in ("greedy", "intrinsic")]) for k in range(6)
+        ]
+        value, low, high = RatioOfMeans(random, others, [k % 2 for k in range(6)])
+        mark, evidence = claims.RandomTakesLonger(by, exploration_only=True)
+        self.assertEqual(mark, claims.NOT_REPRODUCED)
+        self.assertTrue(evidence.startswith(f"{value:.2f} times [{low:.2f}, {high:.2f}]"))
+        self.assertAlmostEqual(value, 5.0, delta=0.3)  # (2.5 h against 0.5 h)
+        # Random's exploration at the source's ratio of the others', its evaluations as theirs:
+        # reproduced without the evaluations, not with them.
+        for seed, run in by["random"].items():
+            mean = np.mean([Exploration(by[s][seed]) for s in ("greedy", "intrinsic")])
+            run.simulated_seconds = run.evaluation_seconds + 3600 * claims.SOURCE_TIME_RATIO * mean
+        self.assertEqual(claims.RandomTakesLonger(by, True)[0], claims.REPRODUCED)
+        self.assertEqual(claims.RandomTakesLonger(by)[0], claims.NOT_REPRODUCED)
+        by["greedy"][3].evaluation_seconds = None  # (a run from before the evaluations were timed)
+        self.assertEqual(claims.RandomTakesLonger(by, True)[0], claims.NOT_TESTABLE)
+        self.assertEqual(claims.RandomTakesLonger(by)[0], claims.NOT_REPRODUCED)
 
     def test_parameter_tuning_across_distance_units(self):
         # Greedy loses 0.3 per try in the coarser unit, intrinsic keeps its level.

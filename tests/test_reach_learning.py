@@ -376,6 +376,16 @@ class TestBattery(unittest.TestCase):
         self.assertTrue(all(arrived[0.0]))
         self.assertFalse(all(arrived[0.2]))
 
+    def test_the_evaluations_robot_time(self):
+        """A run that only evaluates (no problem-try) spends all its robot time in the
+        evaluations; one that explores too spends the rest exploring."""
+        only = self.Run("evaluations_only", self.Settings("greedy", 0, 0, [0], 1, 4))
+        self.assertGreater(only["evaluation_seconds"], 1.0)
+        self.assertEqual(only["evaluation_seconds"], only["simulated_seconds"])
+        both = self.Run("evaluations_and_tries", self.Settings("greedy", 0, 4, [4], 1, 4))
+        self.assertGreater(both["evaluation_seconds"], 1.0)
+        self.assertGreater(both["simulated_seconds"], both["evaluation_seconds"] + 1.0)
+
     def test_weaker_reach_stops_farther(self):
         from mobee_drake.experiments.ch8_reaching import ReachRobot
 

@@ -163,19 +163,33 @@ def BestFrom800(runs: Runs, penalties: bool) -> tuple[str, str]:
     return _Family(runs, comparisons, larger=True)
 
 
-def _Hours(run: ReachRun) -> float:
-    return run.simulated_seconds / 3600
+def _Hours(run: ReachRun, exploration_only: bool) -> float:
+    seconds = run.simulated_seconds
+    if exploration_only:
+        seconds -= run.evaluation_seconds
+    return seconds / 3600
 
 
-def RandomTakesLonger(runs: Runs) -> tuple[str, str]:
-    """Ch. 8.4.4: random exploration takes about 1.86 times the robot time of the others."""
+def RandomTakesLonger(runs: Runs, exploration_only: bool = False) -> tuple[str, str]:
+    """Ch. 8.4.4: random exploration takes about 1.86 times the robot time of the others. The
+    source's experiments "ran for" their hours, which the evaluations are part of; its reason
+    (random's trips across the state space) is the exploration's: ``exploration_only`` leaves
+    the evaluations' robot time out."""
     if not {"random", "greedy", "intrinsic"} <= set(runs):
         return NOT_TESTABLE, "needs random, greedy and intrinsic runs"
     seeds = sorted(set(runs["random"]) & set(runs["greedy"]) & set(runs["intrinsic"]))
     if len(seeds) < 2:
         return NOT_TESTABLE, "fewer than 2 seeds with all three strategies"
-    random = [_Hours(runs["random"][s]) for s in seeds]
-    others = [np.mean([_Hours(runs[o][s]) for o in ("greedy", "intrinsic")]) for s in seeds]
+    timed = all(
+        r.evaluation_seconds is not None for by_seed in runs.values() for r in by_seed.values()
+    )
+    if exploration_only and not timed:
+        return NOT_TESTABLE, "needs runs that timed their evaluations"
+    random = [_Hours(runs["random"][s], exploration_only) for s in seeds]
+    others = [
+        np.mean([_Hours(runs[o][s], exploration_only) for o in ("greedy", "intrinsic")])
+        for s in seeds
+    ]
     blocks = [runs["random"][s].settings.mdp_seed for s in seeds]
     ratio, low, high = RatioOfMeans(random, others, blocks)
     evidence = (
@@ -249,6 +263,11 @@ CLAIMS: tuple[tuple[str, str, Callable[[Runs], tuple[str, str]]], ...] = (
         "random exploration needs about 1.86 times the robot time (8.4.4)",
         "robot hours",
         RandomTakesLonger,
+    ),
+    (
+        "the same",
+        "robot hours of the exploration alone",
+        lambda runs: RandomTakesLonger(runs, exploration_only=True),
     ),
     (
         "random accumulates many more failed transitions (8.4.4, Fig. 8.8)",

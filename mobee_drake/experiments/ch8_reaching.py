@@ -272,6 +272,8 @@ class ReachRun:
             problem-tries' :class:`~mobee_drake.reaching.learner.TryResult` as dicts.
         log: The learner's log of actions (columns: ``reaching.learner.LOG_COLUMNS``).
         simulated_seconds: Robot time, evaluations included.
+        evaluation_seconds: The robot time of the evaluations alone (None: a run from before it
+            was counted); the exploration's is the difference.
         wall_seconds: Wall time of the run (over its resumptions).
         penetrating_steps: Control periods in which two solids penetrated.
         appeared_inside: Problems (tries and evaluations) whose target appeared inside the
@@ -301,6 +303,7 @@ class ReachRun:
     space: dict | None = None
     appeared_inside: int | None = None
     other_penetrating_steps: int | None = None
+    evaluation_seconds: float | None = None
 
     @property
     def strategy(self) -> str:
@@ -497,10 +500,13 @@ def RunOne(
     while True:
         done = int(learner.problem_tries.sum())
         if done in settings.stages and str(done) not in data["evaluations"]:
+            began = robot.simulated_seconds
             data["evaluations"][str(done)] = [
                 [dc.asdict(r) for r in learner.Evaluate(robot, seed=(settings.seed, done, e))]
                 for e in range(settings.evaluations)
             ]
+            if data["evaluation_seconds"] is not None:
+                data["evaluation_seconds"] += robot.simulated_seconds - began
             Save()
         if done >= settings.problem_tries:
             break
@@ -530,9 +536,12 @@ def _Resume(checkpoint: pathlib.Path, robot, learner, keeper) -> dict:
     :class:`AppearanceWatch`'s counts), empty for a new run."""
     generation = CurrentGeneration(checkpoint)
     if generation is None:
-        return dict(evaluations={}, wall_seconds=0.0, target=None, appearance={})
+        return dict(
+            evaluations={}, wall_seconds=0.0, target=None, appearance={}, evaluation_seconds=0.0
+        )
     saved = json.loads((generation / "learner.json").read_text())
     saved.setdefault("appearance", None)  # (a checkpoint from before the count)
+    saved.setdefault("evaluation_seconds", None)  # (and before the evaluations were timed)
     arrays = np.load(generation / "learner.npz")
     if keeper is not None:
         keeper.Restore(learner, robot, arrays, saved.pop("maintenance"))
@@ -560,6 +569,7 @@ def _Result(settings: RunSettings, learner, robot, data: dict, extra: dict) -> R
         num_states=learner.space.num_states,
         appeared_inside=None if counts is None else counts.appeared_inside,
         other_penetrating_steps=None if counts is None else counts.other_penetrating_steps,
+        evaluation_seconds=data["evaluation_seconds"],
         **extra,
     )
 
