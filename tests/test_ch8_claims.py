@@ -186,6 +186,18 @@ class TestClaims(unittest.TestCase):
         self.assertEqual(claims.RandomTakesLonger(by, True)[0], claims.NOT_TESTABLE)
         self.assertEqual(claims.RandomTakesLonger(by)[0], claims.NOT_REPRODUCED)
 
+    def test_the_report_gives_the_evaluations_robot_time(self):
+        from mobee_drake.experiments.ch8_report import _EffortSection
+
+        by_strategy = {s: [r for r in self.strict if r.strategy == s] for s in REWARDS}
+        hours = sum(r.simulated_seconds for r in by_strategy["random"]) / 3600
+        evaluation = 6 * EVALUATION_HOURS
+        (row,) = [line for line in _EffortSection(by_strategy, 4) if line.startswith("| random")]
+        self.assertIn(f"| {hours:.1f} | {evaluation:.1f} ({evaluation / hours:.0%}) |", row)
+        by_strategy["random"][2].evaluation_seconds = None  # (a run from before the timing)
+        (row,) = [line for line in _EffortSection(by_strategy, 4) if line.startswith("| random")]
+        self.assertIn(f"| {hours:.1f} | - |", row)
+
     def test_parameter_tuning_across_distance_units(self):
         # Greedy loses 0.3 per try in the coarser unit, intrinsic keeps its level.
         def Swept(unit, greedy_shift):

@@ -230,6 +230,15 @@ def _RewardSection(results: list[ReachRun], by_strategy: dict, stages) -> list[s
     return lines
 
 
+def _EvaluationHours(runs: list[ReachRun], hours: float) -> str:
+    """The runs' evaluations' robot hours and their share of ``hours``; ``-`` where some run
+    did not time its evaluations."""
+    if any(r.evaluation_seconds is None for r in runs):
+        return "-"
+    evaluation = sum(r.evaluation_seconds for r in runs) / 3600
+    return f"{evaluation:.1f} ({evaluation / hours:.0%})"
+
+
 def _EffortSection(by_strategy: dict, k: int) -> list[str]:
     """Robot time, failed transitions, timed-out problem-tries and safety per strategy."""
     strategies = list(by_strategy)
@@ -237,11 +246,11 @@ def _EffortSection(by_strategy: dict, k: int) -> list[str]:
         "",
         "## Robot time, failed transitions and reaches",
         "",
-        "| strategy | runs | robot hours (all runs) | source's robot hours (5 runs of 6400) "
-        "| actions per problem-try | failed transitions per problem-try | timed-out "
-        "problem-tries | wall hours (all runs) | "
+        "| strategy | runs | robot hours (all runs) | of them, the evaluations' | source's robot "
+        "hours (5 runs of 6400) | actions per problem-try | failed transitions per problem-try | "
+        "timed-out problem-tries | wall hours (all runs) | "
         f"{PENETRATION_HEADER} | periods the safety barrier acted |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for strategy in strategies:
         actions, failed, timeouts, tries = 0, 0, 0, 0
@@ -255,6 +264,7 @@ def _EffortSection(by_strategy: dict, k: int) -> list[str]:
         hours = sum(r.simulated_seconds for r in by_strategy[strategy]) / 3600
         lines.append(
             f"| {strategy} | {len(by_strategy[strategy])} | {hours:.1f} | "
+            f"{_EvaluationHours(by_strategy[strategy], hours)} | "
             f"{SOURCE_HOURS.get(strategy, '-')} | {actions / tries:.2f} | {failed / tries:.2f} | "
             f"{timeouts} | {sum(r.wall_seconds for r in by_strategy[strategy]) / 3600:.2f} | "
             f"{PenetrationCell(by_strategy[strategy])} | "
