@@ -8,46 +8,46 @@ import unittest
 
 from mobee_drake.experiments.ch8_claims import ClaimsTables
 from mobee_drake.experiments.ch8_reaching import StoredResults
-from mobee_drake.experiments.doc_tables import GeneratedTable
+from mobee_drake.experiments.doc_tables import GeneratedBlocks
 
 ROOT = pathlib.Path(__file__).parents[1]
 
-# The opening marker of a generated block written by the ch. 8 report of a kept battery.
-_CH8_KEPT = re.compile(
-    r"^<!-- generated: (?P<name>[\w-]+), by mobee-drake experiment ch8 --report-only "
-    r"--output (?P<folder>docs/results/\S+) ",
-    flags=re.MULTILINE,
-)
-# A generated block, in a text whose whitespace is folded.
-_BLOCK = re.compile(r"<!-- generated: ([\w.-]+), by .*? -->.*?<!-- end generated: \1 -->")
+# The command of a block written by the ch. 8 report of a kept battery.
+_CH8_KEPT = re.compile(r"^mobee-drake experiment ch8 --report-only --output (docs/results/\S+) ")
 # A ratio with its interval, as the prose quotes one: "1.43 [1.40, 1.46]".
 _RATIO = re.compile(r"(\d+\.\d+) \[(\d+\.\d+), (\d+\.\d+)\]")
+
+
+def _Folded(text: str) -> str:
+    return " ".join(text.split())
 
 
 class TestKeptBatteries(unittest.TestCase):
     def test_every_ch8_claims_table_is_what_its_kept_runs_give(self):
         blocks = [
-            (doc, found["name"], ROOT / found["folder"])
+            (doc, name, ROOT / kept[1], table)
             for doc in sorted((ROOT / "docs").glob("*.md"))
-            for found in _CH8_KEPT.finditer(doc.read_text())
+            for name, command, table in GeneratedBlocks(doc)
+            if (kept := _CH8_KEPT.match(command))
         ]
-        self.assertLessEqual({"ch8-stage100", "ch8-sweep400"}, {name for _, name, _ in blocks})
-        for doc, name, folder in blocks:
+        self.assertLessEqual({"ch8-stage100", "ch8-sweep400"}, {name for _, name, _, _ in blocks})
+        for doc, name, folder, table in blocks:
             with self.subTest(doc=doc.name, block=name):
                 results = StoredResults(folder)
                 self.assertTrue(results, f"{folder}: no finished runs")
-                self.assertEqual(
-                    GeneratedTable(doc, name).rstrip(), "\n".join(ClaimsTables(results)).rstrip()
-                )
+                self.assertEqual(table.rstrip(), "\n".join(ClaimsTables(results)).rstrip())
 
     def test_the_ratios_the_prose_quotes_are_its_generated_blocks(self):
         """docs/reaching.md's prose quotes random's robot time over the others' from its
         generated blocks (R times [low, high]); a block written again from new runs fails the
         prose that still quotes the old figures."""
-        text = " ".join((ROOT / "docs" / "reaching.md").read_text().split())
-        blocks = " ".join(block[0] for block in _BLOCK.finditer(text))
-        quoted = _RATIO.findall(_BLOCK.sub("", text))
+        doc = ROOT / "docs" / "reaching.md"
+        prose, tables = doc.read_text(), []
+        for _, _, table in GeneratedBlocks(doc):
+            prose = prose.replace(table, "")
+            tables.append(_Folded(table))
+        quoted = _RATIO.findall(_Folded(prose))
         self.assertTrue(quoted)
         for ratio, low, high in quoted:
             with self.subTest(ratio=ratio):
-                self.assertIn(f"{ratio} times [{low}, {high}]", blocks)
+                self.assertIn(f"{ratio} times [{low}, {high}]", " ".join(tables))

@@ -180,10 +180,9 @@ def RandomTakesLonger(runs: Runs, exploration_only: bool = False) -> tuple[str, 
     seeds = sorted(set(runs["random"]) & set(runs["greedy"]) & set(runs["intrinsic"]))
     if len(seeds) < 2:
         return NOT_TESTABLE, "fewer than 2 seeds with all three strategies"
-    timed = all(
-        r.evaluation_seconds is not None for by_seed in runs.values() for r in by_seed.values()
-    )
-    if exploration_only and not timed:
+    if exploration_only and any(
+        r.evaluation_seconds is None for by_seed in runs.values() for r in by_seed.values()
+    ):
         return NOT_TESTABLE, "needs runs that timed their evaluations"
     random = [_Hours(runs["random"][s], exploration_only) for s in seeds]
     others = [

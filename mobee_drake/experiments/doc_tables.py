@@ -12,12 +12,20 @@ import re
 from mobee_drake.atomic_files import WriteTextAtomically
 
 
-def _Block(name: str) -> re.Pattern:
+def _Block(name: str | None = None) -> re.Pattern:
+    """The block ``name``, or any block."""
+    names = r"[^,\n]+" if name is None else re.escape(name)
     return re.compile(
-        rf"^<!-- generated: {re.escape(name)}, by (?P<command>.*?) -->\n"
-        rf"(?P<table>.*?)^<!-- end generated: {re.escape(name)} -->$",
+        rf"^<!-- generated: (?P<name>{names}), by (?P<command>.*?) -->\n"
+        rf"(?P<table>.*?)^<!-- end generated: (?P=name) -->$",
         flags=re.MULTILINE | re.DOTALL,
     )
+
+
+def GeneratedBlocks(doc: str | pathlib.Path) -> list[tuple[str, str, str]]:
+    """Every generated block of ``doc``, in order: (name, command, text)."""
+    text = pathlib.Path(doc).read_text()
+    return [(m["name"], m["command"], m["table"]) for m in _Block().finditer(text)]
 
 
 def GeneratedTable(doc: str | pathlib.Path, name: str) -> str:
