@@ -324,20 +324,24 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         self.assertIn("(Holm over the 2)", report)
 
     def test_a_reshaping_run_resumes_exactly(self):
-        """A greedy run whose space is developed every 4 problem-tries (its best reach states,
-        one record each enough), killed after 7 tries (checkpoint at 6, after a round) and run
-        again, ends as the run never killed: the same log, space and robot time."""
+        """A random run whose space is maintained every 2 problem-tries by all five rules (set
+        to act on a try or a record), killed after 7 tries (checkpoint at 6, after three rounds
+        that dropped logged state-actions) and run again, ends as the run never killed: the
+        same log, space and robot time."""
         from unittest import mock
 
         from mobee_drake.experiments.ch8_reaching import RunOne, RunSettings
-        from mobee_drake.planning.space_maintenance import MaintenanceConfig
+        from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
         from mobee_drake.reaching.learner import ReachLearner
 
         settings = RunSettings(
-            strategy="greedy", seed=0, problem_tries=10, stages=[], evaluations=1,
+            strategy="random", seed=0, problem_tries=10, stages=[], evaluations=1,
             checkpoint_every=3, mdp="simultaneous",
         )  # fmt: skip
-        maintenance = MaintenanceConfig(every=4, rules=["develop"], develop_min_records=1)
+        maintenance = MaintenanceConfig(
+            every=2, rules=list(RULES), prune_after=1, drop_after=1, drop_miss_share=0.5,
+            shortcut_after=1, develop_min_records=1,
+        )  # fmt: skip
         whole = RunOne(self.output / "whole", self.output, settings, maintenance=maintenance)
         explore, calls = ReachLearner.Explore, []
 
@@ -363,8 +367,15 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         del data["evaluation_seconds"]
         saved.write_text(json.dumps(data))
         resumed = RunOne(self.output / "killed", self.output, settings, maintenance=maintenance)
-        self.assertGreater(whole["space"]["changes"]["develop"], 0)
-        self.assertGreater(whole["space"]["states"], 81)
+        self.assertTrue(all(whole["space"]["changes"][rule] > 0 for rule in RULES))
+        # The checkpoint's log has entries its rounds dropped (-1): they stay dropped through
+        # the rounds after it, in the run resumed from it and in the run never killed.
+        dropped = [
+            i for i, row in enumerate(np.load(saved.with_suffix(".npz"))["log"]) if row[2] == -1
+        ]
+        self.assertTrue(dropped)
+        for run in (whole, resumed):
+            self.assertEqual({run["log"][i][2] for i in dropped}, {-1})
         self.assertEqual(resumed["space"], whole["space"])
         self.assertEqual(resumed["log"], whole["log"])
         self.assertAlmostEqual(resumed["simulated_seconds"], whole["simulated_seconds"])

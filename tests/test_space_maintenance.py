@@ -345,8 +345,25 @@ class TestTheReachLearner(unittest.TestCase):
             np.testing.assert_array_equal(
                 rebuilt.histories.Records(sa)[1], learner.histories.Records(sa)[1]
             )
-        q, v = learner.Values(np.ones(7))
-        self.assertEqual((q.shape, v.shape), ((7,), (3,)))
+        # A second round (state 1 pruned: 0 -> 2 and 2 -> 0 stay as 0 and 1, the reach of
+        # state 2 becomes 2 + 1 = 3): the entries dropped by the first round stay dropped, the
+        # others follow again, and the histories rebuilt from the log are still the live ones.
+        second = EditSpace(edit.space, drop_states=[1])
+        learner.Reshape(second, CarryExplorer(Explorer(edit.space), second).transitions.counts)
+        self.assertEqual([entry[2] for entry in learner.log], [-1, 1, 3, -1, -1])
+        self.assertEqual([entry[3] for entry in learner.log], [0, 1, 1, -1, -1])
+        self.assertEqual([entry[4] for entry in learner.log], [-1, 0, 1, -1, -1])
+        rebuilt = ReachLearner(second.space, learner.model.counts, np.zeros((1, 3)))
+        arrays, data = learner.ToArrays()
+        rebuilt.LoadArrays(arrays, data)
+        for sa in range(learner.num_state_actions):
+            np.testing.assert_array_equal(
+                rebuilt.histories.Records(sa)[1], learner.histories.Records(sa)[1]
+            )
+        self.assertEqual(
+            [len(rebuilt.histories.Records(sa)[1]) for sa in range(learner.num_state_actions)],
+            [0, 1, 0, 1],
+        )
 
     def test_a_round_on_the_reach_learners_space(self):
         """The learner's MDP (every try into state 3 missed, 6 of them) seen as an explorer's

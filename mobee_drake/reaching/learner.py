@@ -270,8 +270,12 @@ class ReachLearner:
         new_index = np.concatenate([edit.action_index, reaches])
         self._SetSpace(space, transition_counts)
         self.histories = self.histories.Moved(new_index, self.reaching)
+
+        def Moved(index: np.ndarray, old: int) -> int:
+            return int(index[old]) if old >= 0 else -1  # (dropped by an earlier round: stays)
+
         self.log = [
-            (t, problem, int(new_index[sa]), int(state_index[s]), int(state_index[o]), *rest)
+            (t, problem, Moved(new_index, sa), Moved(state_index, s), Moved(state_index, o), *rest)
             for t, problem, sa, s, o, *rest in self.log
         ]
 
