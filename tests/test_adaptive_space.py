@@ -135,6 +135,17 @@ class TestSmokeBattery(FigureTest):
         self.output = pathlib.Path(tempfile.mkdtemp()) / "adaptive"
         self.addCleanup(shutil.rmtree, self.output.parent)
 
+    def test_the_exploration_part_refuses_develop(self):
+        """Its agent favours no states: ``develop`` would do nothing (exit code 2, one line)."""
+        stderr = io.StringIO()
+        with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit) as exit:
+            adaptive_space.main(
+                ["--rules", "prune", "develop", "--report-only", "--output", str(self.output)]
+            )
+        self.assertEqual(exit.exception.code, 2)
+        self.assertIn("error: --rules develop: the exploration part's agent", stderr.getvalue())
+        self.assertFalse(self.output.exists())
+
     def test_the_smoke_battery(self):
         """2 seeds x 30 actions on the rank-4 lattice and on a roadmap of 12 states, fixed and
         maintained every 10 actions (a state pruned after one try into it): every run reports;
@@ -144,13 +155,23 @@ class TestSmokeBattery(FigureTest):
             adaptive_space.main(
                 ["--seeds", "2", "--actions", "30", "--tests", "3", "--every", "10",
                  "--prune-after", "1", "--spaces", "rank4", "trm", "--trm-spacing", "0.6",
-                 "--trm-states", "12", "--output", str(self.output), "--workers", "2"]
+                 "--trm-states", "12", "--robots", "icub", "katana", "--output",
+                 str(self.output), "--workers", "2"]
             )  # fmt: skip
         runs = [
             adaptive_space.AdaptiveSpaceRun(**json.loads(path.read_text()))
             for path in self.output.glob("runs/*_seed*/result.json")
         ]
-        self.assertEqual(len(runs), 8)
+        self.assertEqual(len(runs), 16)
+        katana, runs = (
+            [r for r in runs if r.robot == "katana"],
+            [r for r in runs if r.robot == "icub"],
+        )
+        for run in katana:  # (among its scenario's obstacles)
+            with self.subTest(robot="katana", space=run.space, condition=run.condition):
+                self.assertTrue(30 <= run.actions <= 35)
+                self.assertEqual(run.penetrating_steps, 0)
+                self.assertTrue(0 < run.coverage < 1)
         roadmap = json.loads((self.output / "runs" / "icub_roadmap" / "result.json").read_text())
         self.assertEqual(roadmap["vertices"], 12)
         unchanged = [r for r in runs if r.space == "trm" and not sum(r.changes.values())]
@@ -171,7 +192,11 @@ class TestSmokeBattery(FigureTest):
         self.assertRegex(
             report, rf"\| icub \| rank4 \| maintained \| 2 \| 3\d \| .* \| {states:.0f} \|"
         )
-        self.assertIn("icub rank4, prediction error:", report)
+        self.assertIn("icub rank4, maintained minus fixed, prediction error:", report)
+        # The roadmap against the lattice, both fixed: the mean of the paired differences.
+        fixed = {(r.space, r.seed): r.coverage for r in everything if r.condition == "fixed"}
+        difference = np.mean([fixed["trm", k] - fixed["rank4", k] for k in (0, 1)])
+        self.assertIn(f"icub, trm minus rank4 (both fixed), coverage: {difference:+.2f} [", report)
         self.assertIn("The trm spaces: icub, 12 states and", report)
         # The figures of the first seed's maintained runs: each state of the final space is kept
         # or added, and one is removed per prune.
@@ -340,7 +365,7 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         )  # fmt: skip
         maintenance = MaintenanceConfig(
             every=2, rules=list(RULES), prune_after=1, drop_after=1, drop_miss_share=0.5,
-            shortcut_after=1, develop_min_records=1,
+            shortcut_after=1, develop_min_targets=1,
         )  # fmt: skip
         whole = RunOne(self.output / "whole", self.output, settings, maintenance=maintenance)
         explore, calls = ReachLearner.Explore, []

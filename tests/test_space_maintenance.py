@@ -122,13 +122,25 @@ class TestTheRules(unittest.TestCase):
         )
         # The 3 tries of 1 -> 3, now 1 -> (0.5, 0.75), are not carried: a new action.
         self.assertEqual(reshaped.tries.sum(), 0)
+        # With max_states the space grows while it has fewer, state 3 pruned: 3 + 2 under 5,
+        # 3 + 1 under 4.
+        for max_states, size in ((5, 5), (4, 4)):
+            config = MaintenanceConfig(
+                rules=["prune", "grow"], prune_after=6, max_states=max_states
+            )
+            self.assertEqual(Maintenance(config, 4).Apply(explorer, 0, 6)[0].space.num_states, size)
 
     def test_the_robots_state_is_never_pruned(self):
+        """Nor a state it was in: the start, left by an action that arrived elsewhere."""
         explorer = Explorer(SQUARE)
-        _Tried(explorer, 3, 1, 6)
+        _Tried(explorer, 3, 1, 6)  # 1 -> 3 stayed in 1, 6 times
         reshaped, state = Maintenance(MaintenanceConfig(rules=["prune"]), 4).Apply(explorer, 3, 6)
         self.assertIs(reshaped, explorer)
         self.assertEqual(state, 3)
+        _Tried(explorer, 6, 1, 1)  # 3 -> 1 arrived: the robot started in 3
+        reshaped, state = Maintenance(MaintenanceConfig(rules=["prune"]), 4).Apply(explorer, 1, 7)
+        self.assertIs(reshaped, explorer)
+        self.assertEqual(state, 1)
 
     def test_an_often_infeasible_transition_is_dropped_but_not_a_states_last(self):
         """0 -> 1 missed 4 of 5: dropped. 2's both actions missed every time: the one that
@@ -147,12 +159,16 @@ class TestTheRules(unittest.TestCase):
 
     def test_a_chain_often_taken_gets_a_shortcut(self):
         """0 -> 1 -> 3, each arriving, 5 times: an action 0 -> 3 (the diagonal), optimistic.
-        A chain broken by a miss does not count."""
+        A chain broken by a miss, or whose second action does not start where the first
+        arrived, does not count."""
         maintenance = Maintenance(MaintenanceConfig(rules=["shortcut"], shortcut_after=5), 4)
         for _ in range(4):
             maintenance.Observe(SQUARE, 0, 0, 1)
             maintenance.Observe(SQUARE, 1, 3, 3)
         maintenance.Observe(SQUARE, 0, 0, 0)  # missed
+        maintenance.Observe(SQUARE, 0, 1, 2)  # 0 -> 2 arrived, but the robot was moved to 1:
+        maintenance.Observe(SQUARE, 1, 3, 3)  # no chain 0 -> 3
+        self.assertEqual(maintenance.chains[0, 3], 4)
         maintenance.Observe(SQUARE, 0, 0, 1)
         maintenance.Observe(SQUARE, 1, 3, 3)
         explorer = Explorer(SQUARE)
@@ -222,6 +238,25 @@ class TestOnTheSupervisor(unittest.TestCase):
             maintenance=MaintenanceConfig(),
         )
         with self.assertRaisesRegex(ValueError, "agent 'arm': a space that reshapes itself"):
+            ExplorationSupervisor(
+                agents=[agent], joints=["a"], lower=np.array([-1.0]), upper=np.array([1.0]),
+                home=np.array([0.0]),
+            )  # fmt: skip
+
+    def test_an_exploring_agent_cannot_develop(self):
+        """``develop`` grows states beside those a learner favours; the exploring agent
+        favours none, so the rule would do nothing: refused, naming the agent."""
+        from mobee_drake.planning.explorers import ExplorerConfig
+        from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
+
+        agent = Agent(
+            name="arm",
+            joints=["a"],
+            space=FromGraph([[0.0], [1.0]], [(0, 1), (1, 0)]),
+            explorer=ExplorerConfig(),
+            maintenance=MaintenanceConfig(rules=["prune", "develop"]),
+        )
+        with self.assertRaisesRegex(ValueError, "agent 'arm': the rule 'develop' needs"):
             ExplorationSupervisor(
                 agents=[agent], joints=["a"], lower=np.array([-1.0]), upper=np.array([1.0]),
                 home=np.array([0.0]),
@@ -368,7 +403,7 @@ class TestTheReachLearner(unittest.TestCase):
     def test_a_round_on_the_reach_learners_space(self):
         """The learner's MDP (every try into state 3 missed, 6 of them) seen as an explorer's
         model: state 3 is pruned and the learner moves; its favoured states are those whose
-        reaches earned most over enough targets; a transition chain is shown to the
+        reaches earned most over enough different targets; a transition chain is shown to the
         maintenance from the log."""
         from mobee_drake.reaching.learner import ReachLearner
         from mobee_drake.reaching.reshaping import (
@@ -384,11 +419,12 @@ class TestTheReachLearner(unittest.TestCase):
         _Tried(explorer, 0, 1, 2)  # 0 -> 1 arrived twice
         learner = ReachLearner(SQUARE, explorer.transitions.counts, np.zeros((1, 3)))
         np.testing.assert_array_equal(ModelView(learner).tries, explorer.tries)
-        for state, rewards in ((0, [0.2, 0.4]), (1, [0.9]), (2, [0.1, 0.1])):
-            for reward in rewards:
-                learner.histories.Record(learner.Reach(state), np.zeros(3), 0.0, reward)
-        self.assertEqual(FavouredStates(learner, 2, 2), [0, 2])
+        # (state 0: two targets; 1: one; 2: one target twice)
+        for state, x, reward in ((0, 0, 0.2), (0, 1, 0.4), (1, 0, 0.9), (2, 0, 0.1), (2, 0, 0.1)):
+            learner.histories.Record(learner.Reach(state), np.array([x, 0, 0.0]), 0.0, reward)
+        self.assertEqual(FavouredStates(learner, 2, 2), [0])
         self.assertEqual(FavouredStates(learner, 5, 1), [1, 0, 2])
+        self.assertEqual(FavouredStates(learner, 2, 1), [1, 0])
         maintenance = Maintenance(MaintenanceConfig(rules=["prune"]), 4)
         self.assertTrue(MaintainReachSpace(learner, maintenance, 0, 50))
         self.assertEqual(learner.space.num_states, 3)

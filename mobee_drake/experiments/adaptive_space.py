@@ -50,6 +50,7 @@ import numpy as np
 from mobee_drake.atomic_files import CurrentGeneration
 from mobee_drake.experiments import adaptive_space_reaching as reaching_part
 from mobee_drake.experiments.adaptive_space_figures import History, WriteSpaceFigures
+from mobee_drake.experiments.adaptive_space_report import BySetting, ChangesCell, SpaceComparisons
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
 from mobee_drake.experiments.arms import (
     TARGET_RADIUS,
@@ -76,10 +77,9 @@ from mobee_drake.experiments.ch7_model_learning import ExploreJob, Stop
 from mobee_drake.experiments.ch8_reaching import ReachRobot
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
-from mobee_drake.experiments.statistics import PairedBySeed
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel, ObservedOutcomes
-from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
+from mobee_drake.planning.space_maintenance import RULES, ChangesByRule, MaintenanceConfig
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import ExploringAgent
 
@@ -175,10 +175,7 @@ def AdaptiveSpaceJob(
     )
     folder = run.path / "model"
     explorer = LoadAgentModel(str(folder), AGENT, ExplorerConfig())
-    saved = json.loads(((CurrentGeneration(folder) or folder) / f"{AGENT}.json").read_text())
-    changes = collections.Counter(
-        c["rule"] for c in saved.get("maintenance", {}).get("changes", [])
-    )
+    changes = _Changes(folder, f"{AGENT}.json") if condition == "maintained" else []
     error, tested = PredictionError(robot, explorer, tests, seed)
     done = explored.actions[0]
     nearest = Nearest(explorer, ValidConfigurations(arm))
@@ -196,7 +193,7 @@ def AdaptiveSpaceJob(
             tried_share=float(np.mean(explorer.tries > 0)),
             states=explorer.space.num_states,
             state_actions=explorer.space.num_state_actions,
-            changes={rule: changes.get(rule, 0) for rule in RULES},
+            changes=ChangesByRule(c["rule"] for c in changes),
             robot_seconds_per_action=explored.simulated_seconds / max(done, 1),
             wall_seconds=explored.wall_seconds,
             penetrating_steps=explored.penetrating_steps,
@@ -212,16 +209,11 @@ _MEASURES = {
 }
 
 
-def _Groups(runs: list[AdaptiveSpaceRun]) -> dict[tuple, list[AdaptiveSpaceRun]]:
-    """The runs by (robot, space, condition), each group in seed order."""
-    group = collections.defaultdict(list)
-    for r in sorted(runs, key=lambda r: r.seed):
-        group[(r.robot, r.space, r.condition)].append(r)
-    return dict(sorted(group.items()))
+# A run's setting, its condition last.
+_SETTING = ("robot", "space", "condition")
 
 
 def _Row(key: tuple, rs: list[AdaptiveSpaceRun]) -> str:
-    changes = "/".join(f"{np.mean([r.changes.get(rule, 0) for r in rs]):.0f}" for rule in RULES)
     return (
         f"| {' | '.join(key)} | {len(rs)} | {np.mean([r.actions for r in rs]):.0f} | "
         f"{100 * np.mean([r.coverage for r in rs]):.1f} % | "
@@ -230,27 +222,17 @@ def _Row(key: tuple, rs: list[AdaptiveSpaceRun]) -> str:
         f"({np.mean([r.tests for r in rs]):.0f}) | "
         f"{100 * np.mean([r.tried_share for r in rs]):.0f} % | "
         f"{np.mean([r.states for r in rs]):.0f} | "
-        f"{np.mean([r.state_actions for r in rs]):.0f} | {changes} | "
+        f"{np.mean([r.state_actions for r in rs]):.0f} | {ChangesCell(rs)} | "
         f"{np.mean([r.robot_seconds_per_action for r in rs]):.2f} | "
         f"{sum(r.penetrating_steps for r in rs)} | "
         f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
     )
 
 
-def MaintainedMinusFixed(group: dict, keys: list[tuple], measures: dict) -> list[str]:
-    """Report lines: for each key (``group``'s keys are a key and a condition), maintained
-    minus fixed on each of ``measures`` (run -> value), paired by seed, Holm over them all."""
-    families = {
-        " ".join(key): (group.get((*key, "maintained"), []), group.get((*key, "fixed"), []))
-        for key in keys
-    }
-    return PairedBySeed(families, measures, "Maintained minus fixed")
-
-
 def Report(runs: list[AdaptiveSpaceRun], roadmaps: dict[str, dict], command: str) -> str:
     """The report's table, the trm spaces' roadmaps (``roadmaps``: per robot, its roadmap
     job's result) and the paired comparisons (markdown)."""
-    group = _Groups(runs)
+    group = BySetting(runs, _SETTING)
     lines = [
         "| robot | space | condition | runs | actions | coverage | dispersion "
         "| prediction error (tests) | state-actions tried | states | state-actions "
@@ -260,7 +242,7 @@ def Report(runs: list[AdaptiveSpaceRun], roadmaps: dict[str, dict], command: str
         *(_Row(key, rs) for key, rs in group.items()),
     ]
     lines += RoadmapLines(roadmaps)
-    lines += MaintainedMinusFixed(group, sorted({(r.robot, r.space) for r in runs}), _MEASURES)
+    lines += SpaceComparisons(group, "rank4", _MEASURES)
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
 
 
@@ -323,7 +305,7 @@ def _Parser() -> CommandParser:
     exploration.add_argument(
         "--trm-states",
         type=PositiveInt,
-        default=256,
+        default=len(Lattice(LATTICES["rank4"], 4).centres),  # (both arms move 4 joints)
         help="the trm space: at most this many states (the rank-4 lattice's number, by default)",
     )
     exploration.add_argument("--actions", type=PositiveInt, default=2000, help="per run")
@@ -364,7 +346,7 @@ def _InitialCentres(arm: Arm, robot: str, space: str, output: pathlib.Path) -> n
 def SpaceHistories(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> dict[str, list]:
     """Per robot, the history of its first seed's maintained run on each space."""
     arms, histories = Arms(), collections.defaultdict(list)
-    for (robot, space, condition), rs in _Groups(runs).items():
+    for (robot, space, condition), rs in BySetting(runs, _SETTING).items():
         if condition != "maintained":
             continue
         run = output / "runs" / f"{robot}_{space}_maintained_seed{rs[0].seed}" / "model"
@@ -498,6 +480,11 @@ def main(argv: list[str] | None = None) -> None:
         except (OSError, ValueError) as error:
             parser.error(str(error))
     rules = args.rules or (MaintenanceConfig().rules if exploring else list(RULES))
+    if exploring and "develop" in rules:
+        parser.error(
+            "--rules develop: the exploration part's agent favours no states "
+            "(the rule is the reach learner's: --part reaching)"
+        )
     maintenance = MaintenanceConfig(
         every=args.every,
         rules=list(rules),

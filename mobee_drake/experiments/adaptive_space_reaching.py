@@ -23,11 +23,11 @@ fixed on each space, and the roadmap minus the lattice (both fixed), are compare
 seed, Holm-corrected over them all (the robots, spaces, strategies and the two measures: reward
 with penalties, robot hours)."""
 
-import collections
 import dataclasses as dc
 
 import numpy as np
 
+from mobee_drake.experiments.adaptive_space_report import BySetting, ChangesCell, SpaceComparisons
 from mobee_drake.experiments.arguments import PositiveFloat, PositiveInt
 from mobee_drake.experiments.arms import RoadmapFolder, RoadmapJobOf, RoadmapLines
 from mobee_drake.experiments.battery import Job, RunFolder, StopRequested
@@ -41,7 +41,7 @@ from mobee_drake.experiments.ch8_reaching import (
     RunOne,
     RunSettings,
 )
-from mobee_drake.experiments.statistics import PairedBySeed, RunMeans
+from mobee_drake.experiments.statistics import RunMeans
 from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
 from mobee_drake.planning.state_space import Lattice
 
@@ -235,42 +235,27 @@ def Report(
     :class:`~mobee_drake.reaching.targets.TargetGrid` and, per space, each target's distance to
     the nearest state's marker, :func:`~mobee_drake.experiments.arms.TargetGaps`), the targets
     and how near each space comes to them (markdown)."""
-    group = collections.defaultdict(list)
-    for r in sorted(runs, key=lambda r: r.seed):
-        group[(r.robot, r.space, r.strategy, r.condition)].append(r)
+    group = BySetting(runs, ("robot", "space", "strategy", "condition"))
     lines = [
         "| robot | space | strategy | condition | runs | problem-tries | summed reward | without "
         f"the -10s | robot hours | states | transitions | changes ({'/'.join(RULES)}) "
         f"| {PENETRATION_HEADER} | wall s per run |",
         "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|",
     ]
-    for (robot, space, strategy, condition), rs in sorted(group.items()):
-        changes = "/".join(f"{np.mean([r.changes.get(c, 0) for r in rs]):.0f}" for c in RULES)
+    for (robot, space, strategy, condition), rs in group.items():
         lines.append(
             f"| {robot} | {space} | {strategy} | {condition} | {len(rs)} | {rs[0].stage} | "
             f"{np.mean([r.reward for r in rs]):.2f} | "
             f"{np.mean([r.reward_without_penalties for r in rs]):.2f} | "
             f"{np.mean([r.robot_hours for r in rs]):.2f} | "
             f"{np.mean([r.states for r in rs]):.0f} | "
-            f"{np.mean([r.transitions for r in rs]):.0f} | {changes} | "
+            f"{np.mean([r.transitions for r in rs]):.0f} | {ChangesCell(rs)} | "
             f"{PenetrationCell(rs)} | "
             f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
         )
     measures = {"summed reward": lambda r: r.reward, "robot hours": lambda r: r.robot_hours}
-    families = {
-        f"{robot} {space} {strategy}, maintained minus fixed": (
-            group[(robot, space, strategy, "maintained")], group[(robot, space, strategy, "fixed")]
-        )
-        for robot, space, strategy in sorted({(r.robot, r.space, r.strategy) for r in runs})
-    }  # fmt: skip
-    for robot, strategy in sorted({(r.robot, r.strategy) for r in runs}):
-        families[f"{robot} {strategy}, trm minus rank3 (both fixed)"] = (
-            group[(robot, "trm", strategy, "fixed")], group[(robot, "rank3", strategy, "fixed")]
-        )  # fmt: skip
     lines += RoadmapLines(roadmaps or {})
-    both = {r.space for r in runs} >= {"rank3", "trm"}
-    heading = "Maintained minus fixed" + (" and trm minus rank3" if both else "")
-    lines += PairedBySeed(families, measures, heading)
+    lines += SpaceComparisons(group, "rank3", measures)
     for robot, (grid, gaps) in (targets or {}).items():
         levels = ", ".join(f"{axis} {'/'.join(f'{v:.2f}' for v in getattr(grid, axis))}"
                            for axis in "xyz")  # fmt: skip

@@ -12,9 +12,10 @@ about a state-action that stays is lost, and new ones start as the agent's first
 
 The rules (:class:`MaintenanceConfig` holds their parameters):
 
-- ``prune``: a state no action has ever arrived in, after ``prune_after`` tries of the actions
-  into it, is dropped with every action into or out of it (the lattice's states beyond the
-  shoulder's cable constraints, ch. 7.3). The state the robot is in is never dropped.
+- ``prune``: a state the robot was never in (no action arrived in it, none was tried from it),
+  after ``prune_after`` tries of the actions into it, is dropped with every action into or out
+  of it (the lattice's states beyond the shoulder's cable constraints, ch. 7.3). The state the
+  robot is in is never dropped.
 - ``drop``: a transition tried ``drop_after`` times that missed its goal on at least
   ``drop_miss_share`` of them is removed, unless it is its state's last action.
 - ``shortcut``: when the agent has gone from a state through a second to a third, not a
@@ -29,6 +30,8 @@ The rules (:class:`MaintenanceConfig` holds their parameters):
   neighbours: the regions that matter get more states.
 """
 
+import collections
+from collections.abc import Iterable
 import dataclasses as dc
 
 import numpy as np
@@ -57,10 +60,10 @@ class MaintenanceConfig:
     drop_miss_share: float = 0.8
     # shortcut: chains of two arriving actions from one state to a third before the shortcut.
     shortcut_after: int = 5
-    # develop: the learner's favoured states developed per round, and the records a state
-    # needs to be favoured (the reach learner: its reach's recorded targets).
+    # develop: the learner's favoured states developed per round, and the different targets
+    # a state's reach needs records of to be favoured (the reach learner's).
     develop_top: int = 3
-    develop_min_records: int = 5
+    develop_min_targets: int = 5
     # A new state is at least this far (fractions of range) from every other.
     min_spacing: float = 0.05
     # The space grows while it has fewer states than this (0: no limit).
@@ -81,8 +84,8 @@ class MaintenanceConfig:
                 errors.append(f"{name} must be >= 1, got {getattr(self, name)}")
         if not 0 < self.drop_miss_share <= 1:
             errors.append(f"drop_miss_share must be in (0, 1], got {self.drop_miss_share}")
-        if self.develop_min_records < 0:
-            errors.append(f"develop_min_records must be >= 0, got {self.develop_min_records}")
+        if self.develop_min_targets < 0:
+            errors.append(f"develop_min_targets must be >= 0, got {self.develop_min_targets}")
         if not self.min_spacing > 0:
             errors.append(f"min_spacing must be > 0, got {self.min_spacing}")
         return errors
@@ -183,15 +186,19 @@ class Maintenance:
         self.config = config
         # chains[a, c]: how often the agent went a -> b -> c, each action arriving.
         self.chains = np.zeros((num_states, num_states), dtype=int)
-        self._previous = -1  # the start of the last action, if it arrived (else -1)
+        # The start and the end of the last action, if it arrived (else -1, -1).
+        self._previous, self._arrival = -1, -1
         self.changes: list[SpaceChange] = []
 
     def Observe(self, space: StateActionSpace, state: int, state_action: int, outcome: int):
-        """Notes an action's outcome (the agent's model observes it separately)."""
+        """Notes an action's outcome (the agent's model observes it separately). A chain is
+        two arriving actions, the second from where the first arrived (a reach, or a new
+        problem's target pushing the arm, may leave the robot elsewhere)."""
         arrived = outcome == space.action_goal[state_action]
-        if arrived and self._previous >= 0 and self._previous != outcome:
+        chained = self._previous >= 0 and state == self._arrival
+        if arrived and chained and self._previous != outcome:
             self.chains[self._previous, outcome] += 1
-        self._previous = state if arrived else -1
+        self._previous, self._arrival = (state, int(outcome)) if arrived else (-1, -1)
 
     def Due(self, actions_done: int) -> bool:
         """Whether a round is due after ``actions_done`` actions."""
@@ -232,7 +239,9 @@ class Maintenance:
             if change.rule == "shortcut":  # (an action now: no chain to count)
                 self.chains[change.states] = 0
         self.chains = _Moved(self.chains, edit.state_index, edit.space.num_states)
-        self._previous = edit.state_index[self._previous] if self._previous >= 0 else -1
+        self._previous, self._arrival = (
+            int(edit.state_index[s]) if s >= 0 else -1 for s in (self._previous, self._arrival)
+        )
         self.changes += changes
         return edit
 
@@ -269,7 +278,9 @@ class Maintenance:
                 (u, r) for u in pruned for r in space.action_state[space.action_goal == u]
                 if r not in pruned
             ]  # fmt: skip
-            changes += _Halfway(space, config, pairs, "grow", actions_done, [], self._Pruned())
+            changes += _Halfway(
+                space, config, pairs, "grow", actions_done, [], self._Pruned(), len(pruned)
+            )
         if "develop" in rules:  # (from each favoured state to each of its neighbours)
             pairs = [
                 (g, f) for f in favoured if f not in pruned
@@ -277,14 +288,15 @@ class Maintenance:
             ]  # fmt: skip
             grown = [c for c in changes if c.rule == "grow"]
             changes += _Halfway(
-                space, config, pairs, "develop", actions_done, grown, self._Pruned()
+                space, config, pairs, "develop", actions_done, grown, self._Pruned(), len(pruned)
             )
         return changes
 
     def ToData(self) -> tuple[np.ndarray, dict]:
         """(the chain counts, the rest as JSON-able data), for a checkpoint."""
         changes = [dc.asdict(c) for c in self.changes]
-        return self.chains.copy(), dict(previous=int(self._previous), changes=changes)
+        previous, arrival = int(self._previous), int(self._arrival)
+        return self.chains.copy(), dict(previous=previous, arrival=arrival, changes=changes)
 
     @classmethod
     def FromData(cls, config: MaintenanceConfig, chains, data: dict) -> "Maintenance":
@@ -292,6 +304,8 @@ class Maintenance:
         maintenance = cls(config, len(chains))
         maintenance.chains = np.array(chains, dtype=int)
         maintenance._previous = data["previous"]
+        # (a checkpoint from before the arrival was kept: the start's action arrived, there)
+        maintenance._arrival = data.get("arrival", -1)
         maintenance.changes = [
             SpaceChange(**dict(c, states=tuple(c["states"]), centre=tuple(c["centre"])))
             for c in data["changes"]
@@ -309,17 +323,25 @@ class Maintenance:
         return [(int(a), int(c)) for a, c in often if (a, c) not in linked]
 
 
+def ChangesByRule(rules: Iterable[str]) -> dict[str, int]:
+    """How many changes each rule made, ``rules`` naming each change's rule."""
+    counts = collections.Counter(rules)
+    return {rule: counts.get(rule, 0) for rule in RULES}
+
+
 def _ActionOf(space: StateActionSpace, state: int, goal: int) -> int:
     actions = space.Actions(state)
     return int(actions[space.action_goal[actions] == goal][0])
 
 
 def _Prunable(explorer: Explorer, config: MaintenanceConfig, state: int) -> list[int]:
-    """States never arrived in whose incoming actions were tried ``prune_after`` times."""
-    space = explorer.space
+    """States the robot was never in (no action arrived there, none was tried from there: the
+    start) whose incoming actions were tried ``prune_after`` times."""
+    space, m = explorer.space, explorer.space.num_states
     arrived = ObservedOutcomes(explorer).sum(axis=0) > 0
-    tried_into = np.bincount(space.action_goal, weights=explorer.tries, minlength=space.num_states)
-    prunable = ~arrived & (tried_into >= config.prune_after)
+    acted_from = np.bincount(space.action_state, weights=explorer.tries, minlength=m) > 0
+    tried_into = np.bincount(space.action_goal, weights=explorer.tries, minlength=m)
+    prunable = ~arrived & ~acted_from & (tried_into >= config.prune_after)
     prunable[state] = False
     return np.flatnonzero(prunable).tolist()
 
@@ -352,17 +374,19 @@ def _Halfway(
     actions_done: int,
     earlier: list[SpaceChange],
     pruned_before: np.ndarray,
+    pruning: int,
 ) -> list[SpaceChange]:
     """New states halfway along each (far, near) pair of states, as ``rule``'s changes (their
     states: (far, near)), none nearer than ``min_spacing`` to another state (old, ``earlier``'s
     or new) or to a state pruned in an earlier round (``pruned_before``), and only while the
-    space stays under ``max_states``."""
+    space, less the ``pruning`` states this round prunes, has fewer than ``max_states``."""
     centres, made = space.centres, []
     if len(pruned_before):
         centres = np.vstack([centres, pruned_before])
     for far, near in pairs:
         placed = earlier + made
-        if config.max_states and space.num_states + len(placed) >= config.max_states:
+        size = space.num_states - pruning + len(placed)
+        if config.max_states and size >= config.max_states:
             break
         middle = (centres[near] + centres[far]) / 2
         others = np.vstack([centres, [c.centre for c in placed]]) if placed else centres

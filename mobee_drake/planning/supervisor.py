@@ -157,6 +157,11 @@ class ExplorationSupervisor(LeafSystem):
                     f"agents; strategy '{agent.explorer.strategy}' heads for a goal state, "
                     "whose number a round would change"
                 )
+            if agent.maintenance is not None and "develop" in agent.maintenance.rules:
+                raise ValueError(
+                    f"agent '{agent.name}': the rule 'develop' needs a learner that favours "
+                    "states (the reach learner's); an exploring agent favours none"
+                )
             self._columns.append(np.array([joints.index(j) for j in agent.joints]))
         claimed = np.concatenate(self._columns) if self._columns else np.zeros(0, dtype=int)
         if len(set(claimed.tolist())) != len(claimed):

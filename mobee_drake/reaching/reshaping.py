@@ -4,7 +4,8 @@ A round of :class:`~mobee_drake.planning.space_maintenance.Maintenance` reads th
 as an explorer's model (its outcome counts; the tries of each transition are the outcomes it
 observed), and the states the learner favours: "certain states, from which reach actions worked
 well to a wide range of target locations" (ch. 9.4.5), here the ``develop_top`` states whose
-reaches have the highest mean reward over at least ``develop_min_records`` recorded targets.
+reaches have the highest mean reward, among those recorded for at least
+``develop_min_targets`` different targets.
 The edit moves the MDP's counts (:func:`~mobee_drake.planning.space_maintenance.CarryExplorer`)
 and the learner (:meth:`~mobee_drake.reaching.learner.ReachLearner.Reshape`) onto the new
 space.
@@ -17,8 +18,8 @@ import numpy as np
 
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig, ObservedOutcomes
 from mobee_drake.planning.space_maintenance import (
-    RULES,
     CarryExplorer,
+    ChangesByRule,
     Maintenance,
     MaintenanceConfig,
 )
@@ -26,22 +27,24 @@ from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.reaching.learner import ReachLearner
 
 
-def ModelView(learner: ReachLearner, config: ExplorerConfig | None = None) -> Explorer:
-    """The learner's MDP as an explorer's model (``config``: the initialisation it was learned
-    with, 50-50 by default): its counts, and as tries the outcomes each transition observed."""
-    view = Explorer(learner.space, config or ExplorerConfig())
+def ModelView(learner: ReachLearner) -> Explorer:
+    """The learner's MDP as an explorer's model under the initialisation ch. 8's MDPs are
+    learned with (the default's): its counts, and as tries the outcomes each transition
+    observed."""
+    view = Explorer(learner.space, ExplorerConfig())
     view.transitions.counts[...] = learner.model.counts
     view.tries[...] = ObservedOutcomes(view).sum(axis=1)
     return view
 
 
-def FavouredStates(learner: ReachLearner, top: int, min_records: int) -> list[int]:
-    """The ``top`` states whose reaches' mean reward is highest, among those with at least
-    ``min_records`` records (fewer if fewer qualify), best first."""
+def FavouredStates(learner: ReachLearner, top: int, min_targets: int) -> list[int]:
+    """The ``top`` states whose reaches' mean reward is highest, among those whose reaches
+    were recorded for at least ``min_targets`` different targets ("a wide range of target
+    locations", ch. 9.4.5; fewer states if fewer qualify), best first."""
     means = {}
     for state in range(learner.space.num_states):
-        _, rewards = learner.histories.Records(learner.Reach(state))
-        if len(rewards) >= min_records:
+        targets, rewards = learner.histories.Records(learner.Reach(state))
+        if len(rewards) and len(np.unique(targets, axis=0)) >= min_targets:
             means[state] = float(np.mean(rewards))
     return sorted(means, key=lambda s: -means[s])[:top]
 
@@ -51,11 +54,11 @@ def MaintainReachSpace(
 ) -> bool:
     """A round of ``maintenance`` on the learner's space, the robot in ``state`` after ``done``
     problem-tries (its favoured states by the config's ``develop_top`` and
-    ``develop_min_records``); whether the space changed (then the learner is on the new
+    ``develop_min_targets``); whether the space changed (then the learner is on the new
     one)."""
     config = maintenance.config
     view = ModelView(learner)
-    favoured = FavouredStates(learner, config.develop_top, config.develop_min_records)
+    favoured = FavouredStates(learner, config.develop_top, config.develop_min_targets)
     edit = maintenance.Plan(view, state, done, favoured)
     if edit is None:
         return False
@@ -117,11 +120,8 @@ class ReachSpaceKeeper:
 
     def Summary(self, learner: ReachLearner) -> dict:
         """The space at the end: states, state-actions (transitions) and changes by rule."""
-        changes = {rule: 0 for rule in RULES}
-        for change in self.maintenance.changes:
-            changes[change.rule] += 1
         return dict(
             states=learner.space.num_states,
             transitions=learner.num_transitions,
-            changes=changes,
+            changes=ChangesByRule(c.rule for c in self.maintenance.changes),
         )

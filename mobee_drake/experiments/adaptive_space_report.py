@@ -1,0 +1,51 @@
+"""What both parts of the adaptive-space experiment (issue 38) report alike: the runs by
+setting, the changes of a space by rule, and the families of paired comparisons (maintained
+minus fixed on each space; the roadmap minus the lattice, both fixed)."""
+
+import collections
+from collections.abc import Iterable
+
+import numpy as np
+
+from mobee_drake.experiments.statistics import PairedBySeed
+from mobee_drake.planning.space_maintenance import RULES
+
+
+def BySetting(runs: Iterable, fields: tuple[str, ...]) -> dict[tuple, list]:
+    """The runs by their values of ``fields`` (the last the condition), sorted; each group in
+    seed order."""
+    groups = collections.defaultdict(list)
+    for r in sorted(runs, key=lambda r: r.seed):
+        groups[tuple(getattr(r, f) for f in fields)].append(r)
+    return dict(sorted(groups.items()))
+
+
+def ChangesCell(runs: list) -> str:
+    """A report cell: the runs' mean changes per rule, in the order of ``RULES``."""
+    return "/".join(f"{np.mean([r.changes.get(rule, 0) for r in runs]):.0f}" for rule in RULES)
+
+
+def SpaceComparisons(groups: dict[tuple, list], lattice: str, measures: dict) -> list[str]:
+    """Report lines: the paired comparisons of ``groups`` (:func:`BySetting`'s, keyed by
+    robot, space, any other fields, then condition) on each of ``measures`` (run -> value): on
+    each space, maintained minus fixed; and where both ran, the roadmap ("trm") minus
+    ``lattice``, both fixed; Holm over them all."""
+    families = _Families(groups, lattice)
+    both = any("trm minus" in family for family in families)
+    heading = "Maintained minus fixed" + (f" and trm minus {lattice}" if both else "")
+    return PairedBySeed(families, measures, heading)
+
+
+def _Families(groups: dict[tuple, list], lattice: str) -> dict[str, tuple[list, list]]:
+    families = {}
+    for robot, space, *more in sorted({key[:-1] for key in groups}):
+        name = " ".join([robot, space, *more]) + ", maintained minus fixed"
+        families[name] = tuple(
+            groups.get((robot, space, *more, condition), [])
+            for condition in ("maintained", "fixed")
+        )
+    for robot, *more in sorted({(key[0], *key[2:-1]) for key in groups}):
+        trm, grid = (groups.get((robot, space, *more, "fixed"), []) for space in ("trm", lattice))
+        if trm and grid:
+            families[" ".join([robot, *more]) + f", trm minus {lattice} (both fixed)"] = (trm, grid)
+    return families
