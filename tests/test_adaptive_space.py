@@ -21,15 +21,16 @@ from mobee_drake.reaching.targets import LoadTargetGrid
 
 
 class TestMeasures(unittest.TestCase):
-    def test_the_distance_to_the_nearest_arrived_in_state(self):
-        """Only state 0 (0.25, 0.25) of the square was arrived in: the valid configurations'
-        distances are to it alone, state 3 (never arrived in) does not count."""
+    def test_the_distance_to_the_nearest_state_the_robot_was_in(self):
+        """The robot was in states 0 (0.25, 0.25: arrived in) and 1 (0.25, 0.75: acted from)
+        of the square: the valid configurations' distances are to them alone; state 3 (0.75,
+        0.75: never there) does not count."""
         explorer = Explorer(Lattice([0.25, 0.75], 2))
         explorer.Observe(2, 0)  # 1 -> 0 arrived
         explorer.Observe(0, 0)  # 0 -> 1 stayed in 0
         valid = np.array([[0.25, 0.25], [0.3, 0.3], [0.75, 0.75]])
         np.testing.assert_allclose(
-            adaptive_space.Nearest(explorer, valid), [0.0, 0.05 * np.sqrt(2), 0.5 * np.sqrt(2)]
+            adaptive_space.Nearest(explorer, valid), [0.0, 0.05 * np.sqrt(2), 0.5]
         )
         fresh = Explorer(explorer.space)
         self.assertTrue(np.all(np.isinf(adaptive_space.Nearest(fresh, valid))))
@@ -147,13 +148,13 @@ class TestSmokeBattery(FigureTest):
         self.assertFalse(self.output.exists())
 
     def test_the_smoke_battery(self):
-        """2 seeds x 30 actions on the rank-4 lattice and on a roadmap of 12 states, fixed and
-        maintained every 10 actions (a state pruned after one try into it): every run reports;
-        on the lattice only the maintained ones change their space, and its size in the report
-        is what the runs ended with; no penetration."""
+        """2 seeds x 30 actions on the rank-4 lattice and on a roadmap of 12 states, on both
+        arms, fixed and maintained every 5 actions (a state pruned after one try into it), no
+        round at the end: every run reports; on the lattice only the maintained ones change
+        their space, and its size in the report is what the runs ended with; no penetration."""
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             adaptive_space.main(
-                ["--seeds", "2", "--actions", "30", "--tests", "3", "--every", "10",
+                ["--seeds", "2", "--actions", "30", "--tests", "3", "--every", "5",
                  "--prune-after", "1", "--spaces", "rank4", "trm", "--trm-spacing", "0.6",
                  "--trm-states", "12", "--robots", "icub", "katana", "--output",
                  str(self.output), "--workers", "2"]
@@ -186,6 +187,10 @@ class TestSmokeBattery(FigureTest):
                 maintained = run.condition == "maintained"
                 self.assertEqual(sum(run.changes.values()) > 0, maintained)
                 self.assertEqual(run.states != 256, maintained)
+                if maintained:  # (rounds at 5, 10, ... 25, none at the run's end: 30)
+                    folder = self.output / "runs" / f"icub_rank4_maintained_seed{run.seed}"
+                    changes = adaptive_space._Changes(folder / "model", "right_arm.json")
+                    self.assertLessEqual({c["actions_done"] for c in changes}, {5, 10, 15, 20, 25})
         report = (self.output / "report.md").read_text()
         maintained = [r for r in runs if r.condition == "maintained"]
         states = np.mean([r.states for r in maintained])
@@ -218,14 +223,14 @@ class TestTheReachLearnersSpace(unittest.TestCase):
 
     @staticmethod
     def _Reaching(output: pathlib.Path, seeds: int, tries: int, *arguments: str) -> None:
-        """The reaching part, greedy, with the MDP learned with the reaches and ``develop`` a
-        round every half run, quietly."""
+        """The reaching part, greedy, with the MDP learned with the reaches and ``develop`` (a
+        target recorded enough) a round at half the run, quietly."""
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             adaptive_space.main(
                 ["--part", "reaching", "--mdp", "simultaneous", "--strategies", "greedy",
                  "--seeds", str(seeds), "--problem-tries", str(tries), "--stages", str(tries),
                  "--evaluations", "1", "--every", str(tries // 2), "--rules", "develop",
-                 "--output", str(output), *arguments]
+                 "--develop-min-targets", "1", "--output", str(output), *arguments]
             )  # fmt: skip
 
     def test_the_reaching_smoke_battery(self):
@@ -347,6 +352,39 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         self.assertIn("icub greedy, trm minus rank3 (both fixed), summed reward: +1.5", reward)
         self.assertIn("robot hours: -0.25", hours)
         self.assertIn("(Holm over the 2)", report)
+
+    def test_a_stage_is_evaluated_before_its_round(self):
+        """A round due every 4 problem-tries, stages at 4 and 8 (the last): each stage's
+        evaluation sees the space the learner explored, so the round at 4 follows its
+        evaluation, and there is none at 8."""
+        from unittest import mock
+
+        from mobee_drake.experiments.ch8_reaching import RunOne, RunSettings
+        from mobee_drake.planning.space_maintenance import MaintenanceConfig
+        from mobee_drake.reaching import reshaping
+        from mobee_drake.reaching.learner import ReachLearner
+
+        calls, maintain = [], reshaping.MaintainReachSpace
+
+        def Evaluating(learner, robot, seed, targets=None):
+            calls.append(("evaluation", int(learner.problem_tries.sum())))
+            return []  # (what is evaluated does not matter here: when)
+
+        def Maintaining(learner, maintenance, state, done):
+            calls.append(("round", done))
+            return maintain(learner, maintenance, state, done)
+
+        settings = RunSettings(
+            strategy="greedy", seed=0, problem_tries=8, stages=[4, 8], evaluations=1,
+            checkpoint_every=3, mdp="simultaneous",
+        )  # fmt: skip
+        maintenance = MaintenanceConfig(every=4, rules=["develop"], develop_min_targets=1)
+        with (
+            mock.patch.object(ReachLearner, "Evaluate", Evaluating),
+            mock.patch.object(reshaping, "MaintainReachSpace", Maintaining),
+        ):
+            RunOne(self.output / "run", self.output, settings, maintenance=maintenance)
+        self.assertEqual(calls, [("evaluation", 4), ("round", 4), ("evaluation", 8)])
 
     def test_a_reshaping_run_resumes_exactly(self):
         """A random run whose space is maintained every 2 problem-tries by all five rules (set

@@ -1,6 +1,7 @@
 """A state-action space that reshapes itself (ch. 9.4.5): each rule and the carried-over model
 against closed forms on small spaces."""
 
+import json
 import pathlib
 import unittest
 
@@ -18,6 +19,11 @@ from mobee_drake.planning.state_space import FromGraph, Lattice
 # The square: states 0 (0.25, 0.25), 1 (0.25, 0.75), 2 (0.75, 0.25), 3 (0.75, 0.75); actions
 # 0: 0->1, 1: 0->2, 2: 1->0, 3: 1->3, 4: 2->0, 5: 2->3, 6: 3->1, 7: 3->2.
 SQUARE = Lattice([0.25, 0.75], 2)
+
+
+def _Action(space, state: int, goal: int) -> int:
+    (action,) = [a for a in space.Actions(state) if space.action_goal[a] == goal]
+    return int(action)
 
 
 def _Tried(explorer: Explorer, state_action: int, outcome: int, times: int) -> None:
@@ -202,6 +208,30 @@ class TestTheRules(unittest.TestCase):
             Maintenance(MaintenanceConfig(drop_miss_share=0.0), 4)
         self.assertTrue(Maintenance(MaintenanceConfig(every=50), 4).Due(100))
         self.assertFalse(Maintenance(MaintenanceConfig(every=0), 4).Due(100))
+        until = Maintenance(MaintenanceConfig(every=50, until=100), 4)
+        self.assertEqual([until.Due(n) for n in (50, 100, 150)], [True, False, False])
+        with self.assertRaisesRegex(ValueError, "until must be >= 0"):
+            Maintenance(MaintenanceConfig(until=-1), 4)
+
+    def test_a_dropped_transition_never_comes_back_as_a_shortcut(self):
+        """On a line 0 - 1 - 2 with a direct 0 -> 2: 0 -> 2 missed 5 of 5 and is dropped; the
+        chains 0 -> 1 -> 2 then taken 5 times do not bring it back (nor after a checkpoint)."""
+        line = FromGraph([[0.0], [0.5], [1.0]], [(0, 1), (1, 2), (0, 2)])
+        explorer = Explorer(line)
+        zero_two = _Action(line, 0, 2)
+        _Tried(explorer, zero_two, 0, 5)
+        config = MaintenanceConfig(rules=["drop", "shortcut"], shortcut_after=5)
+        maintenance = Maintenance(config, 3)
+        explorer, _ = maintenance.Apply(explorer, 0, 100)
+        self.assertEqual([(c.rule, c.states) for c in maintenance.changes], [("drop", (0, 2))])
+        space = explorer.space
+        for _ in range(5):
+            maintenance.Observe(space, 0, _Action(space, 0, 1), 1)
+            maintenance.Observe(space, 1, _Action(space, 1, 2), 2)
+        self.assertEqual(maintenance.chains[0, 2], 5)
+        resumed = Maintenance.FromData(config, *maintenance.ToData())
+        for m in (maintenance, resumed):
+            self.assertIsNone(m.Plan(explorer, 0, 200))
 
 
 class TestARoadmapSpace(unittest.TestCase):
@@ -262,7 +292,7 @@ class TestOnTheSupervisor(unittest.TestCase):
                 home=np.array([0.0]),
             )  # fmt: skip
 
-    def _Dut(self):
+    def _Dut(self, maintenance=None):
         from mobee_drake.planning.explorers import ExplorerConfig
         from mobee_drake.planning.supervisor import ActionTiming, Agent, ExplorationSupervisor
 
@@ -272,7 +302,8 @@ class TestOnTheSupervisor(unittest.TestCase):
             joints=["a"],
             space=line,
             explorer=ExplorerConfig(strategy="least_tried"),
-            maintenance=MaintenanceConfig(every=4, rules=["prune", "grow"], prune_after=2),
+            maintenance=maintenance
+            or MaintenanceConfig(every=4, rules=["prune", "grow"], prune_after=2),
         )
         return ExplorationSupervisor(
             agents=[agent],
@@ -283,8 +314,13 @@ class TestOnTheSupervisor(unittest.TestCase):
             timing=ActionTiming(settle_time=0.0, min_duration=0.0),
         )
 
-    def _Poll(self, dut, context, actions: int) -> None:
-        for _ in range(actions):  # (each poll ends an action: the robot is still)
+    def _Poll(self, dut, context, actions: int, follow: bool = False) -> None:
+        """Polls that each end an action (the robot is still); with ``follow`` the robot is
+        where the attractor sends it, so each action arrives."""
+        for _ in range(actions):
+            if follow:
+                attractor = dut.GetOutputPort("attractor").Eval(context)
+                dut.GetInputPort("robot_state").FixValue(context, [attractor[0], 0.0])
             context.SetTime(context.get_time() + 0.2)
             dut.CalcForcedUnrestrictedUpdate(context, context.get_mutable_state())
 
@@ -316,31 +352,90 @@ class TestOnTheSupervisor(unittest.TestCase):
             ["agent.arm.states", "agent.arm.state_actions", "agent.arm.space_changes"],
         )
 
-    def test_a_checkpoint_keeps_the_space_and_its_maintenance(self):
-        """Saved after 6 actions and read into a new supervisor, the run goes on exactly as
-        the one not interrupted."""
+    def _Resumed(self, maintenance, actions: int, follow: bool):
+        """(the run not interrupted, the run saved after ``actions`` and read into a new
+        supervisor), each ``actions`` more; and the maintenance as it was saved."""
         import tempfile
 
-        straight, resumed = self._Dut(), self._Dut()
+        straight, resumed = self._Dut(maintenance), self._Dut(maintenance)
         contexts = []
         for dut in (straight, resumed):
             context = dut.CreateDefaultContext()
             dut.GetInputPort("robot_state").FixValue(context, [0.0, 0.0])
             dut.ExecuteInitializationEvents(context)
             contexts.append(context)
-        self._Poll(straight, contexts[0], 6)
+        self._Poll(straight, contexts[0], actions, follow)
+        (saved,) = straight.Records(contexts[0])
+        saved = saved.maintenance.ToData()
         with tempfile.TemporaryDirectory() as folder:
             straight.WriteCheckpoint(contexts[0], pathlib.Path(folder))
             resumed.ReadCheckpoint(contexts[1], pathlib.Path(folder))
         contexts[1].SetTime(contexts[0].get_time())
+        where = straight.GetInputPort("robot_state").Eval(contexts[0])  # (the robot stays)
+        resumed.GetInputPort("robot_state").FixValue(contexts[1], where)
         for dut, context in zip((straight, resumed), contexts):
-            self._Poll(dut, context, 6)
+            self._Poll(dut, context, actions, follow)
         (a,), (b,) = (dut.Records(c) for dut, c in zip((straight, resumed), contexts))
         np.testing.assert_array_equal(a.explorer.space.centres, b.explorer.space.centres)
         np.testing.assert_array_equal(a.explorer.transitions.counts, b.explorer.transitions.counts)
         np.testing.assert_array_equal(a.maintenance.chains, b.maintenance.chains)
         self.assertEqual(a.maintenance.changes, b.maintenance.changes)
+        return a, saved
+
+    def test_a_model_learned_before_brings_its_maintenance(self):
+        """A run started from a maintained agent's saved model carries on its maintenance
+        (where it pruned: nothing grows back there), but no chain from the last run's last
+        action."""
+        import tempfile
+
+        from mobee_drake.planning.explorers import LoadAgentModel
+        from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor, SavedMaintenance
+
+        dut = self._Dut()
+        context = dut.CreateDefaultContext()
+        dut.GetInputPort("robot_state").FixValue(context, [0.0, 0.0])
+        dut.ExecuteInitializationEvents(context)
+        self._Poll(dut, context, 4)  # (the robot stays: a round prunes and grows)
+        self._Poll(dut, context, 2, follow=True)  # (then it arrives: a chain begins)
+        (record,) = dut.Records(context)
+        self.assertGreaterEqual(record.maintenance.ToData()[1]["previous"], 0)
+        config = MaintenanceConfig(every=4, rules=["prune", "grow"], prune_after=2)
+        with tempfile.TemporaryDirectory() as folder:
+            dut.WriteCheckpoint(context, pathlib.Path(folder))
+            model = LoadAgentModel(folder, "arm", record.explorer.config)
+            before = SavedMaintenance(folder, "arm", config)
+            saved = pathlib.Path(folder) / "arm.json"  # (as a fixed agent's: none)
+            saved.write_text(json.dumps(json.loads(saved.read_text()) | dict(maintenance=None)))
+            self.assertIsNone(SavedMaintenance(folder, "arm", config))
+        self.assertEqual(before.changes, record.maintenance.changes)
+        agent = Agent(
+            name="arm", joints=["a"], space=model.space, explorer=record.explorer.config,
+            model=model, maintenance=config, maintained_before=before,
+        )  # fmt: skip
+        again = ExplorationSupervisor(
+            agents=[agent], joints=["a"], lower=np.array([-1.0]), upper=np.array([1.0]),
+            home=np.array([0.0]),
+        )  # fmt: skip
+        context = again.CreateDefaultContext()
+        again.GetInputPort("robot_state").FixValue(context, [0.0, 0.0])
+        again.ExecuteInitializationEvents(context)
+        (started,) = again.Records(context)
+        self.assertEqual(started.maintenance.changes, record.maintenance.changes)
+        np.testing.assert_array_equal(started.maintenance.chains, record.maintenance.chains)
+        self.assertEqual(started.maintenance.ToData()[1]["previous"], -1)
+
+    def test_a_checkpoint_keeps_the_space_and_its_maintenance(self):
+        """Saved after 6 actions and read into a new supervisor, the run goes on exactly as
+        the one not interrupted: a robot that never moves (its space pruned and grown), and
+        one that arrives every time (chains counted into shortcuts: the checkpoint holds
+        chains and the last action's start and end)."""
+        a, _ = self._Resumed(None, 6, follow=False)
         self.assertEqual(len(a.maintenance.changes), 12)
+        chains = MaintenanceConfig(every=4, rules=["shortcut"], shortcut_after=2)
+        a, (saved_chains, saved) = self._Resumed(chains, 6, follow=True)
+        self.assertTrue(saved_chains.any())
+        self.assertGreaterEqual(min(saved["previous"], saved["arrival"]), 0)
+        self.assertIn("shortcut", [c.rule for c in a.maintenance.changes])
 
 
 class TestTheReachLearner(unittest.TestCase):
@@ -430,6 +525,17 @@ class TestTheReachLearner(unittest.TestCase):
         self.assertEqual(learner.space.num_states, 3)
         np.testing.assert_array_equal(learner.histories.Records(learner.Reach(1))[1], [0.9])
         self.assertFalse(MaintainReachSpace(learner, maintenance, 0, 100))  # (nothing left)
+        # A state the MDP never shows the robot in, but the learner's log does (it reached
+        # from there): not pruned, its reach's history kept.
+        unseen = Explorer(SQUARE)
+        _Tried(unseen, 3, 1, 6)  # 1 -> 3 stayed in 1, 6 times
+        logged = ReachLearner(SQUARE, unseen.transitions.counts, np.zeros((1, 3)))
+        logged.histories.Record(logged.Reach(3), np.zeros(3), 0.0, 0.7)
+        logged.log.append((0, 0, logged.Reach(3), 3, 3, 0.0, 0.7, 0, 0, 0))
+        prune = MaintenanceConfig(rules=["prune"])
+        self.assertFalse(MaintainReachSpace(logged, Maintenance(prune, 4), 0, 50))
+        logged.log.clear()  # (the same without the log's record: state 3 goes)
+        self.assertTrue(MaintainReachSpace(logged, Maintenance(prune, 4), 0, 50))
         # 1 -> 0 -> 2, each arriving, a reach between them: one chain from 1 to 2.
         space = learner.space
         one_zero, zero_two = (

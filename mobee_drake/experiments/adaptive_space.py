@@ -18,11 +18,11 @@ Per run, at the end:
   limits, every constraint clause satisfied, no collision; ``arms.VALID_SAMPLES`` of them, drawn
   uniformly in fractions of each joint's range) within ``--radius`` (fractions of range; by
   default the lattices' spacing, within which every point of the range lies of some rank-4
-  lattice state) of the centre of a state the robot arrived in: how much of what the arm can do
-  the agent has been near, whatever its space;
+  lattice state) of the centre of a state the robot was in (arrived in, or acted from: the
+  start): how much of what the arm can do the agent has been near, whatever its space;
 - *dispersion*: the mean distance (fractions of range) from those valid configurations to the
-  nearest centre of a state the robot arrived in (no threshold);
-- *prediction error*: ``--tests`` state-actions of states the robot arrived in, drawn at random,
+  nearest centre of a state the robot was in (no threshold);
+- *prediction error*: ``--tests`` state-actions of states the robot was in, drawn at random,
   run once each on a fresh robot (put in the state's centre first; skipped if it does not get
   there): one minus the probability the learned model gave the outcome (held out: the model
   does not learn from them);
@@ -31,8 +31,11 @@ Per run, at the end:
 - the space's states and state-actions at the end, its changes by rule, the robot's simulated
   time per action, the wall time and the penetrating periods.
 
-Maintained minus fixed is compared paired by seed, Holm-corrected over the arms, the spaces and
-the four measures (coverage, dispersion, prediction error, state-actions tried). The report names
+Maintained minus fixed on each space, and the roadmap minus the rank-4 lattice (both fixed), are
+compared paired by seed, Holm-corrected over all of them and the four measures (coverage,
+dispersion, prediction error, state-actions tried). No round is made at the run's last action
+count (``MaintenanceConfig.until``): the measures see the space the agent explored in its last
+``--every`` actions, not one just reshaped. The report names
 a PNG and, per arm, a Meshcat scene of the first seed's maintained runs
 (:mod:`mobee_drake.experiments.adaptive_space_figures`).
 
@@ -78,8 +81,13 @@ from mobee_drake.experiments.ch8_reaching import ReachRobot
 from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
 from mobee_drake.owned_folders import OwnedFolder
-from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel, ObservedOutcomes
-from mobee_drake.planning.space_maintenance import RULES, ChangesByRule, MaintenanceConfig
+from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
+from mobee_drake.planning.space_maintenance import (
+    RULES,
+    ChangesByRule,
+    MaintenanceConfig,
+    VisitedStates,
+)
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.planning.supervisor import ExploringAgent
 
@@ -116,12 +124,12 @@ class AdaptiveSpaceRun:
 
 
 def Nearest(explorer, valid: np.ndarray) -> np.ndarray:
-    """Per configuration of ``valid``, its distance to the nearest arrived-in state's centre
-    (inf when the robot arrived nowhere)."""
-    arrived = explorer.space.centres[ObservedOutcomes(explorer).sum(axis=0) > 0]
-    if not len(arrived):
+    """Per configuration of ``valid``, its distance to the nearest centre of a state the robot
+    was in (:func:`~mobee_drake.planning.space_maintenance.VisitedStates`; inf: none)."""
+    visited = explorer.space.centres[VisitedStates(explorer)]
+    if not len(visited):
         return np.full(len(valid), np.inf)
-    return np.min(np.linalg.norm(valid[:, None] - arrived[None], axis=2), axis=1)
+    return np.min(np.linalg.norm(valid[:, None] - visited[None], axis=2), axis=1)
 
 
 def PredictionError(robot: str, explorer, tests: int, seed: int) -> tuple[float, int]:
@@ -129,8 +137,8 @@ def PredictionError(robot: str, explorer, tests: int, seed: int) -> tuple[float,
     tests run): see the module. The tests run on a fresh robot of the arm ``robot``, the reach
     learner's (its state-action executor)."""
     space = explorer.space
-    arrived = np.flatnonzero(ObservedOutcomes(explorer).sum(axis=0) > 0)
-    candidates = np.flatnonzero(np.isin(space.action_state, arrived))
+    visited = np.flatnonzero(VisitedStates(explorer))
+    candidates = np.flatnonzero(np.isin(space.action_state, visited))
     rng = np.random.default_rng(seed)
     chosen = rng.choice(candidates, size=min(tests, len(candidates)), replace=False)
     fresh = ReachRobot(space, TARGET_RADIUS, robot=robot)
@@ -154,7 +162,7 @@ def AdaptiveSpaceJob(
     agent = ExploringAgent(
         name=AGENT,
         joints=list(arm.joints),
-        maintenance=maintenance if condition == "maintained" else None,
+        maintenance=dc.replace(maintenance, until=actions) if condition == "maintained" else None,
     )
     if space in LATTICES:
         agent.levels = LATTICES[space]
@@ -265,6 +273,12 @@ def _AddMaintenanceArguments(maintenance) -> None:
         type=PositiveInt,
         default=MaintenanceConfig().prune_after,
         help="tries into a state, none arriving, before it is pruned",
+    )
+    maintenance.add_argument(
+        "--develop-min-targets",
+        type=PositiveInt,
+        default=MaintenanceConfig().develop_min_targets,
+        help="develop: the different targets a state's reach needs records of to be favoured",
     )
     maintenance.add_argument(
         "--max-states",
@@ -489,6 +503,7 @@ def main(argv: list[str] | None = None) -> None:
         every=args.every,
         rules=list(rules),
         prune_after=args.prune_after,
+        develop_min_targets=args.develop_min_targets,
         max_states=args.max_states or 0,
     )
     output = pathlib.Path(

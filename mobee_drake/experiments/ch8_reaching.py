@@ -510,10 +510,12 @@ def RunOne(
             Save()
         if done >= settings.problem_tries:
             break
+        if keeper is not None:  # (after the stage's evaluation; resumed, the round is redone)
+            keeper.Maintain(learner, robot, done)
         since = len(learner.log)
         learner.Explore(robot)
         if keeper is not None:
-            keeper.AfterTry(learner, robot, done + 1, since)
+            keeper.Observe(learner, since)
         if (done + 1) % settings.checkpoint_every == 0:
             Save()
         if should_stop is not None and should_stop():

@@ -12,15 +12,16 @@ about a state-action that stays is lost, and new ones start as the agent's first
 
 The rules (:class:`MaintenanceConfig` holds their parameters):
 
-- ``prune``: a state the robot was never in (no action arrived in it, none was tried from it),
-  after ``prune_after`` tries of the actions into it, is dropped with every action into or out
-  of it (the lattice's states beyond the shoulder's cable constraints, ch. 7.3). The state the
-  robot is in is never dropped.
+- ``prune``: a state the robot was never in (no action arrived in it, none was tried from it,
+  nor does its learner say it was there), after ``prune_after`` tries of the actions into it,
+  is dropped with every action into or out of it (the lattice's states beyond the shoulder's
+  cable constraints, ch. 7.3). The state the robot is in is never dropped.
 - ``drop``: a transition tried ``drop_after`` times that missed its goal on at least
   ``drop_miss_share`` of them is removed, unless it is its state's last action.
-- ``shortcut``: when the agent has gone from a state through a second to a third, not a
-  neighbour of the first, ``shortcut_after`` times (two consecutive actions that each arrived),
-  an action from the first straight to the third is added.
+- ``shortcut``: when the agent has gone from a state through a second to a third, not linked
+  to the first, ``shortcut_after`` times (two consecutive actions that each arrived, the second
+  from where the first did), an action from the first straight to the third is added, unless
+  ``drop`` removed that transition before (no shortcut brings a dropped transition back).
 - ``grow``: halfway between a state pruned in this round and each state that had an action into
   it, a new state, joined both ways to every state within that action's length of it: the
   boundary of the reachable region is probed more finely, down to ``min_spacing``, never back
@@ -32,6 +33,7 @@ The rules (:class:`MaintenanceConfig` holds their parameters):
 
 import collections
 from collections.abc import Iterable
+import copy
 import dataclasses as dc
 
 import numpy as np
@@ -68,6 +70,9 @@ class MaintenanceConfig:
     min_spacing: float = 0.05
     # The space grows while it has fewer states than this (0: no limit).
     max_states: int = 0
+    # No round at or after this many actions (0: no such limit): a run that ends there is
+    # measured on the space it explored, not on one just reshaped.
+    until: int = 0
 
     def Errors(self) -> list[str]:
         """What is wrong with the settings that their types cannot say (empty: nothing)."""
@@ -76,7 +81,7 @@ class MaintenanceConfig:
             for r in self.rules
             if r not in RULES
         ]
-        for name in ("every", "max_states"):
+        for name in ("every", "max_states", "until"):
             if getattr(self, name) < 0:
                 errors.append(f"{name} must be >= 0, got {getattr(self, name)}")
         for name in ("prune_after", "drop_after", "shortcut_after", "develop_top"):
@@ -189,6 +194,8 @@ class Maintenance:
         # The start and the end of the last action, if it arrived (else -1, -1).
         self._previous, self._arrival = -1, -1
         self.changes: list[SpaceChange] = []
+        # The (start, goal) centres of every transition dropped (no shortcut brings one back).
+        self._dropped: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
 
     def Observe(self, space: StateActionSpace, state: int, state_action: int, outcome: int):
         """Notes an action's outcome (the agent's model observes it separately). A chain is
@@ -202,18 +209,22 @@ class Maintenance:
 
     def Due(self, actions_done: int) -> bool:
         """Whether a round is due after ``actions_done`` actions."""
-        every = self.config.every
-        return every > 0 and actions_done > 0 and actions_done % every == 0
+        every, until = self.config.every, self.config.until
+        before_the_end = not until or actions_done < until
+        return every > 0 and actions_done > 0 and actions_done % every == 0 and before_the_end
 
     def Plan(
-        self, explorer: Explorer, state: int, actions_done: int, favoured=()
+        self, explorer: Explorer, state: int, actions_done: int, favoured=(), visited=()
     ) -> "SpaceEdit | None":
         """A round of every enabled rule on ``explorer``'s space, the robot in ``state``, the
-        learner's ``favoured`` states given (for ``develop``): the edit (None: no change),
-        recorded as made (the chain counts follow it). A state whose every action would go (to
-        pruned states, with nothing grown beside it) keeps those goals."""
+        learner's ``favoured`` states given (for ``develop``) and the states it was in that its
+        model does not show (``visited``: never pruned): the edit (None: no change), recorded
+        as made (the chain counts follow it). A state whose every action would go (to pruned
+        states, with nothing grown beside it) keeps those goals."""
         space = explorer.space
-        pruned = _Prunable(explorer, self.config, state) if "prune" in self.config.rules else []
+        pruned = []
+        if "prune" in self.config.rules:
+            pruned = _Prunable(explorer, self.config, [state, *visited])
         while True:
             changes = self._Changes(explorer, pruned, actions_done, favoured)
             if not changes:
@@ -238,6 +249,7 @@ class Maintenance:
         for change in changes:
             if change.rule == "shortcut":  # (an action now: no chain to count)
                 self.chains[change.states] = 0
+        self._dropped += [_Pair(space, *c.states) for c in changes if c.rule == "drop"]
         self.chains = _Moved(self.chains, edit.state_index, edit.space.num_states)
         self._previous, self._arrival = (
             int(edit.state_index[s]) if s >= 0 else -1 for s in (self._previous, self._arrival)
@@ -296,7 +308,8 @@ class Maintenance:
         """(the chain counts, the rest as JSON-able data), for a checkpoint."""
         changes = [dc.asdict(c) for c in self.changes]
         previous, arrival = int(self._previous), int(self._arrival)
-        return self.chains.copy(), dict(previous=previous, arrival=arrival, changes=changes)
+        data = dict(previous=previous, arrival=arrival, changes=changes)
+        return self.chains.copy(), data | dict(dropped=self._dropped)
 
     @classmethod
     def FromData(cls, config: MaintenanceConfig, chains, data: dict) -> "Maintenance":
@@ -304,13 +317,22 @@ class Maintenance:
         maintenance = cls(config, len(chains))
         maintenance.chains = np.array(chains, dtype=int)
         maintenance._previous = data["previous"]
-        # (a checkpoint from before the arrival was kept: the start's action arrived, there)
+        # (-1 from a checkpoint from before the arrival was kept: the next chain starts afresh)
         maintenance._arrival = data.get("arrival", -1)
         maintenance.changes = [
             SpaceChange(**dict(c, states=tuple(c["states"]), centre=tuple(c["centre"])))
             for c in data["changes"]
         ]
+        # (none from a checkpoint from before they were kept)
+        maintenance._dropped = [tuple(map(tuple, pair)) for pair in data.get("dropped", [])]
         return maintenance
+
+    def Continued(self) -> "Maintenance":
+        """A copy for a new run on the space this one shaped: what it counted and changed
+        carries on, but no chain runs on from the last run's last action."""
+        continued = copy.deepcopy(self)
+        continued._previous, continued._arrival = -1, -1
+        return continued
 
     def _Pruned(self) -> np.ndarray:
         """(p, d): the centres of the states pruned in earlier rounds (no new state goes
@@ -318,9 +340,13 @@ class Maintenance:
         return np.array([c.centre for c in self.changes if c.rule == "prune" and c.centre])
 
     def _Shortcuts(self, space: StateActionSpace) -> list[tuple[int, int]]:
+        """The chains taken often enough between states not linked now nor dropped before."""
         linked = set(zip(space.action_state.tolist(), space.action_goal.tolist()))
         often = np.argwhere(self.chains >= self.config.shortcut_after)
-        return [(int(a), int(c)) for a, c in often if (a, c) not in linked]
+        return [
+            (int(a), int(c)) for a, c in often
+            if (a, c) not in linked and _Pair(space, a, c) not in set(self._dropped)
+        ]  # fmt: skip
 
 
 def ChangesByRule(rules: Iterable[str]) -> dict[str, int]:
@@ -329,20 +355,31 @@ def ChangesByRule(rules: Iterable[str]) -> dict[str, int]:
     return {rule: counts.get(rule, 0) for rule in RULES}
 
 
+def _Pair(space: StateActionSpace, state: int, goal: int) -> tuple[tuple[float, ...], ...]:
+    """An action's (start, goal) centres: what names it across edits of the space."""
+    return tuple(space.centres[state].tolist()), tuple(space.centres[goal].tolist())
+
+
 def _ActionOf(space: StateActionSpace, state: int, goal: int) -> int:
     actions = space.Actions(state)
     return int(actions[space.action_goal[actions] == goal][0])
 
 
-def _Prunable(explorer: Explorer, config: MaintenanceConfig, state: int) -> list[int]:
-    """States the robot was never in (no action arrived there, none was tried from there: the
-    start) whose incoming actions were tried ``prune_after`` times."""
+def VisitedStates(explorer: Explorer) -> np.ndarray:
+    """Per state, whether the model shows the robot there: an action arrived there, or one
+    was tried from there (the start)."""
     space, m = explorer.space, explorer.space.num_states
     arrived = ObservedOutcomes(explorer).sum(axis=0) > 0
-    acted_from = np.bincount(space.action_state, weights=explorer.tries, minlength=m) > 0
-    tried_into = np.bincount(space.action_goal, weights=explorer.tries, minlength=m)
-    prunable = ~arrived & ~acted_from & (tried_into >= config.prune_after)
-    prunable[state] = False
+    return arrived | (np.bincount(space.action_state, weights=explorer.tries, minlength=m) > 0)
+
+
+def _Prunable(explorer: Explorer, config: MaintenanceConfig, kept) -> list[int]:
+    """States the robot was never in (:func:`VisitedStates`, nor ``kept``: where it is, and
+    where its learner saw it) whose incoming actions were tried ``prune_after`` times."""
+    space = explorer.space
+    tried_into = np.bincount(space.action_goal, weights=explorer.tries, minlength=space.num_states)
+    prunable = ~VisitedStates(explorer) & (tried_into >= config.prune_after)
+    prunable[list(kept)] = False
     return np.flatnonzero(prunable).tolist()
 
 

@@ -25,7 +25,7 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 
-from mobee_drake.atomic_files import StrictJson
+from mobee_drake.atomic_files import CurrentGeneration, StrictJson
 from mobee_drake.planning.actuation_noise import NoisyPosture, ValidateNoise
 from mobee_drake.planning.explorers import (
     Explorer,
@@ -90,6 +90,9 @@ class Agent:
     seed: int = 0
     # Reshapes the space as the agent learns (ch. 9.4.5; None: the space stays).
     maintenance: MaintenanceConfig | None = None
+    # With ``model`` and ``maintenance``: the maintenance that reshaped the model's space (what
+    # it pruned and dropped: nothing grows back there), carried on; None: a fresh one.
+    maintained_before: Maintenance | None = None
 
 
 class ExplorationSupervisor(LeafSystem):
@@ -235,7 +238,12 @@ class ExplorationSupervisor(LeafSystem):
                 q,
                 context.get_time(),
                 0,
-                agent.maintenance and Maintenance(agent.maintenance, agent.space.num_states),
+                agent.maintenance
+                and (
+                    agent.maintained_before.Continued()
+                    if agent.maintained_before
+                    else Maintenance(agent.maintenance, agent.space.num_states)
+                ),
             )
             for agent, columns in zip(self._agents, self._columns)
         )
@@ -415,6 +423,17 @@ class ExplorationSupervisor(LeafSystem):
         self.SetRecords(context, tuple(records))
 
 
+def SavedMaintenance(folder: str, name: str, config: MaintenanceConfig) -> Maintenance | None:
+    """The maintenance agent ``name`` saved in a checkpoint folder (its newest generation, or
+    the folder's own files), under ``config``; None if its space was not maintained."""
+    base = (CurrentGeneration(folder) or pathlib.Path(folder)) / name
+    data = json.loads(base.with_suffix(".json").read_text())
+    if not data.get("maintenance"):
+        return None
+    chains = np.load(base.with_suffix(".npz"))["maintenance_chains"]
+    return Maintenance.FromData(config, chains, data["maintenance"])
+
+
 def RoadmapStateSpace(
     folder: str, joints: list[str], all_joints: list[str], lower: np.ndarray, upper: np.ndarray
 ) -> StateActionSpace:
@@ -523,8 +542,10 @@ class ExploreAttractor:
                 if config.model
                 else None
             )
+            maintained_before = None
             if model is not None and config.maintenance is not None:
                 space = model.space  # (as it had reshaped itself)
+                maintained_before = SavedMaintenance(config.model, config.name, config.maintenance)
             agents.append(
                 Agent(
                     name=config.name,
@@ -534,6 +555,7 @@ class ExploreAttractor:
                     model=model,
                     seed=seed,
                     maintenance=config.maintenance,
+                    maintained_before=maintained_before,
                 )
             )
         supervisor = parts.builder.AddNamedSystem(

@@ -49,6 +49,12 @@ def FavouredStates(learner: ReachLearner, top: int, min_targets: int) -> list[in
     return sorted(means, key=lambda s: -means[s])[:top]
 
 
+def LoggedStates(learner: ReachLearner) -> list[int]:
+    """The states the learner's log shows the robot in (where each action started and ended;
+    the MDP's counts miss its reaches, and moves that felt an object, ch. 9.4.1)."""
+    return sorted({int(s) for entry in learner.log for s in entry[3:5] if s >= 0})
+
+
 def MaintainReachSpace(
     learner: ReachLearner, maintenance: Maintenance, state: int, done: int
 ) -> bool:
@@ -59,7 +65,7 @@ def MaintainReachSpace(
     config = maintenance.config
     view = ModelView(learner)
     favoured = FavouredStates(learner, config.develop_top, config.develop_min_targets)
-    edit = maintenance.Plan(view, state, done, favoured)
+    edit = maintenance.Plan(view, state, done, favoured, LoggedStates(learner))
     if edit is None:
         return False
     learner.Reshape(edit, CarryExplorer(view, edit).transitions.counts)
@@ -83,13 +89,17 @@ class ReachSpaceKeeper:
     def __init__(self, config: MaintenanceConfig, num_states: int):
         self.maintenance = Maintenance(config, num_states)
 
-    def AfterTry(self, learner: ReachLearner, robot, done: int, since: int) -> None:
-        """After a problem-try (``done`` of them now; its actions logged from entry
-        ``since``)."""
+    def Observe(self, learner: ReachLearner, since: int) -> None:
+        """After a problem-try: its actions, logged from entry ``since``, shown to the
+        maintenance."""
         ObserveTransitions(learner, self.maintenance, since)
+
+    def Maintain(self, learner: ReachLearner, robot, done: int) -> None:
+        """A round, if one is due after ``done`` problem-tries. A run calls it after the
+        evaluation of a stage at ``done`` (which sees the space as it was learned) and before
+        the next try, never after the last."""
         if self.maintenance.Due(done):
-            state = robot.State()
-            if MaintainReachSpace(learner, self.maintenance, state, done):
+            if MaintainReachSpace(learner, self.maintenance, robot.State(), done):
                 robot.space = learner.space
 
     def ToArrays(self, learner: ReachLearner) -> tuple[dict[str, np.ndarray], dict]:
