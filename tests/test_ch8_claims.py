@@ -7,7 +7,7 @@ import numpy as np
 
 from mobee_drake.experiments import ch8_claims as claims
 from mobee_drake.experiments.ch8_reaching import ReachRun
-from mobee_drake.experiments.statistics import RatioOfMeans
+from mobee_drake.experiments.statistics import ComparePaired, RatioOfMeans
 
 STAGES = (100, 800, 1600)
 PROBLEMS = 3
@@ -94,6 +94,14 @@ class TestClaims(unittest.TestCase):
                 claims.REPRODUCED,  # greedy's lines
             ],
         )
+        # The trend is tested against 0 within the MDPs, as the other claims are.
+        trends = [claims._Trend(True, list(STAGES))(r) for r in self.strict
+                  if r.strategy == "intrinsic"]  # fmt: skip
+        blocks = [k % 2 for k in range(6)]
+        expected = ComparePaired(trends, np.zeros(6), blocks)
+        improves = claims.Verdicts(self.strict)[2].evidence
+        self.assertEqual(improves, f"per doubling, minus 0 {expected.Text()}")
+        self.assertIn("over 2 MDPs", improves)
 
     def test_a_setting_where_intrinsic_is_level_is_marked_on_its_own(self):
         level = [

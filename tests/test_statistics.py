@@ -292,6 +292,10 @@ class TestPairedAndFamilies(unittest.TestCase):
         t = d.mean() / math.sqrt(within / 12)
         self.assertAlmostEqual(c.t_p, 2 * stats.t.sf(abs(t), 9))
         self.assertAlmostEqual(c.block_p, stats.f_oneway(d[:4], d[4:8], d[8:]).pvalue)
+        means = [d[k : k + 4].mean() for k in (0, 4, 8)]  # (for MDPs learned anew: 2 df)
+        self.assertAlmostEqual(c.over_blocks_p, stats.ttest_1samp(means, 0).pvalue)
+        self.assertIn(f"for MDPs learned anew p = {c.over_blocks_p:.2g})", c.Text())
+        self.assertTrue(math.isnan(one.over_blocks_p))
         self.assertEqual(c.a_larger, int(np.sum(d > 0)))
         # An MDP's own shift of the difference (summing to 0) is not noise to the blocked test.
         shifted = a + np.repeat([-1.0, 0.0, 1.0], 4)

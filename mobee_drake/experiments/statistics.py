@@ -379,9 +379,10 @@ class PairedComparison:
     sd: float
     # Cohen's d_z: the mean difference over the differences' standard deviation.
     d_z: float
-    # The test of the mean difference with the block as a factor (a randomised block design:
-    # the error is the differences' variance within the blocks, n - blocks degrees of freedom;
-    # with one block, the paired t-test), and Wilcoxon's signed-rank test, two-sided.
+    # The test of the mean difference with the block as a fixed factor (a randomised block
+    # design: the error is the differences' variance within the blocks, n - blocks degrees of
+    # freedom, so its inference holds for these MDPs; with one block, the paired t-test), and
+    # Wilcoxon's signed-rank test, two-sided.
     t_p: float
     wilcoxon_p: float
     # Pairs in which a is larger.
@@ -389,6 +390,9 @@ class PairedComparison:
     # Whether the difference depends on the block (the MDP): one-way ANOVA of the differences
     # over the blocks (NaN with one block, or a block of one pair).
     block_p: float
+    # The block as a random factor (inference for MDPs learned anew): the one-sample t-test of
+    # the blocks' mean differences, blocks - 1 degrees of freedom (NaN with fewer than 3).
+    over_blocks_p: float = math.nan
 
     def Text(self, p: float | None = None) -> str:
         """One line: the difference with its interval, d_z, the test's p (or ``p``, an adjusted
@@ -397,6 +401,7 @@ class PairedComparison:
         shown = self.t_p if p is None else p
         blocks = (
             f"; over {self.blocks} MDPs, the MDP's effect p = {_Number(self.block_p, '.2g')}"
+            f", for MDPs learned anew p = {_Number(self.over_blocks_p, '.2g')}"
             if self.blocks > 1
             else ""
         )
@@ -410,9 +415,10 @@ class PairedComparison:
 def ComparePaired(a, b, blocks) -> PairedComparison:
     """Paired comparison of run values ``a`` and ``b`` (run i of a matched with run i of b) in
     ``blocks`` (one label per pair: its MDP). The mean difference is tested against the
-    differences' variance within the blocks (so the MDPs' own differences are not taken for
-    noise, nor pairs of one MDP for independent MDPs); with one block this is the paired
-    t-test."""
+    differences' variance within the blocks (the MDP a fixed factor: how much a strategy's lead
+    varies from one MDP to another is not taken for noise, so the test speaks for these MDPs);
+    with one block this is the paired t-test. ``over_blocks_p`` speaks for MDPs learned anew
+    (the MDP a random factor: the blocks' mean differences, one value each)."""
     a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
     blocks = np.asarray(blocks)
     if a.shape != b.shape or a.ndim != 1 or blocks.shape != a.shape:
@@ -440,7 +446,15 @@ def ComparePaired(a, b, blocks) -> PairedComparison:
         wilcoxon_p=float(stats.wilcoxon(d).pvalue) if np.any(d != 0) else math.nan,
         a_larger=int(np.sum(d > 0)),
         block_p=float(stats.f_oneway(*groups).pvalue) if varied else math.nan,
+        over_blocks_p=_OverBlocks([g.mean() for g in groups]),
     )
+
+
+def _OverBlocks(means: list[float]) -> float:
+    """The one-sample t-test's p of the blocks' mean differences (NaN below 3 blocks)."""
+    if len(means) < 3 or np.std(means) == 0:
+        return math.nan
+    return float(stats.ttest_1samp(means, 0.0).pvalue)
 
 
 def PairedBySeed(families: dict, measures: dict, heading: str) -> list[str]:
