@@ -165,6 +165,16 @@ class TestClaims(unittest.TestCase):
         marks = _Marks(late)
         self.assertEqual(marks[0, "unit0.03_force300"], claims.NOT_TESTABLE)
 
+    def test_the_ratio_says_which_tries_ran_out_of_actions(self):
+        """Random's extra time may be tries that run out of actions (no reach): the evidence
+        gives each strategy's share of them, from the logs."""
+        by = {s: {r.settings.seed: r for r in self.strict if r.settings.strategy == s}
+              for s in REWARDS}  # fmt: skip
+        for run in by["random"].values():  # every fourth try loses its reach
+            run.log = [row for row in run.log if not (row[2] >= 4 and row[0] % 4 == 0)]
+        _, evidence = claims.RandomTakesLonger(by)
+        self.assertTrue(evidence.endswith("random 25.0%, greedy 0.0%, intrinsic 0.0%"), evidence)
+
     def test_the_ratio_of_the_exploration_alone(self):
         """The same ratio without each run's evaluation time, over the seeds whose runs all
         timed their evaluations (the ratio with them over every seed)."""

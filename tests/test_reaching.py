@@ -91,6 +91,9 @@ class FakeRobot:
     def SetProblem(self, target):
         self.target = target
 
+    def EndProblem(self):
+        self.target = None
+
     def State(self):
         return self.state
 
@@ -244,6 +247,34 @@ class TestReachLearner(unittest.TestCase):
         self.assertEqual(learner.rng.bit_generator.state, before[2])
         for sa, rewards in enumerate(before[3]):
             np.testing.assert_array_equal(learner.histories.History(sa)[2], rewards)
+
+    def test_a_try_that_runs_out_of_actions_ends_its_problem(self):
+        """One action a try, random's drawn reach elsewhere: the try runs out of actions, and
+        its target leaves the world as a reach's does (an evaluation's walk is not to go around
+        it)."""
+        space, learner = _Learner("random", max_actions=1)
+        robot = FakeRobot(space, PALMS)
+        timed_out = 0
+        for _ in range(6):
+            if learner.Explore(robot).reward is None:
+                timed_out += 1
+                self.assertIsNone(robot.target)
+        self.assertGreater(timed_out, 0)
+
+    def test_the_walk_to_the_start_takes_transitions_only(self):
+        """An evaluation walks to its start state by transitions. Where no transition's value
+        leads there (this MDP's moves all stay put, so from the far corner every move and the
+        reach are worth 0), ties drawn at random (``random-tie``) still never pick the reach."""
+        from mobee_drake.reaching.learner import ReachLearner, ReachLearningConfig
+
+        space, _ = _Learner()
+        stays = np.zeros((space.num_state_actions, space.num_states))
+        stays[np.arange(space.num_state_actions), space.action_state] = 1.0
+        config = ReachLearningConfig(strategy="greedy", plateau_rule="random-tie")
+        learner = ReachLearner(space, stays, PALMS[:1], config)
+        for seed in range(20):
+            robot = FakeRobot(space, PALMS, state=3 - int(np.random.default_rng(seed).integers(4)))
+            learner.Evaluate(robot, seed=seed)  # (an IndexError if the walk drew the reach)
 
     def test_exact_resume(self):
         for strategy, predictor, learn_mdp in [

@@ -22,7 +22,12 @@ import numpy as np
 from scipy import stats
 
 from mobee_drake.experiments.ch8_figures import RunLog
-from mobee_drake.experiments.ch8_measures import Fingerprints, RunSums, RunTrends
+from mobee_drake.experiments.ch8_measures import (
+    Fingerprints,
+    RunSums,
+    RunTrends,
+    TimedOutShare,
+)
 from mobee_drake.experiments.ch8_reaching import ReachRun, SettingLabel
 from mobee_drake.experiments.statistics import (
     ComparePaired,
@@ -203,11 +208,15 @@ def RandomTakesLonger(runs: Runs, exploration_only: bool = False) -> tuple[str, 
     ]
     blocks = [runs["random"][s].settings.mdp_seed for s in seeds]
     ratio, low, high = RatioOfMeans(random, others, blocks)
+    # Where random's extra time goes: tries that ran out of actions (ch. 8.1's cycles) or trips.
+    timed_out = {o: np.mean([TimedOutShare(runs[o][s]) for s in seeds]) for o in strategies}
     evidence = (
         f"{ratio:.2f} times [{low:.2f}, {high:.2f}] (95 % bootstrap over {len(seeds)} seeds in "
         f"{len(set(blocks))} MDPs"
         + (f", leaving out {every - len(seeds)} with untimed runs" if len(seeds) < every else "")
-        + f"; the source: {SOURCE_TIME_RATIO:.2f})"
+        + f"; the source: {SOURCE_TIME_RATIO:.2f}); problem-tries that ran out of actions "
+        f"without a reach: random {timed_out['random']:.1%}, greedy {timed_out['greedy']:.1%}, "
+        f"intrinsic {timed_out['intrinsic']:.1%}"
     )
     # More time than the others, and as much as the source's within the interval.
     held = 1.0 < low <= SOURCE_TIME_RATIO <= high

@@ -68,6 +68,13 @@ def Fingerprints(run: ReachRun) -> dict:
     )
 
 
+def TimedOutShare(run: ReachRun) -> float:
+    """The share of the run's exploratory problem-tries that ran out of actions without a
+    reach (a try reaches at most once; the rest end after ``max_actions``)."""
+    log = RunLog(run)
+    return 1.0 - np.count_nonzero(log[:, 2] >= run.num_transitions) / run.settings.problem_tries
+
+
 def RunSums(runs: list[ReachRun], stage: int, penalties: bool) -> np.ndarray:
     """One value per run: the mean of its evaluations' sums at ``stage``."""
     return RunMeans([[EvaluationSum(e, penalties) for e in r.evaluations[stage]] for r in runs])

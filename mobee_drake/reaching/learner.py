@@ -146,6 +146,9 @@ class Robot(Protocol):
     def SetProblem(self, target: np.ndarray) -> None:
         """Puts the problem's target object into the world (replacing the previous one)."""
 
+    def EndProblem(self) -> None:
+        """Takes the problem's target out of the world, if it is there (a reach does it)."""
+
     def State(self) -> int:
         """The MDP state of the robot's configuration."""
 
@@ -401,6 +404,7 @@ class ReachLearner:
                 )
             if self.reaching[sa]:
                 return TryResult(problem, action, reward, sa, failed, [float(c) for c in reached])
+        robot.EndProblem()  # (out of actions: the try is over, as after a reach)
         return TryResult(problem, self.config.max_actions, None, -1, failed)
 
     def Explore(self, robot: Robot) -> TryResult:
@@ -437,6 +441,7 @@ class ReachLearner:
             (self.space.action_goal == start).astype(float), np.zeros(self.space.num_states)
         )
         q, _ = self.Values(into_start)
+        q[self.reaching] = -np.inf  # (the walk moves; where no move leads there, a reach ties)
         for _ in range(self.config.max_actions):
             state = robot.State()
             if state == start:

@@ -8,7 +8,8 @@ target, so the palm may touch and enter it while the rest of the arm is still ke
 ends its problem-try: when it has ended (settled back at its state's centre) the filter and the
 target go, so that nothing the robot does before the next problem (an evaluation's walk to its
 start state) has to push the hand out of a target it was let into; the next problem's target
-appears with ``SetProblem``. (A try that times out keeps its target: no hand was let into it.) A
+appears with ``SetProblem``. A try that runs out of actions ends too (``EndProblem``): its
+target goes, so that the walk does not go around the target of a problem that is over. A
 transition therefore must go around the target, and fails when it cannot.
 """
 
@@ -165,9 +166,13 @@ class SimulatedRobot:
         self.executor.StartReach(self._executor_context, self._Centre(self.State()), target)
         self._Finish()
         filters.RemoveDeclaration(touch)
-        self.station.world.Remove(self.context, TARGET_NAME)  # (the problem-try is over)
-        self.target = None
+        self.EndProblem()  # (the problem-try is over)
         return self.executor.ReachedPosition(self._executor_context)
+
+    def EndProblem(self) -> None:
+        if self.target is not None:
+            self.station.world.Remove(self.context, TARGET_NAME)
+            self.target = None
 
     def FeltObject(self) -> bool:
         return self.executor.FeltObject(self._executor_context)
