@@ -1,6 +1,6 @@
 """When a greedy reach planner moves (issue 23, point 5): the reward ratio one step and a path
 of steps need, in closed form (:mod:`mobee_drake.reaching.discounting`) against value iteration on
-a learned MDP, and what the ch. 8 runs' rewards and predictions give (docs/reaching.md).
+a learned MDP, and what the ch. 8 runs' rewards and predictions give (docs/reaching_history.md).
 
 With ``--reach-force``, it also measures what moving could gain (issue 23, point 6): reaches for a
 sample of the problems from a sample of start states, on the reach learner's robot with each

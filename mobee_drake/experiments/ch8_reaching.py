@@ -255,7 +255,7 @@ DISTANCE_UNIT_RANGE = (1e-4, 100.0)  # (m)
 
 REACH_PRESETS = {
     # Issue 23, point 6: the setting of the sweep whose behaviour matches the source's
-    # fingerprints best (docs/reaching.md, "Calibration against the source's behaviour").
+    # fingerprints best (docs/reaching_history.md, "Calibration against the source's behaviour").
     "calibrated": ReachPreset(distance_unit=0.03, reach_force=300.0),
     # The first reading: SI units and the full reach, in which exploitation never moves.
     "metres": ReachPreset(PredictorConfig().distance_unit, ReachForcing().force),

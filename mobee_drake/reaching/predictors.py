@@ -31,7 +31,7 @@ Distances in eq. 8.1-8.7 are counted in ``PredictorConfig.distance_unit`` (the s
 unit; metres by default). The unit sets how much the pre-reach state matters: a transition costs
 the factor gamma = 0.9, so moving to reach from elsewhere pays only where eq. 8.4 predicts more
 than 1/0.9 times the reward here; in metres the measured reaches' misses of 1.3-32.5 cm earn
-0.755-0.987 (docs/reaching.md, issue 23).
+0.755-0.987 (docs/reaching_history.md, issue 23).
 """
 
 import dataclasses as dc
