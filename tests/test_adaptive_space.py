@@ -388,9 +388,10 @@ class TestTheReachLearnersSpace(unittest.TestCase):
 
     def test_a_reshaping_run_resumes_exactly(self):
         """A random run whose space is maintained every 2 problem-tries by all five rules (set
-        to act on a try or a record), killed after 7 tries (checkpoint at 6, after three rounds
-        that dropped logged state-actions) and run again, ends as the run never killed: the
-        same log, space and robot time."""
+        to act on a try or a record), killed after 7 tries (checkpoint at 6, after the rounds at
+        2 and 4 dropped logged state-actions, before the round due at 6, which the resumed run
+        makes) and run again, ends as the run never killed: the same log, space and robot
+        time."""
         from unittest import mock
 
         from mobee_drake.experiments.ch8_reaching import RunOne, RunSettings

@@ -212,6 +212,8 @@ class TestTheRules(unittest.TestCase):
         self.assertEqual([until.Due(n) for n in (50, 100, 150)], [True, False, False])
         with self.assertRaisesRegex(ValueError, "until must be >= 0"):
             Maintenance(MaintenanceConfig(until=-1), 4)
+        with self.assertRaisesRegex(ValueError, "develop_min_targets must be >= 1"):
+            Maintenance(MaintenanceConfig(develop_min_targets=0), 4)
 
     def test_a_dropped_transition_never_comes_back_as_a_shortcut(self):
         """On a line 0 - 1 - 2 with a direct 0 -> 2: 0 -> 2 missed 5 of 5 and is dropped; the
@@ -229,8 +231,9 @@ class TestTheRules(unittest.TestCase):
             maintenance.Observe(space, 0, _Action(space, 0, 1), 1)
             maintenance.Observe(space, 1, _Action(space, 1, 2), 2)
         self.assertEqual(maintenance.chains[0, 2], 5)
-        resumed = Maintenance.FromData(config, *maintenance.ToData())
-        for m in (maintenance, resumed):
+        chains, data = maintenance.ToData()
+        resumed = Maintenance.FromData(config, chains, json.loads(json.dumps(data)))
+        for m in (maintenance, resumed, maintenance.Continued()):
             self.assertIsNone(m.Plan(explorer, 0, 200))
 
 
@@ -396,9 +399,10 @@ class TestOnTheSupervisor(unittest.TestCase):
         dut.GetInputPort("robot_state").FixValue(context, [0.0, 0.0])
         dut.ExecuteInitializationEvents(context)
         self._Poll(dut, context, 4)  # (the robot stays: a round prunes and grows)
-        self._Poll(dut, context, 2, follow=True)  # (then it arrives: a chain begins)
+        self._Poll(dut, context, 3, follow=True)  # (then it arrives: chains are counted)
         (record,) = dut.Records(context)
         self.assertGreaterEqual(record.maintenance.ToData()[1]["previous"], 0)
+        self.assertTrue(record.maintenance.chains.any())
         config = MaintenanceConfig(every=4, rules=["prune", "grow"], prune_after=2)
         with tempfile.TemporaryDirectory() as folder:
             dut.WriteCheckpoint(context, pathlib.Path(folder))

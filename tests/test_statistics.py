@@ -292,10 +292,17 @@ class TestPairedAndFamilies(unittest.TestCase):
         t = d.mean() / math.sqrt(within / 12)
         self.assertAlmostEqual(c.t_p, 2 * stats.t.sf(abs(t), 9))
         self.assertAlmostEqual(c.block_p, stats.f_oneway(d[:4], d[4:8], d[8:]).pvalue)
-        means = [d[k : k + 4].mean() for k in (0, 4, 8)]  # (for MDPs learned anew: 2 df)
-        self.assertAlmostEqual(c.over_blocks_p, stats.ttest_1samp(means, 0).pvalue)
-        self.assertIn(f"for MDPs learned anew p = {c.over_blocks_p:.2g})", c.Text())
+        # For MDPs learned anew: the MDPs' means against 0 on 2 df, their standard error the
+        # larger of their spread's and the within-MDP one.
+        means = np.array([d[k : k + 4].mean() for k in (0, 4, 8)])
+        se = max(means.std(ddof=1) / math.sqrt(3), math.sqrt(within / 12))
+        self.assertAlmostEqual(c.over_blocks_p, 2 * stats.t.sf(abs(means.mean()) / se, 2))
+        self.assertIn(f"for MDPs learned anew p = {c.over_blocks_p:.2g} (unadjusted))", c.Text())
         self.assertTrue(math.isnan(one.over_blocks_p))
+        # Three MDPs whose means agree by chance are no evidence beyond the within-MDP spread.
+        agree = np.array([1, -3, 0.95, -2.9, 1.1, -3.1])
+        close = ComparePaired(agree, np.zeros(6), np.repeat([0, 1, 2], 2))
+        self.assertGreaterEqual(close.over_blocks_p, close.t_p)
         self.assertEqual(c.a_larger, int(np.sum(d > 0)))
         # An MDP's own shift of the difference (summing to 0) is not noise to the blocked test.
         shifted = a + np.repeat([-1.0, 0.0, 1.0], 4)

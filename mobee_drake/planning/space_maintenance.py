@@ -84,13 +84,17 @@ class MaintenanceConfig:
         for name in ("every", "max_states", "until"):
             if getattr(self, name) < 0:
                 errors.append(f"{name} must be >= 0, got {getattr(self, name)}")
-        for name in ("prune_after", "drop_after", "shortcut_after", "develop_top"):
+        for name in (
+            "prune_after",
+            "drop_after",
+            "shortcut_after",
+            "develop_top",
+            "develop_min_targets",
+        ):
             if getattr(self, name) < 1:
                 errors.append(f"{name} must be >= 1, got {getattr(self, name)}")
         if not 0 < self.drop_miss_share <= 1:
             errors.append(f"drop_miss_share must be in (0, 1], got {self.drop_miss_share}")
-        if self.develop_min_targets < 0:
-            errors.append(f"develop_min_targets must be >= 0, got {self.develop_min_targets}")
         if not self.min_spacing > 0:
             errors.append(f"min_spacing must be > 0, got {self.min_spacing}")
         return errors
