@@ -189,7 +189,7 @@ class TestSmokeBattery(FigureTest):
                 self.assertEqual(run.states != 256, maintained)
                 if maintained:  # (rounds at 5, 10, ... 25, none at the run's end: 30)
                     folder = self.output / "runs" / f"icub_rank4_maintained_seed{run.seed}"
-                    changes = adaptive_space._Changes(folder / "model", "right_arm.json")
+                    changes = adaptive_space.SpaceChanges(folder / "model", "right_arm")
                     self.assertLessEqual({c["actions_done"] for c in changes}, {5, 10, 15, 20, 25})
         report = (self.output / "report.md").read_text()
         maintained = [r for r in runs if r.condition == "maintained"]

@@ -45,12 +45,10 @@ Run: ``mobee-drake experiment adaptive-space [--robots icub katana] [--seeds 10]
 
 import collections
 import dataclasses as dc
-import json
 import pathlib
 
 import numpy as np
 
-from mobee_drake.atomic_files import CurrentGeneration
 from mobee_drake.experiments import adaptive_space_reaching as reaching_part
 from mobee_drake.experiments.adaptive_space_figures import History, WriteSpaceFigures
 from mobee_drake.experiments.adaptive_space_report import BySetting, ChangesCell, SpaceComparisons
@@ -89,7 +87,7 @@ from mobee_drake.planning.space_maintenance import (
     VisitedStates,
 )
 from mobee_drake.planning.state_space import Lattice
-from mobee_drake.planning.supervisor import ExploringAgent
+from mobee_drake.planning.supervisor import ExploringAgent, SavedMaintenance
 
 # The lattices compared: their levels (fractions of each joint's range; rank3 is ch. 8's); and
 # "trm", a roadmap over the valid configurations (mobee_drake.trm.configuration), built once per
@@ -183,7 +181,7 @@ def AdaptiveSpaceJob(
     )
     folder = run.path / "model"
     explorer = LoadAgentModel(str(folder), AGENT, ExplorerConfig())
-    changes = _Changes(folder, f"{AGENT}.json") if condition == "maintained" else []
+    changes = SpaceChanges(folder, AGENT)
     error, tested = PredictionError(robot, explorer, tests, seed)
     done = explored.actions[0]
     nearest = Nearest(explorer, ValidConfigurations(arm))
@@ -364,17 +362,17 @@ def SpaceHistories(runs: list[AdaptiveSpaceRun], output: pathlib.Path) -> dict[s
         if condition != "maintained":
             continue
         run = output / "runs" / f"{robot}_{space}_maintained_seed{rs[0].seed}" / "model"
-        changes = _Changes(run, f"{AGENT}.json")
+        changes = SpaceChanges(run, AGENT)
         initial = _InitialCentres(arms[robot], robot, space, output)
         histories[robot].append(History(f"{robot}, {space}", arms[robot], initial, changes))
     return dict(histories)
 
 
-def _Changes(checkpoint: pathlib.Path, name: str) -> list[dict]:
-    """A maintained run's changes of its space: the maintenance's, in the newest generation of
-    its ``checkpoint`` folder (or the folder itself), in the file ``name``."""
-    saved = json.loads(((CurrentGeneration(checkpoint) or checkpoint) / name).read_text())
-    return saved["maintenance"]["changes"]
+def SpaceChanges(checkpoint: pathlib.Path, name: str) -> list[dict]:
+    """A maintained run's changes of its space (as dicts): the maintenance saved in the newest
+    generation of its ``checkpoint`` folder (or the folder itself) as ``name``.json/.npz."""
+    maintenance = SavedMaintenance(str(checkpoint), name, MaintenanceConfig())
+    return [dc.asdict(c) for c in maintenance.changes] if maintenance else []
 
 
 def _Results(args, jobs: list[Job], output: pathlib.Path, description: str) -> dict[str, dict]:
@@ -468,7 +466,7 @@ def ReachSpaceHistories(runs: list, output: pathlib.Path) -> dict[str, list]:
         initial = _ReachCentres(arms[robot], robot, space, output)
         if initial is None:  # (its roadmap is not there: nothing to draw it from)
             continue
-        changes = _Changes(output / "runs" / name / "checkpoint", "learner.json")
+        changes = SpaceChanges(output / "runs" / name / "checkpoint", "learner")
         title = f"{robot}, {space}, {strategy}"
         histories[robot].append(
             History(title, arms[robot], initial, changes, ReachTargets(arms[robot]))

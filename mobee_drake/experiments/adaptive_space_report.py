@@ -30,22 +30,17 @@ def SpaceComparisons(groups: dict[tuple, list], lattice: str, measures: dict) ->
     robot, space, any other fields, then condition) on each of ``measures`` (run -> value): on
     each space, maintained minus fixed; and where both ran, the roadmap ("trm") minus
     ``lattice``, both fixed; Holm over them all."""
-    families = _Families(groups, lattice)
-    both = any("trm minus" in family for family in families)
-    heading = "Maintained minus fixed" + (f" and trm minus {lattice}" if both else "")
-    return PairedBySeed(families, measures, heading)
-
-
-def _Families(groups: dict[tuple, list], lattice: str) -> dict[str, tuple[list, list]]:
-    families = {}
-    for robot, space, *more in sorted({key[:-1] for key in groups}):
-        name = " ".join([robot, space, *more]) + ", maintained minus fixed"
-        families[name] = tuple(
+    maintained = {
+        " ".join([robot, space, *more]) + ", maintained minus fixed": tuple(
             groups.get((robot, space, *more, condition), [])
             for condition in ("maintained", "fixed")
         )
+        for robot, space, *more in sorted({key[:-1] for key in groups})
+    }
+    roadmap = {}
     for robot, *more in sorted({(key[0], *key[2:-1]) for key in groups}):
         trm, grid = (groups.get((robot, space, *more, "fixed"), []) for space in ("trm", lattice))
         if trm and grid:
-            families[" ".join([robot, *more]) + f", trm minus {lattice} (both fixed)"] = (trm, grid)
-    return families
+            roadmap[" ".join([robot, *more]) + f", trm minus {lattice} (both fixed)"] = (trm, grid)
+    heading = "Maintained minus fixed" + (f" and trm minus {lattice}" if roadmap else "")
+    return PairedBySeed(maintained | roadmap, measures, heading)
