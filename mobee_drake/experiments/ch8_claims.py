@@ -26,7 +26,7 @@ from mobee_drake.experiments.ch8_measures import (
     Fingerprints,
     RunSums,
     RunTrends,
-    TimedOutShare,
+    TimedOutTries,
 )
 from mobee_drake.experiments.ch8_reaching import ReachRun, SettingLabel
 from mobee_drake.experiments.statistics import (
@@ -209,7 +209,10 @@ def RandomTakesLonger(runs: Runs, exploration_only: bool = False) -> tuple[str, 
     blocks = [runs["random"][s].settings.mdp_seed for s in seeds]
     ratio, low, high = RatioOfMeans(random, others, blocks)
     # Where random's extra time goes: tries that ran out of actions (ch. 8.1's cycles) or trips.
-    timed_out = {o: np.mean([TimedOutShare(runs[o][s]) for s in seeds]) for o in strategies}
+    timed_out = {
+        o: np.mean([TimedOutTries(runs[o][s]) / runs[o][s].settings.problem_tries for s in seeds])
+        for o in strategies
+    }
     evidence = (
         f"{ratio:.2f} times [{low:.2f}, {high:.2f}] (95 % bootstrap over {len(seeds)} seeds in "
         f"{len(set(blocks))} MDPs"

@@ -68,13 +68,13 @@ def Fingerprints(run: ReachRun) -> dict:
     )
 
 
-def TimedOutShare(run: ReachRun) -> float:
-    """The share of the run's exploratory problem-tries that ran out of actions without a
-    reach (a try reaches at most once; the rest end after ``max_actions``). For runs on a fixed
-    space, whose log numbers every reach from ``num_transitions`` on (a reshaped space's log
-    renumbers them)."""
-    log = RunLog(run)
-    return 1.0 - np.count_nonzero(log[:, 2] >= run.num_transitions) / run.settings.problem_tries
+def TimedOutTries(run: ReachRun) -> int:
+    """The run's exploratory problem-tries that ran out of actions without a reach (a try
+    reaches at most once; the rest end after ``max_actions``). For runs on a fixed space, whose
+    log numbers every reach from ``num_transitions`` on (a reshaped space's log renumbers
+    them)."""
+    reaches = np.count_nonzero(RunLog(run)[:, 2] >= run.num_transitions)
+    return run.settings.problem_tries - int(reaches)
 
 
 def RunSums(runs: list[ReachRun], stage: int, penalties: bool) -> np.ndarray:

@@ -25,6 +25,7 @@ from mobee_drake.experiments.ch8_measures import (
     RobotTimeRatio,
     RunSums,
     RunTrends,
+    TimedOutTries,
 )
 from mobee_drake.experiments.ch8_reaching import SOURCE_HOURS, ReachRun, SettingLabel
 from mobee_drake.experiments.plots import SaveFigure
@@ -171,7 +172,7 @@ def _SettingReport(output: pathlib.Path, results: list[ReachRun]) -> str:
     prints = {s: [Fingerprints(r) for r in runs] for s, runs in by_strategy.items()}
     sections = (
         _RewardSection(results, by_strategy, stages),
-        _EffortSection(by_strategy, k),
+        _EffortSection(by_strategy),
         _MdpSection(results, by_strategy, k),
         _FingerprintSection(results, prints, stages, m),
         _UnpairedSection(by_strategy, prints, stages),
@@ -239,7 +240,7 @@ def _EvaluationHours(runs: list[ReachRun], hours: float) -> str:
     return f"{evaluation:.1f} ({evaluation / hours:.0%})"
 
 
-def _EffortSection(by_strategy: dict, k: int) -> list[str]:
+def _EffortSection(by_strategy: dict) -> list[str]:
     """Robot time, failed transitions, timed-out problem-tries and safety per strategy."""
     strategies = list(by_strategy)
     lines = [
@@ -259,8 +260,7 @@ def _EffortSection(by_strategy: dict, k: int) -> list[str]:
             actions += len(log)
             failed += int(np.sum(log[:, 6] < 0))
             tries += r.settings.problem_tries
-            reaches = log[log[:, 2] >= k]
-            timeouts += r.settings.problem_tries - len(reaches)
+            timeouts += TimedOutTries(r)
         hours = sum(r.simulated_seconds for r in by_strategy[strategy]) / 3600
         lines.append(
             f"| {strategy} | {len(by_strategy[strategy])} | {hours:.1f} | "
