@@ -455,6 +455,19 @@ def _AddRecords(builder, config, mobee, robot_state, attractor, client, companio
     return request_ports, event_ledger, scripted_events, data_log
 
 
+def _CheckTrailMarker(visualization: Visualization, mobee: Mobee) -> None:
+    """Fails with a clear message when the trail's marker is not one of the robot's."""
+    if not visualization.trail_marker:
+        return
+    try:
+        mobee.marker_index(visualization.trail_marker)
+    except ValueError as e:
+        raise ValueError(
+            f"visualization trail_marker: {e} (the default, "
+            f"{Visualization.trail_marker}, is the iCub's; '' draws no trail)"
+        ) from None
+
+
 def MakeMobeeStation(
     config: StationConfig, meshcat: Meshcat | None = None, *, prebuild_callback=None
 ) -> Station:
@@ -497,14 +510,7 @@ def MakeMobeeStation(
     attractor, marker_forces = _ConnectClient(
         builder, client, mobee, mover, isinstance(mover_config, Reflex)
     )
-    if config.visualization.trail_marker:  # Checked with or without a viewer.
-        try:
-            mobee.marker_index(config.visualization.trail_marker)
-        except ValueError as e:
-            raise ValueError(
-                f"visualization trail_marker: {e} (the default, "
-                f"{Visualization.trail_marker}, is the iCub's; '' draws no trail)"
-            ) from None
+    _CheckTrailMarker(config.visualization, mobee)  # With or without a viewer.
     visualizer = None
     if meshcat is not None:
         visualizer = AddViewer(

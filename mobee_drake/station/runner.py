@@ -7,6 +7,7 @@ import pathlib
 import time
 
 from pydrake.systems.analysis import InitializeParams, Simulator, SimulatorConfig
+from pydrake.systems.framework import Context
 
 from mobee_drake.atomic_files import WriteTextAtomically
 from mobee_drake.owned_folders import OwnedFolder
@@ -146,6 +147,48 @@ def _StartRecording(station: Station, duration: float) -> None:
     station.meshcat.StartRecording(frames_per_second=rate, set_visualizations_while_recording=True)
 
 
+class _CheckpointSaver:
+    """A run's checkpoints in one folder: resumed from at the start, saved whenever a client has
+    completed an action (the data log, if kept with them, saved alongside)."""
+
+    def __init__(
+        self,
+        station: Station,
+        folder: str,
+        configuration: str,
+        log: CheckpointedLog | None,
+    ):
+        self._station = station
+        self._folder = folder
+        self._configuration = configuration
+        self._log = log
+        self._saved_actions = 0
+
+    def Resume(self, context: Context) -> float | None:
+        """Loads the folder's checkpoint into ``context``, if it has one; returns its time."""
+        if not HasCheckpoint(self._folder):
+            return None
+        LoadCheckpoint(self._station, context, self._folder, self._configuration)
+        resumed = context.get_time()
+        if self._log is not None:
+            self._log.Resume(LogSegments(self._folder), resumed)
+        return resumed
+
+    def Start(self, context: Context) -> None:
+        """Counts the actions completed when the simulation starts (none need saving)."""
+        self._saved_actions = CompletedActions(self._station, context)
+
+    def Save(self, context: Context) -> None:
+        segments = self._log.Save(context) if self._log is not None else 0
+        SaveCheckpoint(self._station, context, self._folder, self._configuration, segments)
+
+    def AfterChunk(self, context: Context) -> None:
+        done = CompletedActions(self._station, context)
+        if done > self._saved_actions:
+            self.Save(context)
+            self._saved_actions = done
+
+
 def RunStation(
     station: Station,
     duration: float,
@@ -183,16 +226,12 @@ def RunStation(
         if realtime_rate is not None:
             simulator.set_target_realtime_rate(realtime_rate)
         context = simulator.get_mutable_context()
-        resumed = None
         # With checkpoints the log is saved with them (and resumed from them).
         log = None
         if checkpoint and data_log and station.data_log is not None:
             log = CheckpointedLog(station.data_log, checkpoint)
-        if checkpoint and HasCheckpoint(checkpoint):
-            LoadCheckpoint(station, context, checkpoint, configuration)
-            resumed = context.get_time()
-            if log is not None:
-                log.Resume(LogSegments(checkpoint), resumed)
+        saver = _CheckpointSaver(station, checkpoint, configuration, log) if checkpoint else None
+        resumed = saver.Resume(context) if saver else None
         if resumed is not None and resumed >= duration:
             report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
             return RunSummary(0.0, 0.0, report, finished_before=resumed)
@@ -200,18 +239,6 @@ def RunStation(
             CheckStart(station.diagram, context)
         if record:  # (Before the initialization's drawing, which the recording keeps.)
             _StartRecording(station, duration - (resumed or 0.0))
-        saved = [0]
-
-        def Save(context) -> None:
-            segments = log.Save(context) if log is not None else 0
-            SaveCheckpoint(station, context, checkpoint, configuration, segments)
-
-        def AfterChunk(context):
-            done = CompletedActions(station, context)
-            if checkpoint and done > saved[0]:
-                Save(context)
-                saved[0] = done
-
         start = time.perf_counter()
         # A live run served until Ctrl-C ends normally on it, whenever it comes.
         serving = math.isinf(duration)
@@ -219,13 +246,15 @@ def RunStation(
             simulator.Initialize(
                 InitializeParams(suppress_initialization_events=resumed is not None)
             )
-            saved[0] = CompletedActions(station, context)
+            if saver:
+                saver.Start(context)
             if on_start is not None:
                 on_start()
             start = time.perf_counter()
-            Advance(station, simulator, duration, progress=progress, after_chunk=AfterChunk)
-        if checkpoint:
-            Save(context)
+            after_chunk = saver.AfterChunk if saver else None
+            Advance(station, simulator, duration, progress=progress, after_chunk=after_chunk)
+        if saver:
+            saver.Save(context)
         wall = time.perf_counter() - start
         report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
         return RunSummary(

@@ -27,7 +27,7 @@ from mobee_drake.mobee.system import Mobee
 from mobee_drake.robots.assembly import FreezeJoints
 from mobee_drake.robots.couplings import CoupledPositions, LinearMapSystem
 from mobee_drake.robots.scenario_robot import AddGhostRobot
-from mobee_drake.station.config import StationConfig
+from mobee_drake.station.config import StationConfig, Visualization
 from mobee_drake.world.live_world import ROLE_COLORS, LiveWorld
 
 ATTRACTOR_ALPHA = 0.25
@@ -451,25 +451,7 @@ def AddViewer(
         "world_drawer", WorldDrawer(meshcat=meshcat, world=world, period=period)
     )
     builder.Connect(scene_graph.get_query_output_port(), world_drawer.get_input_port())
-    num_markers = len(mobee.marker_names)
-    if settings.camera_position:
-        meshcat.SetCameraPose(settings.camera_position, settings.camera_target)
-    else:
-        framer = builder.AddNamedSystem(
-            "camera_framer",
-            CameraFramer(
-                meshcat=meshcat,
-                world=world,
-                marker_index=(
-                    mobee.marker_index(settings.trail_marker) if settings.trail_marker else None
-                ),
-                num_markers=num_markers,
-            ),
-        )
-        builder.Connect(
-            mobee.GetOutputPort("marker_positions"), framer.GetInputPort("marker_positions")
-        )
-        builder.Connect(scene_graph.get_query_output_port(), framer.GetInputPort("geometry_query"))
+    _AddCamera(builder, settings, meshcat, scene_graph, mobee, world)
     # MoBeE's primitives, hidden by default (toggle "collision" in Meshcat's controls).
     _AddGeometryLayer(
         builder,
@@ -483,12 +465,64 @@ def AddViewer(
         ),
         COLLISION_LAYER_FRAMES * period,
     )
+    _AddForceDrawer(builder, meshcat, mobee, config.time_step, marker_forces)
+    if settings.trail_marker:
+        trail = builder.AddNamedSystem(
+            "trail",
+            TrailDrawer(
+                meshcat=meshcat,
+                marker_index=mobee.marker_index(settings.trail_marker),
+                num_markers=len(mobee.marker_names),
+                period=max(config.time_step, 0.02),
+            ),
+        )
+        builder.Connect(mobee.GetOutputPort("marker_positions"), trail.get_input_port())
+    return visualizer
+
+
+def _AddCamera(
+    builder: DiagramBuilder,
+    settings: Visualization,
+    meshcat: Meshcat,
+    scene_graph: SceneGraph,
+    mobee: Mobee,
+    world: LiveWorld,
+) -> None:
+    """Places the camera where the scenario says, or adds the framer that follows the arm."""
+    if settings.camera_position:
+        meshcat.SetCameraPose(settings.camera_position, settings.camera_target)
+        return
+    framer = builder.AddNamedSystem(
+        "camera_framer",
+        CameraFramer(
+            meshcat=meshcat,
+            world=world,
+            marker_index=(
+                mobee.marker_index(settings.trail_marker) if settings.trail_marker else None
+            ),
+            num_markers=len(mobee.marker_names),
+        ),
+    )
+    builder.Connect(
+        mobee.GetOutputPort("marker_positions"), framer.GetInputPort("marker_positions")
+    )
+    builder.Connect(scene_graph.get_query_output_port(), framer.GetInputPort("geometry_query"))
+
+
+def _AddForceDrawer(
+    builder: DiagramBuilder,
+    meshcat: Meshcat,
+    mobee: Mobee,
+    time_step: float,
+    marker_forces: OutputPort | str | None,
+) -> None:
+    """Adds the arrows of MoBeE's field forces and of the client's marker forces, if any."""
     forces = builder.AddNamedSystem(
         "force_drawer",
         ForceDrawer(
             meshcat=meshcat,
-            num_markers=num_markers,
-            period=max(config.time_step, 1 / 30),
+            num_markers=len(mobee.marker_names),
+            period=max(time_step, 1 / 30),
         ),
     )
     builder.Connect(mobee.GetOutputPort("field_contacts"), forces.GetInputPort("field_contacts"))
@@ -499,15 +533,3 @@ def AddViewer(
         builder.ConnectInput(marker_forces, forces.GetInputPort("marker_forces"))
     elif marker_forces is not None:
         builder.Connect(marker_forces, forces.GetInputPort("marker_forces"))
-    if settings.trail_marker:
-        trail = builder.AddNamedSystem(
-            "trail",
-            TrailDrawer(
-                meshcat=meshcat,
-                marker_index=mobee.marker_index(settings.trail_marker),
-                num_markers=num_markers,
-                period=max(config.time_step, 0.02),
-            ),
-        )
-        builder.Connect(mobee.GetOutputPort("marker_positions"), trail.get_input_port())
-    return visualizer
