@@ -500,13 +500,7 @@ def RunOne(
     while True:
         done = int(learner.problem_tries.sum())
         if done in settings.stages and str(done) not in data["evaluations"]:
-            began = robot.simulated_seconds
-            data["evaluations"][str(done)] = [
-                [dc.asdict(r) for r in learner.Evaluate(robot, seed=(settings.seed, done, e))]
-                for e in range(settings.evaluations)
-            ]
-            if data["evaluation_seconds"] is not None:
-                data["evaluation_seconds"] += robot.simulated_seconds - began
+            _EvaluateStage(settings, learner, robot, data, done)
             Save()
         if done >= settings.problem_tries:
             break
@@ -530,6 +524,18 @@ def RunOne(
     elif settings.mdp == "simultaneous":
         extra = dict(mdp=_LearnedMdp(run_dir, learner, model))
     return _Result(settings, learner, robot, data, extra).ToJson()
+
+
+def _EvaluateStage(settings: RunSettings, learner, robot, data: dict, done: int) -> None:
+    """The exploitation evaluations of the stage at ``done`` problem-tries (ch. 8.3.3), each
+    problem's records, into ``data``, and their robot time (when the run times them)."""
+    began = robot.simulated_seconds
+    data["evaluations"][str(done)] = [
+        [dc.asdict(r) for r in learner.Evaluate(robot, seed=(settings.seed, done, e))]
+        for e in range(settings.evaluations)
+    ]
+    if data["evaluation_seconds"] is not None:
+        data["evaluation_seconds"] += robot.simulated_seconds - began
 
 
 def _Resume(checkpoint: pathlib.Path, robot, learner, keeper) -> dict:

@@ -95,6 +95,42 @@ class Agent:
     maintained_before: Maintenance | None = None
 
 
+def _CheckAgent(agent: Agent, joints: list[str]) -> None:
+    """Fails in one line when ``agent`` cannot run on MoBeE's ``joints``."""
+    unknown = [j for j in agent.joints if j not in joints]
+    if unknown:
+        raise ValueError(
+            f"agent '{agent.name}': unknown joints {unknown}; MoBeE's "
+            "joints are: " + ", ".join(joints)
+        )
+    if (
+        agent.model is not None
+        and agent.model.space.num_state_actions != agent.space.num_state_actions
+    ):
+        raise ValueError(
+            f"agent '{agent.name}': its model has "
+            f"{agent.model.space.num_state_actions} state-actions, its "
+            f"space {agent.space.num_state_actions}"
+        )
+    if agent.space.centres.shape[1] != len(agent.joints):
+        raise ValueError(
+            f"agent '{agent.name}': its space has "
+            f"{agent.space.centres.shape[1]} dimensions for "
+            f"{len(agent.joints)} joints"
+        )
+    if agent.maintenance is not None and STRATEGIES[agent.explorer.strategy].seeks_goal:
+        raise ValueError(
+            f"agent '{agent.name}': a space that reshapes itself is for exploring "
+            f"agents; strategy '{agent.explorer.strategy}' heads for a goal state, "
+            "whose number a round would change"
+        )
+    if agent.maintenance is not None and "develop" in agent.maintenance.rules:
+        raise ValueError(
+            f"agent '{agent.name}': the rule 'develop' needs a learner that favours "
+            "states (the reach learner's); an exploring agent favours none"
+        )
+
+
 class ExplorationSupervisor(LeafSystem):
     """Runs exploring agents on the robot and writes MoBeE's attractor.
 
@@ -133,38 +169,7 @@ class ExplorationSupervisor(LeafSystem):
         self._n = len(joints)
         self._columns = []
         for agent in self._agents:
-            unknown = [j for j in agent.joints if j not in joints]
-            if unknown:
-                raise ValueError(
-                    f"agent '{agent.name}': unknown joints {unknown}; MoBeE's "
-                    "joints are: " + ", ".join(joints)
-                )
-            if (
-                agent.model is not None
-                and agent.model.space.num_state_actions != agent.space.num_state_actions
-            ):
-                raise ValueError(
-                    f"agent '{agent.name}': its model has "
-                    f"{agent.model.space.num_state_actions} state-actions, its "
-                    f"space {agent.space.num_state_actions}"
-                )
-            if agent.space.centres.shape[1] != len(agent.joints):
-                raise ValueError(
-                    f"agent '{agent.name}': its space has "
-                    f"{agent.space.centres.shape[1]} dimensions for "
-                    f"{len(agent.joints)} joints"
-                )
-            if agent.maintenance is not None and STRATEGIES[agent.explorer.strategy].seeks_goal:
-                raise ValueError(
-                    f"agent '{agent.name}': a space that reshapes itself is for exploring "
-                    f"agents; strategy '{agent.explorer.strategy}' heads for a goal state, "
-                    "whose number a round would change"
-                )
-            if agent.maintenance is not None and "develop" in agent.maintenance.rules:
-                raise ValueError(
-                    f"agent '{agent.name}': the rule 'develop' needs a learner that favours "
-                    "states (the reach learner's); an exploring agent favours none"
-                )
+            _CheckAgent(agent, joints)
             self._columns.append(np.array([joints.index(j) for j in agent.joints]))
         claimed = np.concatenate(self._columns) if self._columns else np.zeros(0, dtype=int)
         if len(set(claimed.tolist())) != len(claimed):
