@@ -96,7 +96,7 @@ class Agent:
 
 
 def _CheckAgent(agent: Agent, joints: list[str]) -> None:
-    """Fails in one line when ``agent`` cannot run on MoBeE's ``joints``."""
+    """Raises ValueError (a one-line message) when ``agent`` cannot run on MoBeE's ``joints``."""
     unknown = [j for j in agent.joints if j not in joints]
     if unknown:
         raise ValueError(

@@ -149,7 +149,7 @@ def _StartRecording(station: Station, duration: float) -> None:
 
 class _CheckpointSaver:
     """A run's checkpoints in one folder: resumed from at the start, saved whenever a client has
-    completed an action (the data log, if kept with them, saved alongside)."""
+    completed an action and at the end (the data log, if kept with them, saved alongside)."""
 
     def __init__(
         self,
@@ -179,10 +179,12 @@ class _CheckpointSaver:
         self._saved_actions = CompletedActions(self._station, context)
 
     def Save(self, context: Context) -> None:
+        """Saves the checkpoint of ``context`` (and the log's new segments)."""
         segments = self._log.Save(context) if self._log is not None else 0
         SaveCheckpoint(self._station, context, self._folder, self._configuration, segments)
 
     def AfterChunk(self, context: Context) -> None:
+        """Saves when a client has completed an action since the last save."""
         done = CompletedActions(self._station, context)
         if done > self._saved_actions:
             self.Save(context)
@@ -231,7 +233,7 @@ def RunStation(
         if checkpoint and data_log and station.data_log is not None:
             log = CheckpointedLog(station.data_log, checkpoint)
         saver = _CheckpointSaver(station, checkpoint, configuration, log) if checkpoint else None
-        resumed = saver.Resume(context) if saver else None
+        resumed = saver.Resume(context) if saver is not None else None
         if resumed is not None and resumed >= duration:
             report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
             return RunSummary(0.0, 0.0, report, finished_before=resumed)
@@ -246,14 +248,14 @@ def RunStation(
             simulator.Initialize(
                 InitializeParams(suppress_initialization_events=resumed is not None)
             )
-            if saver:
+            if saver is not None:
                 saver.Start(context)
             if on_start is not None:
                 on_start()
             start = time.perf_counter()
-            after_chunk = saver.AfterChunk if saver else None
+            after_chunk = saver.AfterChunk if saver is not None else None
             Advance(station, simulator, duration, progress=progress, after_chunk=after_chunk)
-        if saver:
+        if saver is not None:
             saver.Save(context)
         wall = time.perf_counter() - start
         report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
