@@ -138,6 +138,18 @@ class TestClaims(unittest.TestCase):
         for i in (0, 3, 4, 6, 7, 8, 9):
             self.assertEqual(marks[i, "unit0.03_force300"], claims.NOT_TESTABLE, i)
 
+    def test_a_claim_against_the_others_needs_both(self):
+        # A unit swept with greedy and intrinsic alone: intrinsic far ahead of greedy at every
+        # stage is not "the best" (nor the least competent, nor more improving) of the three.
+        pair = [_Run(s, k, shift=5.0 if s == "intrinsic" else 0.0)
+                for s in ("greedy", "intrinsic") for k in range(6)]  # fmt: skip
+        marks = _Marks(pair)
+        for i in (0, 1, 3, 4, 5, 8):
+            self.assertEqual(marks[i, "unit0.03_force300"], claims.NOT_TESTABLE, i)
+        self.assertIn("both other strategies", claims.Verdicts(pair)[4].evidence)
+        # Greedy's lines compare greedy with intrinsic alone: still marked.
+        self.assertNotEqual(marks[9, "unit0.03_force300"], claims.NOT_TESTABLE)
+
     def test_the_ratio_and_a_missing_stage(self):
         verdicts = claims.Verdicts(self.strict)
         ratio = next(v for v in verdicts if v.claim.startswith("random exploration needs"))

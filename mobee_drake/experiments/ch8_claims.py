@@ -73,7 +73,7 @@ def _Family(runs: Runs, comparisons, larger: bool) -> tuple[str, str]:
     """Marks a claim made of paired comparisons ``(label, a, b, value)``, each claiming that a's
     value is ``larger`` (or smaller) than b's; Holm over the family."""
     if not comparisons:
-        return NOT_TESTABLE, "no other strategy's runs to compare with"
+        return NOT_TESTABLE, "needs the runs of both other strategies"
     done: list[tuple[str, PairedComparison]] = []
     for label, a, b, value in comparisons:
         values_a, values_b, blocks = _Pairs(runs, a, b, value)
@@ -127,7 +127,11 @@ def _Trended(runs: Runs) -> list[int]:
 
 
 def _OthersThan(runs: Runs, strategy: str) -> list[str]:
-    return [s for s in ("random", "greedy", "intrinsic") if s != strategy and s in runs]
+    """The two other strategies, when the setting has runs of both, else none: a claim against
+    "the others" (least competent, the best, many more) is not the claim against one of them
+    (e.g. a distance unit swept with greedy and intrinsic alone)."""
+    others = [s for s in ("random", "greedy", "intrinsic") if s != strategy]
+    return others if all(s in runs for s in others) else []
 
 
 def LeastCompetentFirst(runs: Runs, penalties: bool) -> tuple[str, str]:
@@ -235,7 +239,7 @@ def RandomFailsMore(runs: Runs) -> tuple[str, str]:
     """Fig. 8.8: the random explorer accumulates many more failed transitions."""
     comparisons = [(f"minus {o}", "random", o, _FailedPerTry) for o in _OthersThan(runs, "random")]
     if "random" not in runs or not comparisons:
-        return NOT_TESTABLE, "needs random runs and another strategy's"
+        return NOT_TESTABLE, "needs random, greedy and intrinsic runs"
     return _Family(runs, comparisons, larger=True)
 
 
