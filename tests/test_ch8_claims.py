@@ -1,6 +1,7 @@
 """The ch. 8 claims table from constructed result files (issue 33): each claim's mark follows
 the constructed runs, paired by seed, under each setting."""
 
+import re
 import unittest
 
 import numpy as np
@@ -253,6 +254,18 @@ class TestClaims(unittest.TestCase):
         results = Swept(0.03, 0.0) + Swept(0.1, -0.3)
         ((group, mark, evidence),) = claims.LessTuning(results)
         self.assertEqual((group, mark), ("force300", claims.REPRODUCED), evidence)
+        # The same seed's runs in the two units differ by the shift alone: the units' means lie
+        # 0.3 x 27 problems apart for greedy, not at all for intrinsic.
+        spread = re.search(
+            r"mean sums \(not marked\): greedy ([\d.]+), intrinsic ([\d.]+), greedy minus "
+            r"intrinsic \+([\d.]+) \[\+([\d.]+), \+([\d.]+)\]",
+            evidence,
+        )
+        greedy, intrinsic, difference, low, high = map(float, spread.groups())
+        np.testing.assert_allclose(
+            [greedy, intrinsic, difference], [0.3 * PROBLEMS, 0, 0.3 * PROBLEMS]
+        )
+        self.assertTrue(0 < low <= difference <= high, evidence)
         reversed_ = (
             Swept(0.03, 0.0)
             + [r for r in Swept(0.1, 0.0) if r.strategy == "greedy"]

@@ -319,6 +319,13 @@ def _EtaSquared(groups: list[np.ndarray]) -> float:
     return float(between / total) if total else 0.0
 
 
+def _UnitSpread(groups: list[np.ndarray]) -> float:
+    """How far apart the units' mean sums lie (the largest minus the smallest), in reward: how
+    much choosing the unit matters, whatever the runs' spread within a unit."""
+    means = [g.mean() for g in groups]
+    return float(max(means) - min(means))
+
+
 def _UnitGroups(runs: list[ReachRun]) -> list[np.ndarray] | None:
     """Per distance unit, the runs' sums at their last common stage (the source's sum); None
     with fewer than 2 units of 2 runs."""
@@ -339,20 +346,29 @@ def _LessTuningIn(runs: list[ReachRun]) -> tuple[str, str]:
     if None in groups.values():
         return NOT_TESTABLE, "needs greedy and intrinsic runs over at least 2 distance units"
     eta = {s: _EtaSquared(g) for s, g in groups.items()}
+    spread = {s: _UnitSpread(g) for s, g in groups.items()}
     greedy_p = float(stats.f_oneway(*groups["greedy"]).pvalue)
-    # The difference of the eta squareds, its bootstrap interval: runs resampled within units.
+    # Greedy minus intrinsic, of the eta squareds and of the spreads, with bootstrap intervals:
+    # runs resampled within units.
     rng = np.random.default_rng(0)
-    differences = [
-        _EtaSquared([rng.choice(g, g.size) for g in groups["greedy"]])
-        - _EtaSquared([rng.choice(g, g.size) for g in groups["intrinsic"]])
-        for _ in range(2000)
-    ]
-    low, high = np.percentile(differences, [2.5, 97.5])
+    differences = []
+    for _ in range(2000):
+        drawn = {s: [rng.choice(g, g.size) for g in groups[s]] for s in groups}
+        differences.append(
+            [
+                _EtaSquared(drawn["greedy"]) - _EtaSquared(drawn["intrinsic"]),
+                _UnitSpread(drawn["greedy"]) - _UnitSpread(drawn["intrinsic"]),
+            ]
+        )
+    (low, spread_low), (high, spread_high) = np.percentile(differences, [2.5, 97.5], axis=0)
     held = greedy_p < ALPHA and low > 0
     evidence = (
         f"the unit's share of the variance of the last stage's sums: greedy {eta['greedy']:.2f} "
         f"(ANOVA p = {greedy_p:.2g}), intrinsic {eta['intrinsic']:.2f}; greedy minus intrinsic "
-        f"{eta['greedy'] - eta['intrinsic']:+.2f} [{low:+.2f}, {high:+.2f}]"
+        f"{eta['greedy'] - eta['intrinsic']:+.2f} [{low:+.2f}, {high:+.2f}]; the range of the "
+        f"units' mean sums (not marked): greedy {spread['greedy']:.2f}, intrinsic "
+        f"{spread['intrinsic']:.2f}, greedy minus intrinsic "
+        f"{spread['greedy'] - spread['intrinsic']:+.2f} [{spread_low:+.2f}, {spread_high:+.2f}]"
     )
     return (REPRODUCED if held else NOT_REPRODUCED), evidence
 
