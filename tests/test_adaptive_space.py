@@ -332,12 +332,13 @@ class TestTheReachLearnersSpace(unittest.TestCase):
 
     def test_the_report_compares_the_roadmap_with_the_lattice(self):
         """Constructed runs: trm's fixed runs reach 1.5 more than the lattice's, seed by seed
-        (0.5 apart from seed to seed), and take 0.25 robot hours less."""
+        (0.5 apart from seed to seed), and take 0.25 robot hours less; trm's maintained runs
+        reach 2.5 more than the fixed lattice's (1.0 more than fixed trm's)."""
         from mobee_drake.experiments.adaptive_space_reaching import AdaptiveReachRun, Report
 
-        def Run(space, seed, reward, hours):
+        def Run(space, seed, reward, hours, condition="fixed"):
             return AdaptiveReachRun(
-                strategy="greedy", condition="fixed", seed=seed, stage=8, reward=reward,
+                strategy="greedy", condition=condition, seed=seed, stage=8, reward=reward,
                 reward_without_penalties=reward, robot_hours=hours, states=81, transitions=351,
                 changes={}, penetrating_steps=0, wall_seconds=1.0, space=space,
             )  # fmt: skip
@@ -352,6 +353,16 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         self.assertIn("icub greedy, trm minus rank3 (both fixed), summed reward: +1.5", reward)
         self.assertIn("robot hours: -0.25", hours)
         self.assertIn("(Holm over the 2)", report)
+        self.assertNotIn("trm maintained minus", report)
+        runs += [Run("trm", k, 22.5 + 0.5 * k + 0.02 * k * k, 1.75, "maintained") for k in range(4)]
+        report = Report(runs, "test")
+        (reward,) = [line for line in report.splitlines() if "summed reward" in line
+                     and "trm maintained minus rank3 fixed" in line]  # fmt: skip
+        gain = np.mean([2.5 + 0.02 * k * k for k in range(4)])
+        self.assertIn(
+            f"icub greedy, trm maintained minus rank3 fixed, summed reward: {gain:+.2f}", reward
+        )
+        self.assertIn("(Holm over the 6)", report)  # (and trm maintained minus fixed)
 
     def test_a_stage_is_evaluated_before_its_round(self):
         """A round due every 4 problem-tries, stages at 4 and 8 (the last): each stage's

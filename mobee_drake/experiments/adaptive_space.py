@@ -31,12 +31,12 @@ Per run, at the end:
 - the space's states and state-actions at the end, its changes by rule, the robot's simulated
   time per action, the wall time and the penetrating periods.
 
-Maintained minus fixed on each space, and the roadmap minus the rank-4 lattice (both fixed), are
-compared paired by seed, Holm-corrected over all of them and the four measures (coverage,
-dispersion, prediction error, state-actions tried). No round is made at the run's last action
-count (``MaintenanceConfig.until``): the measures see the space the agent explored in its last
-``--every`` actions, not one just reshaped. The report names
-a PNG and, per arm, a Meshcat scene of the first seed's maintained runs
+Maintained minus fixed on each space, and the roadmap, fixed and maintained, minus the fixed
+rank-4 lattice, are compared paired by seed, Holm-corrected over all of them and the four
+measures (coverage, dispersion, prediction error, state-actions tried). No round is made at the
+run's last action count (``MaintenanceConfig.until``): the measures see the space the agent
+explored in its last ``--every`` actions, not one just reshaped. The report names a PNG and, per
+arm, a Meshcat scene of the first seed's maintained runs
 (:mod:`mobee_drake.experiments.adaptive_space_figures`).
 
 Run: ``mobee-drake experiment adaptive-space [--robots icub katana] [--seeds 10] [--actions 2000]

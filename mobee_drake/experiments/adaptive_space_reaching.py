@@ -19,9 +19,9 @@ runs' setting).
 Per run, at the last stage: the evaluations' summed reward (ch. 8.3.3, with the -10 of every
 failed transition and without), the robot's simulated hours, the space's size and its changes,
 and the penetrating periods (:mod:`~mobee_drake.reaching.appearance`'s split). Maintained minus
-fixed on each space, and the roadmap minus the lattice (both fixed), are compared paired by
-seed, Holm-corrected over them all (the robots, spaces, strategies and the two measures: reward
-with penalties, robot hours)."""
+fixed on each space, and the roadmap, fixed and maintained, minus the fixed lattice, are
+compared paired by seed, Holm-corrected over them all (the robots, spaces, strategies and the
+two measures: reward with penalties, robot hours)."""
 
 import dataclasses as dc
 
