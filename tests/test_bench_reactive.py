@@ -16,6 +16,7 @@ from mobee_drake import cli
 from mobee_drake.experiments import reactive_controllers, reactive_tasks
 from mobee_drake.experiments import reactive_report as report
 from mobee_drake.experiments import reactive_runs as runs
+from mobee_drake.experiments.doc_tables import GeneratedBlocks
 from mobee_drake.experiments.plots import SaveFigure
 from mobee_drake.mobee.params import MobeeParams
 from mobee_drake.world.objects import Sphere
@@ -178,6 +179,32 @@ class TestCommand(unittest.TestCase):
         text = out.getvalue()
         self.assertIn("| MoBeE (defaults), palm goal | 0/1 | 0/1 |", text)
         self.assertIn(f"mobee,{reactive_tasks.SHIPPED},shipped,", text)
+
+    def test_the_tables_go_into_the_docs_generated_block(self):
+        with tempfile.TemporaryDirectory() as folder:
+            doc = pathlib.Path(folder) / "reactive.md"
+            doc.write_text("<!-- generated: reactive, by x -->\n<!-- end generated: reactive -->\n")
+            with contextlib.redirect_stdout(io.StringIO()) as out:
+                cli.main(
+                    ["bench", "reactive", "--tasks", "0", "--horizon", "0.5", "--controllers",
+                     "mobee", "--quiet", "--doc", str(doc)]
+                )  # fmt: skip
+            ((name, command, table),) = GeneratedBlocks(doc)
+            self.assertIn(table.strip(), out.getvalue())
+            self.assertIn("| MoBeE (defaults), palm goal | 0/1 | 0/1 |", table)
+            self.assertIn("Reached by 0.5 s / by 0.5 s, per kind of task:", table)
+            self.assertIn("at a load average of", table)
+            self.assertEqual(
+                command,
+                "mobee-drake bench reactive --tasks 0 --seed 0 --horizon 0.5 --controllers mobee "
+                f"--mobee-preset defaults --doc {doc} --doc-table reactive",
+            )
+            # A doc without the block: one line and exit code 2, before anything runs.
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err), self.assertRaises(SystemExit) as exit_:
+                cli.main(["bench", "reactive", "--doc", str(doc), "--doc-table", "other"])
+            self.assertEqual(exit_.exception.code, 2)
+            self.assertIn(f"{doc}: no generated block 'other'", err.getvalue())
 
     def test_every_option_says_its_default(self):
         out = io.StringIO()

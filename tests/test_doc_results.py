@@ -51,3 +51,39 @@ class TestKeptBatteries(unittest.TestCase):
         for ratio, low, high in quoted:
             with self.subTest(ratio=ratio):
                 self.assertIn(f"{ratio} times [{low}, {high}]", " ".join(tables))
+
+
+def _Rows(table: str) -> dict[str, list[str]]:
+    """The rows of the first markdown table in a generated block: the first cell, then the
+    others."""
+    rows = {}
+    for line in table.split("\n\n|", 1)[-1].split("\n\n")[0].splitlines():
+        if not line.startswith("|---"):
+            cells = [c.strip() for c in line.strip("|").split("|")]
+            rows[cells[0]] = cells[1:]
+    return rows
+
+
+class TestReactiveQuotes(unittest.TestCase):
+    """The figures docs/reactive.md and docs/mobee.md quote from `bench reactive` are its
+    generated tables' (median time to reach: column 3; worst clearance to obstacles: 5)."""
+
+    def test_the_quoted_times_and_clearances_are_the_tables(self):
+        blocks = {
+            name: _Rows(table) for name, _, table in GeneratedBlocks(ROOT / "docs/reactive.md")
+        }
+        main, no_flow = blocks["reactive"], blocks["reactive-no-flow"]
+        palm, fast = main["MoBeE (defaults), palm goal"], main["DiffIK, 1 cm, 1 rad/s"]
+        slow = [main["DiffIK, 1 cm"][2], main["DiffIK, 3 cm (MoBeE's field)"][2]]
+        unflowed = no_flow["MoBeE (defaults_no_flow), palm goal"]
+        reactive = _Folded((ROOT / "docs/reactive.md").read_text())
+        self.assertIn(
+            f"median time to reach: {palm[2]} s against {slow[0]} and {slow[1]} s", reactive
+        )
+        self.assertIn(f"(median {fast[2]} against {palm[2]} s)", reactive)
+        mobee = _Folded((ROOT / "docs/mobee.md").read_text())
+        self.assertIn(
+            f"worst clearance from {unflowed[4].lstrip('+')} to {palm[4].lstrip('+')} cm and "
+            f"shortened their median time from {unflowed[2]} to {palm[2]} s",
+            mobee,
+        )

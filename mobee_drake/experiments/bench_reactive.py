@@ -30,12 +30,17 @@ which solids penetrated, the tasks that broke a joint-space constraint (MoBeE's 
 joint limits), and the wall time of the controller's own step (median and 95th percentile).
 
 Run: ``mobee-drake bench reactive [--tasks 20] [--seed 0] [--horizon 15] [--controllers ...]
-[--mobee-preset defaults] [--detail] [--plot FILE.png]``.
+[--mobee-preset defaults] [--detail] [--plot FILE.png] [--doc DOC [--doc-table NAME]]``; with
+``--doc`` the tables are also written into the doc's generated block, with the date and the
+machine's load (the step costs are wall time, which other work inflates).
 """
 
+import datetime
+import os
 import time
 
 from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveFloat
+from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
 from mobee_drake.experiments.plots import SaveFigure
 from mobee_drake.experiments.reactive_controllers import CONTROLLERS, MOBEE_PRESETS, Controllers
 from mobee_drake.experiments.reactive_report import (
@@ -74,7 +79,16 @@ def main(argv=None) -> None:
     parser.add_argument("--detail", action="store_true", help="print one CSV row per run")
     parser.add_argument("--plot", default="", help="save the figure to this PNG")
     parser.add_argument("--quiet", action="store_true", help="no line per run while running")
+    parser.add_argument("--doc", help="a doc whose generated block (--doc-table) gets the tables")
+    parser.add_argument(
+        "--doc-table", default="reactive", help="the name of --doc's block (default: reactive)"
+    )
     args = parser.parse_args(argv)
+    if args.doc:
+        try:
+            GeneratedTable(args.doc, args.doc_table)
+        except (OSError, ValueError) as error:
+            parser.error(f"--doc: {error}")
     scene = TaskScene()
     tasks = MakeTasks(args.tasks, args.seed, scene)
     available = Controllers(args.mobee_preset)
@@ -91,19 +105,34 @@ def main(argv=None) -> None:
     wall = time.perf_counter() - begin
     early = min(EARLY, args.horizon)
     summaries = [Summarize(labels[name], rows, early) for name, rows in results.items()]
-    print(
-        f"\n{len(tasks)} tasks ({SHIPPED} and {args.tasks} random, seed {args.seed}), "
-        f"{args.horizon:g} s each at {1000 * PERIOD:g} ms, in {wall:.0f} s:\n"
+    text = (
+        f"{len(tasks)} tasks ({SHIPPED} and {args.tasks} random, seed {args.seed}), "
+        f"{args.horizon:g} s each at {1000 * PERIOD:g} ms, in {wall:.0f} s "
+        f"({datetime.datetime.now(datetime.UTC):%Y-%m-%d}, {os.cpu_count()} cores at a load "
+        f"average of {os.getloadavg()[0]:.1f}):\n\n"
+        f"{Table(summaries, args.horizon, early)}\n\n"
+        f"{KindTable(results, labels, args.horizon, early)}"
     )
-    print(Table(summaries, args.horizon, early))
-    print()
-    print(KindTable(results, labels, args.horizon, early))
+    print(f"\n{text}")
+    if args.doc:
+        WriteGeneratedTable(args.doc, args.doc_table, _Command(args), text)
     if args.detail:
         print(f"\n{DETAIL_COLUMNS}")
         print("\n".join(DetailRows(results)))
     if args.plot:
         SaveFigure(ReactiveFigure(results, labels, args.horizon, early), args.plot, dpi=90)
         print(f"plot: {args.plot}")
+
+
+def _Command(args) -> str:
+    """The command line that writes ``args.doc``'s block (the options that change the runs)."""
+    return (
+        f"mobee-drake bench reactive --tasks {args.tasks} --seed {args.seed} --horizon "
+        f"{args.horizon:g} --controllers {' '.join(args.controllers)} --mobee-preset "
+        f"{args.mobee_preset}"
+        + (f" --plot {args.plot}" if args.plot else "")
+        + f" --doc {args.doc} --doc-table {args.doc_table}"
+    )
 
 
 if __name__ == "__main__":
