@@ -39,13 +39,13 @@ def SpaceComparisons(groups: dict[tuple, list], lattice: str, measures: dict) ->
         )
         for robot, space, *more in sorted({key[:-1] for key in groups})
     }
+    labels = {
+        "fixed": f"trm minus {lattice} (both fixed)",
+        "maintained": f"trm maintained minus {lattice} fixed",
+    }
     roadmap = {}
     for robot, *more in sorted({(key[0], *key[2:-1]) for key in groups}):
         grid = groups.get((robot, lattice, *more, "fixed"), [])
-        labels = {
-            "fixed": f"trm minus {lattice} (both fixed)",
-            "maintained": f"trm maintained minus {lattice} fixed",
-        }
         for condition, label in labels.items():
             trm = groups.get((robot, "trm", *more, condition), [])
             if trm and grid:
