@@ -125,8 +125,6 @@ class TestMistakes(unittest.TestCase):
                 ],
                 "the robot starts in penetration: the robot: 'r_hand'",
             ),  # fmt: skip
-            (["bench", "safety", "--doc", str(notes)], "no generated block 'safety scenes'"),
-            (["bench", "ik", "--doc", str(notes)], "no generated block 'ngik-benchmark'"),
             (["bench", "safety", "--report-only"], "--report-only needs --output"),
             # Issue 31, item 11: nonsense that ran silently, or ended in a Python type error.
             (["run", "reach_around_ball", "--set", ""], "overrides '': not a YAML mapping"),
@@ -199,6 +197,38 @@ class TestMistakes(unittest.TestCase):
                 self.assertEqual(len(err.strip().splitlines()), 1, err)
                 self.assertIn(message, err)
                 self.assertNotIn("Traceback", err)
+
+    def test_a_doc_without_its_block_is_refused_before_anything_runs(self):
+        # Every command that writes a block of a doc reads the doc first: a mistyped --doc would
+        # otherwise end a battery of hours in an error at its last line.
+        scratch = pathlib.Path(tempfile.mkdtemp())
+        self.addCleanup(shutil.rmtree, scratch)
+        notes = scratch / "notes.md"
+        notes.write_text("mine")
+        for command, block in (
+            (["experiment", "adaptive-space"], "adaptive-space"),
+            (["experiment", "adaptive-space", "--part", "reaching"], "adaptive-space-reaching"),
+            (["experiment", "ch7", "--experiment", "7.1"], "ch7-7.1"),
+            (["experiment", "ch8"], "ch8-claims"),
+            (["experiment", "parallel-behaviours"], "parallel-behaviours"),
+            (["experiment", "roadmaps", "--scratch-table"], "roadmap-from-scratch"),
+            (["experiment", "saggriac"], "saggriac-interest"),
+            (["experiment", "trm"], "trm-examples"),
+            (["bench", "forces"], "forces"),
+            (["bench", "ik"], "ngik-benchmark"),
+            (["bench", "objects"], "object count"),
+            (["bench", "reactive"], "reactive"),
+            (["bench", "safety"], "safety scenes"),
+            (["bench", "viewer"], "viewer"),
+        ):
+            with self.subTest(command):
+                code, _, err = _Call(*command, "--doc", str(notes))
+                self.assertEqual(code, 2)
+                self.assertEqual(len(err.strip().splitlines()), 1, err)
+                self.assertIn(f"--doc: {notes}: no generated block '{block}'", err)
+        code, _, err = _Call("experiment", "ch8", "--doc", str(scratch / "missing.md"))
+        self.assertEqual(code, 2)
+        self.assertIn(f"--doc: [Errno 2] No such file or directory: '{scratch}/missing.md'", err)
 
     def test_a_failed_battery_is_one_line_and_exit_code_1(self):
         """Issue 31, item 7: a killed worker or a full disk ended in a multi-screen traceback."""

@@ -76,7 +76,7 @@ from mobee_drake.experiments.battery import (
 )
 from mobee_drake.experiments.ch7_model_learning import ExploreJob, Stop
 from mobee_drake.experiments.ch8_reaching import ReachRobot
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel
@@ -486,11 +486,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     exploring = args.part == "exploration"
     block = "adaptive-space" if exploring else "adaptive-space-reaching"
-    if args.doc:
-        try:
-            GeneratedTable(args.doc, block)
-        except (OSError, ValueError) as error:
-            parser.error(str(error))
+    CheckDocBlocks(parser, args.doc, block)
     rules = args.rules or (MaintenanceConfig().rules if exploring else list(RULES))
     if exploring and "develop" in rules:
         parser.error(

@@ -35,7 +35,7 @@ from mobee_drake.experiments.arguments import (
     NonNegativeInt,
     PositiveInt,
 )
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.experiments.plots import Figure, SaveFigure, plt
 from mobee_drake.mobee.barrier import StepModel
 from mobee_drake.mobee.system import Mobee
@@ -359,11 +359,7 @@ def main(argv=None) -> None:
     args = parser.parse_args(argv)
     if args.plot and not CanWrite(args.plot):  # (checked before the work)
         parser.error(f"--plot {args.plot}: cannot be written (its folder is missing, read-only?)")
-    if args.doc:
-        try:
-            GeneratedTable(args.doc, args.doc_table)
-        except (OSError, ValueError) as error:
-            parser.error(f"--doc: {error}")
+    CheckDocBlocks(parser, args.doc, args.doc_table)
     if args.stages:
         print("| robot | boxes | " + " | ".join(f"{s} (us)" for s in STAGES) + " |")
         print("|---|---:|" + "---:|" * len(STAGES))

@@ -36,7 +36,7 @@ from pydrake.solvers import Solve
 from scipy import stats
 
 from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.experiments.statistics import Holm
 from mobee_drake.ngik.costs import CollisionCost, MarkerOrientationCost, MarkerPositionCost
 from mobee_drake.ngik.kinematic_model import KinematicModel
@@ -281,11 +281,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--doc", help="a doc whose generated block to rewrite with the results")
     parser.add_argument("--doc-table", default=DOC_TABLE, help="the name of --doc's block")
     args = parser.parse_args(argv)
-    if args.doc:
-        try:
-            GeneratedTable(args.doc, args.doc_table)
-        except (OSError, ValueError) as error:
-            parser.error(f"--doc: {error}")
+    CheckDocBlocks(parser, args.doc, args.doc_table)
     rows = Run(args.problems, args.seed)
     mark, evidence = OptimiserMark(rows)
     text = (

@@ -31,7 +31,7 @@ from pydrake.systems.framework import DiagramBuilder
 
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
 from mobee_drake.experiments.battery import DieWithParent
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.robots.scenario_robot import AddScenarioRobot
 from mobee_drake.scenario import BuildScenario, LoadScenario
 from mobee_drake.station.config import MAX_OBJECTS, StationConfig
@@ -170,11 +170,7 @@ def main(argv=None) -> None:
     )
     parser.add_argument("--doc", help="a doc whose generated object-count table to rewrite")
     args = parser.parse_args(argv)
-    if args.doc:  # Checked before anything runs.
-        try:
-            GeneratedTable(args.doc, DOC_TABLE)
-        except (OSError, ValueError) as error:
-            parser.error(f"--doc: {error}")
+    CheckDocBlocks(parser, args.doc, DOC_TABLE)  # Checked before anything runs.
     print(f"each build in a fresh process capped at {args.cap_gib:g} GiB; limit {MAX_OBJECTS:,}")
     table = Table(args.counts, int(args.cap_gib * 2**30))
     if args.doc:

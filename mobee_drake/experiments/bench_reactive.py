@@ -40,7 +40,7 @@ import os
 import time
 
 from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveFloat
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.experiments.plots import SaveFigure
 from mobee_drake.experiments.reactive_controllers import CONTROLLERS, MOBEE_PRESETS, Controllers
 from mobee_drake.experiments.reactive_report import (
@@ -84,11 +84,7 @@ def main(argv=None) -> None:
         "--doc-table", default="reactive", help="the name of --doc's block (default: reactive)"
     )
     args = parser.parse_args(argv)
-    if args.doc:
-        try:
-            GeneratedTable(args.doc, args.doc_table)
-        except (OSError, ValueError) as error:
-            parser.error(f"--doc: {error}")
+    CheckDocBlocks(parser, args.doc, args.doc_table)
     scene = TaskScene()
     tasks = MakeTasks(args.tasks, args.seed, scene)
     available = Controllers(args.mobee_preset)

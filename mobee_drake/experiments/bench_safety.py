@@ -33,7 +33,7 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 
 from mobee_drake.atomic_files import StrictJson, WriteTextAtomically
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.scenario import LoadScenario, Scenario
 from mobee_drake.station.builder import MakeMobeeStation
@@ -424,12 +424,7 @@ def main(argv=None) -> None:
     if args.report_only and not args.output:
         parser.error("--report-only needs --output, the folder of an earlier run")
     command = "mobee-drake bench safety " + " ".join(argv if argv is not None else [])
-    if args.doc:  # Checked before anything runs.
-        try:
-            for name in ("safety scenes", "safety babbling"):
-                GeneratedTable(args.doc, name)
-        except (OSError, ValueError) as error:
-            parser.error(f"--doc: {error}")
+    CheckDocBlocks(parser, args.doc, "safety scenes", "safety babbling")
     folder = pathlib.Path(args.output) if args.output else None
     with OwnedFolder(folder, "safety benchmark") if folder else contextlib.nullcontext():
         if args.report_only:

@@ -54,7 +54,7 @@ from mobee_drake.atomic_files import StrictJson, WriteTextAtomically
 from mobee_drake.experiments import browser_probe
 from mobee_drake.experiments.arguments import CommandParser, NonEmpty, PositiveFloat, PositiveInt
 from mobee_drake.experiments.browser_probe import BrowserSession, BrowserUnavailable
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 
 MAIN_JOB = "reach_around_ball"
 LIVE_SCENARIO = "interactive"
@@ -442,11 +442,7 @@ def main(argv=None) -> None:
         parser.error(f"--label: letters, digits, '_', '.' or '-' only, got '{args.label}'")
     if args.report_only and not args.doc:
         parser.error("--report-only needs --doc")
-    if args.doc:  # Checked before anything runs.
-        try:
-            GeneratedTable(args.doc, DOC_BLOCK)
-        except (OSError, ValueError) as error:
-            parser.error(f"--doc: {error}")
+    CheckDocBlocks(parser, args.doc, DOC_BLOCK)  # Checked before anything runs.
     folder = pathlib.Path(args.results)
     if not args.report_only:
         signal.signal(signal.SIGTERM, _Terminate)

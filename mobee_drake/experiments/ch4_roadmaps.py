@@ -29,7 +29,7 @@ import numpy as np
 from pydrake.geometry import StartMeshcat
 
 from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.ngik.costs import CollisionCost, HomeCost, MarkerPositionCost
 from mobee_drake.ngik.kinematic_model import KinematicModel
 from mobee_drake.ngik.nes import NesConfig
@@ -283,11 +283,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     if args.doc and not args.scratch_table:
         parser.error("--doc writes the table of --scratch-table")
-    if args.doc:
-        try:
-            GeneratedTable(args.doc, DOC_TABLE)
-        except (OSError, ValueError) as error:
-            parser.error(f"--doc: {error}")
+    CheckDocBlocks(parser, args.doc, DOC_TABLE)
     if args.scratch_table:
         lines = ScratchTable(args.seeds)
         if args.doc:

@@ -20,7 +20,7 @@ from mobee_drake.experiments.ch7_model_learning import (
     RunThreeAgentsControls,
 )
 from mobee_drake.experiments.ch7_report import REPORTS
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.owned_folders import ClaimFolder
 
 
@@ -70,11 +70,7 @@ def main(argv=None) -> None:
     if noise and args.experiment == "7.4.1":
         parser.error("--transition-noise: 7.4.1 runs on the noise-free robot only")
     block = f"ch7-{args.experiment}"
-    if args.doc:
-        try:
-            GeneratedTable(args.doc, block)
-        except (OSError, ValueError) as error:
-            parser.error(f"--doc: {error}")
+    CheckDocBlocks(parser, args.doc, block)
     output = ClaimFolder(args.output, "battery")  # (a file or a user's folder refused)
     backend = BackendOf(args)
     if args.experiment == "7.1":

@@ -38,7 +38,7 @@ from mobee_drake.experiments.ch8_reaching import (
     TrainMdp,
 )
 from mobee_drake.experiments.ch8_report import Report
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.owned_folders import ClaimFolder, OwnedFolder
 from mobee_drake.reaching.learner import (
     EVALUATION_HISTORIES,
@@ -269,11 +269,7 @@ def main(argv=None) -> None:
     output = pathlib.Path(args.output)
     if args.report_only and not output.is_dir():  # (checked before a folder is made)
         parser.error(f"--report-only: {output} is not a folder of reach-learning runs")
-    if args.doc:
-        try:
-            GeneratedTable(args.doc, args.doc_table)
-        except (OSError, ValueError) as error:
-            parser.error(f"--doc: {error}")
+    CheckDocBlocks(parser, args.doc, args.doc_table)
     ClaimFolder(output, "battery")  # (a file, or a folder of the user's, refused in one line)
     variants = _Variants(args, stages)
     settings = variants[0]

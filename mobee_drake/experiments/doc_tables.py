@@ -6,6 +6,7 @@ command that generates it, so that a table and its benchmark cannot disagree.
     <!-- end generated: NAME -->
 """
 
+import argparse
 import pathlib
 import re
 
@@ -35,6 +36,19 @@ def GeneratedTable(doc: str | pathlib.Path, name: str) -> str:
     if match is None:
         raise ValueError(f"{doc}: no generated block '{name}'")
     return match["table"]
+
+
+def CheckDocBlocks(parser: argparse.ArgumentParser, doc: str | None, *names: str) -> None:
+    """Ends the command in one line through ``parser.error`` (exit code 2) if ``doc`` is given
+    and cannot be read or lacks one of the generated blocks ``names``: checked before a run
+    spends its time."""
+    if not doc:
+        return
+    for name in names:
+        try:
+            GeneratedTable(doc, name)
+        except (OSError, ValueError) as error:
+            parser.error(f"--doc: {error}")
 
 
 def WriteGeneratedTable(doc: str | pathlib.Path, name: str, command: str, table: str) -> None:

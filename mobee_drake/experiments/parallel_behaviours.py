@@ -35,7 +35,7 @@ from mobee_drake.experiments.battery import (
     RunBattery,
     RunFolder,
 )
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.experiments.plots import Legend, SaveFigure, plt
 from mobee_drake.experiments.statistics import FiniteMean, PairedBySeed
 from mobee_drake.owned_folders import OwnedFolder
@@ -193,11 +193,7 @@ def main(argv: list[str] | None = None) -> None:
     )
     AddBackendArguments(parser)
     args = parser.parse_args(argv)
-    if args.doc:
-        try:
-            GeneratedTable(args.doc, "parallel-behaviours")
-        except (OSError, ValueError) as error:
-            parser.error(f"--doc: {error}")
+    CheckDocBlocks(parser, args.doc, "parallel-behaviours")
     output = pathlib.Path(args.output)
     jobs = [
         Job(

@@ -12,7 +12,7 @@ from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
 )
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.experiments.saggriac import FULL, METHODS, SMOKE, VARIANTS, RunAll, RunSpec
 from mobee_drake.experiments.saggriac_interest import Issue34Lines
 from mobee_drake.experiments.saggriac_report import Analyse
@@ -123,11 +123,7 @@ def main(argv=None) -> None:
                 f"--checkpoints {args.checkpoints}: more evaluations than experiment "
                 f"{experiment}'s budget of {budgets[experiment]}"
             )
-    if args.doc:
-        try:
-            GeneratedTable(args.doc, args.doc_table)
-        except (OSError, ValueError) as error:
-            parser.error(f"--doc: {error}")
+    CheckDocBlocks(parser, args.doc, args.doc_table)
     # Seed-major order: an interrupted battery leaves every group with about as many seeds.
     specs = [
         RunSpec(experiment, method, seed, budgets[experiment], args.checkpoints, variant)

@@ -39,7 +39,7 @@ from mobee_drake.experiments.battery import (
     RunFolder,
 )
 from mobee_drake.experiments.ch8_reaching import RIGHT_ARM, LoadTrainedLearner, ReachScenario
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.experiments.statistics import FiniteMean, PairedBySeed
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.reaching.appearance import AppearanceWatch
@@ -325,10 +325,9 @@ def main(argv: list[str] | None = None) -> None:
     block = args.block or "-".join(filter(None, ["torso-reach", module.Label()]))
     try:
         LoadTrainedLearner(args.learner)
-        if args.doc:
-            GeneratedTable(args.doc, block)
     except (OSError, ValueError) as error:
         parser.error(str(error))
+    CheckDocBlocks(parser, args.doc, block)
     learner_dir = str(pathlib.Path(args.learner).resolve())
     jobs = [
         Job(

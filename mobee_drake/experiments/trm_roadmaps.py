@@ -21,7 +21,7 @@ import numpy as np
 
 from mobee_drake.atomic_files import WriteTextAtomically
 from mobee_drake.experiments.arguments import CommandParser, NonNegativeInt, PositiveInt
-from mobee_drake.experiments.doc_tables import GeneratedTable, WriteGeneratedTable
+from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.experiments.plots import Figure, SaveFigure, plt
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.station.viewer import RecordingMeshcat
@@ -175,11 +175,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--doc", help="a doc whose generated block to rewrite with the table")
     parser.add_argument("--doc-table", default=DOC_TABLE, help="the name of --doc's block")
     args = parser.parse_args(argv)
-    if args.doc:
-        try:
-            GeneratedTable(args.doc, args.doc_table)
-        except (OSError, ValueError) as error:
-            parser.error(f"--doc: {error}")
+    CheckDocBlocks(parser, args.doc, args.doc_table)
     output = pathlib.Path(args.output)
     config = TrmConfig(max_vertices=args.max_vertices)
     # (Claimed like every folder a command writes: never a user's, one writer at a time.)
