@@ -15,25 +15,20 @@ from test_figures import FigureTest
 from mobee_drake.experiments import adaptive_space
 from mobee_drake.experiments.adaptive_space_figures import Figure
 from mobee_drake.experiments.arms import Arms, ReachTargets, ValidConfigurations
-from mobee_drake.planning.explorers import Explorer
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.reaching.targets import LoadTargetGrid
 
 
 class TestMeasures(unittest.TestCase):
-    def test_the_distance_to_the_nearest_state_the_robot_was_in(self):
-        """The robot was in states 0 (0.25, 0.25: arrived in) and 1 (0.25, 0.75: acted from)
-        of the square: the valid configurations' distances are to them alone; state 3 (0.75,
-        0.75: never there) does not count."""
-        explorer = Explorer(Lattice([0.25, 0.75], 2))
-        explorer.Observe(2, 0)  # 1 -> 0 arrived
-        explorer.Observe(0, 0)  # 0 -> 1 stayed in 0
+    def test_the_distance_to_the_nearest_configuration_an_action_ended_in(self):
+        """Actions ended at (0.25, 0.25) and (0.25, 0.75): the valid configurations' distances
+        are to those, not to any state's centre; with no action, none is near."""
+        settled = np.array([[0.25, 0.25], [0.25, 0.75]])
         valid = np.array([[0.25, 0.25], [0.3, 0.3], [0.75, 0.75]])
         np.testing.assert_allclose(
-            adaptive_space.Nearest(explorer, valid), [0.0, 0.05 * np.sqrt(2), 0.5]
+            adaptive_space.Nearest(settled, valid), [0.0, 0.05 * np.sqrt(2), 0.5]
         )
-        fresh = Explorer(explorer.space)
-        self.assertTrue(np.all(np.isinf(adaptive_space.Nearest(fresh, valid))))
+        self.assertTrue(np.all(np.isinf(adaptive_space.Nearest(np.zeros((0, 2)), valid))))
 
     def test_the_valid_configurations_keep_the_constraints_and_the_obstacles(self):
         """The iCub's sample keeps some draws and drops others (the shoulder's cable
@@ -197,11 +192,14 @@ class TestSmokeBattery(FigureTest):
         self.assertRegex(
             report, rf"\| icub \| rank4 \| maintained \| 2 \| 3\d \| .* \| {states:.0f} \|"
         )
-        self.assertIn("icub rank4, maintained minus fixed, prediction error:", report)
+        self.assertIn("icub rank4, maintained minus fixed, prediction error (%):", report)
         # The roadmap against the lattice, both fixed: the mean of the paired differences.
         fixed = {(r.space, r.seed): r.coverage for r in everything if r.condition == "fixed"}
-        difference = np.mean([fixed["trm", k] - fixed["rank4", k] for k in (0, 1)])
-        self.assertIn(f"icub, trm minus rank4 (both fixed), coverage: {difference:+.2f} [", report)
+        difference = 100 * np.mean([fixed["trm", k] - fixed["rank4", k] for k in (0, 1)])
+        self.assertIn(
+            f"icub, trm minus rank4 (both fixed), coverage (%): {difference:+.2f} [", report
+        )
+        self.assertIn("icub rank4, maintained minus fixed, robot s per action:", report)
         self.assertIn("The trm spaces: icub, 12 states and", report)
         # The figures of the first seed's maintained runs: each state of the final space is kept
         # or added, and one is removed per prune.
@@ -332,15 +330,17 @@ class TestTheReachLearnersSpace(unittest.TestCase):
 
     def test_the_report_compares_the_roadmap_with_the_lattice(self):
         """Constructed runs: trm's fixed runs reach 1.5 more than the lattice's, seed by seed
-        (0.5 apart from seed to seed), and take 0.25 robot hours less; trm's maintained runs
-        reach 2.5 more than the fixed lattice's (1.0 more than fixed trm's)."""
+        (0.5 apart from seed to seed), and take 0.25 robot hours less exploring (the evaluations
+        0.5 h in each); trm's maintained runs reach 2.5 more than the fixed lattice's (1.0 more
+        than fixed trm's). What was learned and what it cost are two families."""
         from mobee_drake.experiments.adaptive_space_reaching import AdaptiveReachRun, Report
 
         def Run(space, seed, reward, hours, condition="fixed"):
             return AdaptiveReachRun(
                 strategy="greedy", condition=condition, seed=seed, stage=8, reward=reward,
-                reward_without_penalties=reward, robot_hours=hours, states=81, transitions=351,
-                changes={}, penetrating_steps=0, wall_seconds=1.0, space=space,
+                reward_without_penalties=reward, robot_hours=hours + 0.5, states=81,
+                transitions=351, changes={}, penetrating_steps=0, wall_seconds=1.0, space=space,
+                exploring_hours=hours,
             )  # fmt: skip
 
         runs = [Run("rank3", k, 20.0 + 0.5 * k, 2.0 + 0.1 * k) for k in range(4)]
@@ -351,8 +351,9 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         (hours,) = [line for line in report.splitlines() if "trm minus rank3" in line
                     and "robot hours" in line]  # fmt: skip
         self.assertIn("icub greedy, trm minus rank3 (both fixed), summed reward: +1.5", reward)
-        self.assertIn("robot hours: -0.25", hours)
-        self.assertIn("(Holm over the 2)", report)
+        self.assertIn("robot hours exploring: -0.25", hours)
+        self.assertIn("what was learned, paired by seed (Holm over the 1)", report)
+        self.assertIn("what it cost, paired by seed (Holm over the 2)", report)
         self.assertNotIn("trm maintained minus", report)
         runs += [Run("trm", k, 22.5 + 0.5 * k + 0.02 * k * k, 1.75, "maintained") for k in range(4)]
         report = Report(runs, "test")
@@ -362,7 +363,8 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         self.assertIn(
             f"icub greedy, trm maintained minus rank3 fixed, summed reward: {gain:+.2f}", reward
         )
-        self.assertIn("(Holm over the 6)", report)  # (and trm maintained minus fixed)
+        self.assertIn("what was learned, paired by seed (Holm over the 3)", report)
+        self.assertIn("what it cost, paired by seed (Holm over the 6)", report)
 
     def test_a_stage_is_evaluated_before_its_round(self):
         """A round due every 4 problem-tries, stages at 4 and 8 (the last): each stage's

@@ -35,6 +35,7 @@ from mobee_drake.owned_folders import ClaimFolder, FolderError, OwnedFolder
 from mobee_drake.planning.supervisor import ExploringAgent
 from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS
 from mobee_drake.scenario import LoadScenario, RunScenario
+from mobee_drake.station.checkpoint import SavedWallSeconds
 
 # The steps of a generation's write, as WriteGeneration marks them, and a kill inside the
 # caller's write (after its first file).
@@ -257,35 +258,41 @@ class TestCommandsClaimTheirFolders(TemporaryFolder):
 
 class TestExplorationCheckpoints(TemporaryFolder):
     """An exploration (the ch. 8 MDP's training, ch. 7.4.1's) interrupted after a checkpoint
-    resumes to the model an uninterrupted one learns."""
+    resumes to the model an uninterrupted one learns, and counts the wall time before."""
 
-    def _Explore(self, folder: pathlib.Path, interrupt_at: int | None = None) -> dict:
+    def _Explore(self, folder: pathlib.Path, interrupt_at: int | None = None):
+        """(the saved model's arrays, the run's wall time)."""
         agent = ExploringAgent(name="arm", joints=list(RIGHT_SHOULDER_ELBOW_JOINTS))
 
         def Progress(done: int) -> None:  # Told after the chunk's checkpoint.
             if interrupt_at is not None and done >= interrupt_at:
                 raise KeyboardInterrupt
 
-        Explore(
+        run = Explore(
             ExplorationScenario([agent], random_seed=4),
             stop=Stop(actions=12),
             checkpoint=folder,
             progress=Progress,
         )
-        return dict(np.load(CurrentGeneration(folder) / "arm.npz"))
+        return dict(np.load(CurrentGeneration(folder) / "arm.npz")), run.wall_seconds
 
     def test_an_interrupted_exploration_resumes_exactly(self):
-        whole = self._Explore(self.folder / "whole")
+        whole, _ = self._Explore(self.folder / "whole")
         with self.assertRaises(KeyboardInterrupt):
             self._Explore(self.folder / "interrupted", interrupt_at=4)
         saved = dict(np.load(CurrentGeneration(self.folder / "interrupted") / "arm.npz"))
         self.assertLess(saved["tries"].sum(), whole["tries"].sum())
-        resumed = self._Explore(self.folder / "interrupted")
-        for key in ("counts", "rewards", "tries"):
+        before = SavedWallSeconds(self.folder / "interrupted")
+        self.assertGreater(before, 0.0)
+        resumed, wall_seconds = self._Explore(self.folder / "interrupted")
+        for key in ("counts", "rewards", "tries", "settled"):
             np.testing.assert_array_equal(resumed[key], whole[key], key)
-        # Run again, it is done: the model does not change.
-        again = self._Explore(self.folder / "interrupted")
+        self.assertEqual(len(whole["settled"]), 12)
+        self.assertGreater(wall_seconds, before)  # (the time before the interruption counts)
+        # Run again, it is done: the model does not change, the wall time is what it was.
+        again, wall_seconds = self._Explore(self.folder / "interrupted")
         np.testing.assert_array_equal(again["counts"], whole["counts"])
+        self.assertGreaterEqual(wall_seconds, SavedWallSeconds(self.folder / "interrupted"))
 
 
 class TestInterrupts(TemporaryFolder):

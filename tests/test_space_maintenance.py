@@ -13,8 +13,10 @@ from mobee_drake.planning.space_maintenance import (
     EditSpace,
     Maintenance,
     MaintenanceConfig,
+    VisitedStates,
 )
 from mobee_drake.planning.state_space import FromGraph, Lattice
+from mobee_drake.planning.supervisor import SavedSettled
 
 # The square: states 0 (0.25, 0.25), 1 (0.25, 0.75), 2 (0.75, 0.25), 3 (0.75, 0.75); actions
 # 0: 0->1, 1: 0->2, 2: 1->0, 3: 1->3, 4: 2->0, 5: 2->3, 6: 3->1, 7: 3->2.
@@ -147,6 +149,33 @@ class TestTheRules(unittest.TestCase):
         reshaped, state = Maintenance(MaintenanceConfig(rules=["prune"]), 4).Apply(explorer, 1, 7)
         self.assertIs(reshaped, explorer)
         self.assertEqual(state, 1)
+
+    def test_a_state_the_robot_was_in_stays_when_the_model_forgets_it(self):
+        """0 -> 1 arrived once and missed 4 times, 1 -> 3 missed 5 times: round 1 drops both
+        and the model no longer shows the robot in 1 (1 -> 0, never tried, stays). 3 -> 1 then
+        misses 6 times: state 1 is not pruned, as the robot was there."""
+        config = MaintenanceConfig(rules=["prune", "drop"], prune_after=6)
+        explorer, maintenance = Explorer(SQUARE), Maintenance(config, 4)
+
+        def Tried(state: int, goal: int, outcome: int, times: int) -> None:
+            state_action = _Action(explorer.space, state, goal)
+            for _ in range(times):
+                explorer.Observe(state_action, outcome)
+                maintenance.Observe(explorer.space, state, state_action, outcome)
+
+        Tried(0, 1, 1, 1)
+        Tried(0, 1, 0, 4)
+        Tried(1, 3, 1, 5)
+        explorer, _ = maintenance.Apply(explorer, 0, 10)
+        self.assertEqual([c.states for c in maintenance.changes], [(0, 1), (1, 3)])
+        self.assertFalse(VisitedStates(explorer)[1])
+        Tried(3, 1, 3, 6)
+        explorer, _ = maintenance.Apply(explorer, 0, 16)
+        self.assertEqual(explorer.space.num_states, 4)
+        self.assertEqual([c.rule for c in maintenance.changes], ["drop"] * 3)  # (3 -> 1)
+        np.testing.assert_array_equal(maintenance.entered, [True, True, False, True])
+        restored = Maintenance.FromData(config, *maintenance.ToData())
+        np.testing.assert_array_equal(restored.entered, maintenance.entered)
 
     def test_an_often_infeasible_transition_is_dropped_but_not_a_states_last(self):
         """0 -> 1 missed 4 of 5: dropped. 2's both actions missed every time: the one that
@@ -340,6 +369,8 @@ class TestOnTheSupervisor(unittest.TestCase):
         (record,) = dut.Records(context)
         np.testing.assert_allclose(record.explorer.space.centres[:, 0], [0.5, 0.25, 0.75])
         self.assertEqual(record.state, 0)
+        self.assertEqual(record.settled, 4 * ((0.5,),))  # (where each action ended)
+        np.testing.assert_array_equal(record.maintenance.entered, [True, False, False])
         np.testing.assert_allclose(dut.GetOutputPort("data_log").Eval(context)[3:], [3, 6, 4])
         goal = record.explorer.space.action_goal[record.state_action]
         attractor = dut.GetOutputPort("attractor").Eval(context)
@@ -369,10 +400,11 @@ class TestOnTheSupervisor(unittest.TestCase):
             contexts.append(context)
         self._Poll(straight, contexts[0], actions, follow)
         (saved,) = straight.Records(contexts[0])
-        saved = saved.maintenance.ToData()
+        settled, saved = saved.settled, saved.maintenance.ToData()
         with tempfile.TemporaryDirectory() as folder:
             straight.WriteCheckpoint(contexts[0], pathlib.Path(folder))
             resumed.ReadCheckpoint(contexts[1], pathlib.Path(folder))
+            np.testing.assert_array_equal(SavedSettled(folder, "arm"), settled)
         contexts[1].SetTime(contexts[0].get_time())
         where = straight.GetInputPort("robot_state").Eval(contexts[0])  # (the robot stays)
         resumed.GetInputPort("robot_state").FixValue(contexts[1], where)
@@ -382,7 +414,9 @@ class TestOnTheSupervisor(unittest.TestCase):
         np.testing.assert_array_equal(a.explorer.space.centres, b.explorer.space.centres)
         np.testing.assert_array_equal(a.explorer.transitions.counts, b.explorer.transitions.counts)
         np.testing.assert_array_equal(a.maintenance.chains, b.maintenance.chains)
+        np.testing.assert_array_equal(a.maintenance.entered, b.maintenance.entered)
         self.assertEqual(a.maintenance.changes, b.maintenance.changes)
+        self.assertEqual((len(a.settled), a.settled), (2 * actions, b.settled))
         return a, saved
 
     def test_a_model_learned_before_brings_its_maintenance(self):

@@ -17,12 +17,16 @@ Per run, at the end:
 - *coverage*: the share of a fixed sample of the arm's valid configurations (within the joint
   limits, every constraint clause satisfied, no collision; ``arms.VALID_SAMPLES`` of them, drawn
   uniformly in fractions of each joint's range) within ``--radius`` (fractions of range; by
-  default the lattices' spacing, within which every point of the range lies of some rank-4
-  lattice state) of the centre of a state the robot was in (arrived in, or acted from: the
-  start): how much of what the arm can do the agent has been near, whatever its space;
+  default the lattices' spacing) of a configuration in which one of the run's actions ended
+  (:attr:`~mobee_drake.planning.supervisor.AgentRecord.settled`, where the arm was, not the
+  state it was counted in): how much of what the arm can do the agent has been near, whatever
+  its space and however that space was cut;
 - *dispersion*: the mean distance (fractions of range) from those valid configurations to the
-  nearest centre of a state the robot was in (no threshold);
-- *prediction error*: ``--tests`` state-actions of states the robot was in, drawn at random,
+  nearest configuration in which an action ended (no threshold);
+- *prediction error*: ``--tests`` state-actions of states the robot was in (an action started
+  or ended there: as the model shows, and as the maintenance saw it where ``drop`` made the
+  model forget; :attr:`~mobee_drake.planning.space_maintenance.Maintenance.entered`), drawn at
+  random,
   run once each on a fresh robot (put in the state's centre first; skipped if it does not get
   there): one minus the probability the learned model gave the outcome (held out: the model
   does not learn from them);
@@ -48,6 +52,7 @@ import dataclasses as dc
 import pathlib
 
 import numpy as np
+import scipy.spatial
 
 from mobee_drake.experiments import adaptive_space_reaching as reaching_part
 from mobee_drake.experiments.adaptive_space_figures import History, WriteSpaceFigures
@@ -87,7 +92,7 @@ from mobee_drake.planning.space_maintenance import (
     VisitedStates,
 )
 from mobee_drake.planning.state_space import Lattice
-from mobee_drake.planning.supervisor import ExploringAgent, SavedMaintenance
+from mobee_drake.planning.supervisor import ExploringAgent, SavedMaintenance, SavedSettled
 
 # The lattices compared: their levels (fractions of each joint's range; rank3 is ch. 8's); and
 # "trm", a roadmap over the valid configurations (mobee_drake.trm.configuration), built once per
@@ -121,21 +126,23 @@ class AdaptiveSpaceRun:
     penetrating_steps: int
 
 
-def Nearest(explorer, valid: np.ndarray) -> np.ndarray:
-    """Per configuration of ``valid``, its distance to the nearest centre of a state the robot
-    was in (:func:`~mobee_drake.planning.space_maintenance.VisitedStates`; inf: none)."""
-    visited = explorer.space.centres[VisitedStates(explorer)]
-    if not len(visited):
+def Nearest(settled: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """Per configuration of ``valid``, its distance to the nearest configuration in which an
+    action ended (``settled``, both in fractions of range; inf: none)."""
+    if not len(settled):
         return np.full(len(valid), np.inf)
-    return np.min(np.linalg.norm(valid[:, None] - visited[None], axis=2), axis=1)
+    return scipy.spatial.cKDTree(settled).query(valid)[0]
 
 
-def PredictionError(robot: str, explorer, tests: int, seed: int) -> tuple[float, int]:
+def PredictionError(
+    robot: str, explorer, visited: np.ndarray, tests: int, seed: int
+) -> tuple[float, int]:
     """(the mean of one minus the model's probability of each held-out test's outcome, the
-    tests run): see the module. The tests run on a fresh robot of the arm ``robot``, the reach
-    learner's (its state-action executor)."""
+    tests run): see the module. The tests are actions of the states the robot was in
+    (``visited``, per state) and run on a fresh robot of the arm ``robot``, the reach learner's
+    (its state-action executor)."""
     space = explorer.space
-    visited = np.flatnonzero(VisitedStates(explorer))
+    visited = np.flatnonzero(visited)
     candidates = np.flatnonzero(np.isin(space.action_state, visited))
     rng = np.random.default_rng(seed)
     chosen = rng.choice(candidates, size=min(tests, len(candidates)), replace=False)
@@ -179,12 +186,15 @@ def AdaptiveSpaceJob(
             robot=None if robot == "icub" else arm.robot,  # (the iCub's upper body, as ch. 7)
         )
     )
-    folder = run.path / "model"
-    explorer = LoadAgentModel(str(folder), AGENT, ExplorerConfig())
-    changes = SpaceChanges(folder, AGENT)
-    error, tested = PredictionError(robot, explorer, tests, seed)
+    folder = str(run.path / "model")
+    explorer = LoadAgentModel(folder, AGENT, ExplorerConfig())
+    maintenance = SavedMaintenance(folder, AGENT, MaintenanceConfig())
+    visited = VisitedStates(explorer)  # (and those the model forgot when `drop` removed all
+    if maintenance is not None:  # of a state's tried transitions)
+        visited |= maintenance.entered
+    error, tested = PredictionError(robot, explorer, visited, tests, seed)
     done = explored.actions[0]
-    nearest = Nearest(explorer, ValidConfigurations(arm))
+    nearest = Nearest(SavedSettled(folder, AGENT), ValidConfigurations(arm))
     return dc.asdict(
         AdaptiveSpaceRun(
             robot=robot,
@@ -199,7 +209,7 @@ def AdaptiveSpaceJob(
             tried_share=float(np.mean(explorer.tries > 0)),
             states=explorer.space.num_states,
             state_actions=explorer.space.num_state_actions,
-            changes=ChangesByRule(c["rule"] for c in changes),
+            changes=ChangesByRule(c.rule for c in (maintenance.changes if maintenance else ())),
             robot_seconds_per_action=explored.simulated_seconds / max(done, 1),
             wall_seconds=explored.wall_seconds,
             penetrating_steps=explored.penetrating_steps,
@@ -207,11 +217,17 @@ def AdaptiveSpaceJob(
     )
 
 
+# What a run learned (in percentage points, or % of range), and what it cost: each a family of
+# comparisons of its own.
 _MEASURES = {
-    "coverage": lambda r: r.coverage,
-    "dispersion": lambda r: r.dispersion,
-    "prediction error": lambda r: r.prediction_error,
-    "state-actions tried": lambda r: r.tried_share,
+    "coverage (%)": lambda r: 100 * r.coverage,
+    "dispersion (% of range)": lambda r: 100 * r.dispersion,
+    "prediction error (%)": lambda r: 100 * r.prediction_error,
+    "state-actions tried (%)": lambda r: 100 * r.tried_share,
+}
+_COSTS = {
+    "robot s per action": lambda r: r.robot_seconds_per_action,
+    "wall s per run": lambda r: r.wall_seconds,
 }
 
 
@@ -248,7 +264,8 @@ def Report(runs: list[AdaptiveSpaceRun], roadmaps: dict[str, dict], command: str
         *(_Row(key, rs) for key, rs in group.items()),
     ]
     lines += RoadmapLines(roadmaps)
-    lines += SpaceComparisons(group, "rank4", _MEASURES)
+    lines += SpaceComparisons(group, "rank4", _MEASURES, "what was learned")
+    lines += SpaceComparisons(group, "rank4", _COSTS, "what it cost")
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
 
 

@@ -77,6 +77,9 @@ class AdaptiveReachRun:
     appeared_inside: int | None = None
     other_penetrating_steps: int | None = None
     space: str = "rank3"  # (the battery's first runs were the lattice's, without the field)
+    # The robot hours of the exploration alone, without the evaluations' (None: a run from
+    # before they were timed).
+    exploring_hours: float | None = None
 
 
 def AdaptiveReachJob(
@@ -126,6 +129,9 @@ def AdaptiveReachJob(
             reward=float(sums[0]),
             reward_without_penalties=float(sums[1]),
             robot_hours=result.simulated_seconds / 3600,
+            exploring_hours=None
+            if result.evaluation_seconds is None
+            else (result.simulated_seconds - result.evaluation_seconds) / 3600,
             states=ended["states"],
             transitions=ended["transitions"],
             changes={rule: ended["changes"].get(rule, 0) for rule in RULES},
@@ -224,6 +230,13 @@ def _RunJobs(args, maintenance: MaintenanceConfig, robot: str, space: str) -> li
     ]
 
 
+def _Mean(values) -> str:
+    """A cell: the mean to two places ("-" if a value is missing: runs from before it was
+    measured)."""
+    values = list(values)
+    return "-" if any(v is None for v in values) else f"{np.mean(values):.2f}"
+
+
 def Report(
     runs: list[AdaptiveReachRun],
     command: str,
@@ -238,7 +251,7 @@ def Report(
     group = BySetting(runs, ("robot", "space", "strategy", "condition"))
     lines = [
         "| robot | space | strategy | condition | runs | problem-tries | summed reward | without "
-        f"the -10s | robot hours | states | transitions | changes ({'/'.join(RULES)}) "
+        f"the -10s | robot hours (exploring) | states | transitions | changes ({'/'.join(RULES)}) "
         f"| {PENETRATION_HEADER} | wall s per run |",
         "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|",
     ]
@@ -247,15 +260,24 @@ def Report(
             f"| {robot} | {space} | {strategy} | {condition} | {len(rs)} | {rs[0].stage} | "
             f"{np.mean([r.reward for r in rs]):.2f} | "
             f"{np.mean([r.reward_without_penalties for r in rs]):.2f} | "
-            f"{np.mean([r.robot_hours for r in rs]):.2f} | "
+            f"{np.mean([r.robot_hours for r in rs]):.2f} "
+            f"({_Mean(r.exploring_hours for r in rs)}) | "
             f"{np.mean([r.states for r in rs]):.0f} | "
             f"{np.mean([r.transitions for r in rs]):.0f} | {ChangesCell(rs)} | "
             f"{PenetrationCell(rs)} | "
             f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
         )
-    measures = {"summed reward": lambda r: r.reward, "robot hours": lambda r: r.robot_hours}
+    costs = {
+        "robot hours exploring": lambda r: (
+            np.nan if r.exploring_hours is None else r.exploring_hours
+        ),
+        "wall s per run": lambda r: r.wall_seconds,
+    }
     lines += RoadmapLines(roadmaps or {})
-    lines += SpaceComparisons(group, "rank3", measures)
+    lines += SpaceComparisons(
+        group, "rank3", {"summed reward": lambda r: r.reward}, "what was learned"
+    )
+    lines += SpaceComparisons(group, "rank3", costs, "what it cost")
     for robot, (grid, gaps) in (targets or {}).items():
         levels = ", ".join(f"{axis} {'/'.join(f'{v:.2f}' for v in getattr(grid, axis))}"
                            for axis in "xyz")  # fmt: skip

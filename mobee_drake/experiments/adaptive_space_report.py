@@ -25,13 +25,15 @@ def ChangesCell(runs: list) -> str:
     return "/".join(f"{np.mean([r.changes.get(rule, 0) for r in runs]):.0f}" for rule in RULES)
 
 
-def SpaceComparisons(groups: dict[tuple, list], lattice: str, measures: dict) -> list[str]:
+def SpaceComparisons(
+    groups: dict[tuple, list], lattice: str, measures: dict, family: str = ""
+) -> list[str]:
     """Report lines: the paired comparisons of ``groups`` (:func:`BySetting`'s, keyed by
     robot, space, any other fields, then condition) on each of ``measures`` (run -> value): on
     each space, maintained minus fixed; and where they ran, the roadmap ("trm"), fixed and
     maintained, minus the fixed ``lattice`` (the second is ch. 9.4.5's whole proposal, a space
     placed for the task and reshaped by what is learned, against the source's space); Holm over
-    them all."""
+    them all, a ``family`` of their own (named in the heading: what it learned, what it cost)."""
     maintained = {
         " ".join([robot, space, *more]) + ", maintained minus fixed": tuple(
             groups.get((robot, space, *more, condition), [])
@@ -51,4 +53,5 @@ def SpaceComparisons(groups: dict[tuple, list], lattice: str, measures: dict) ->
             if trm and grid:
                 roadmap[" ".join([robot, *more]) + f", {label}"] = (trm, grid)
     heading = "Maintained minus fixed" + (f" and trm minus {lattice}" if roadmap else "")
+    heading += f", {family}" if family else ""
     return PairedBySeed(maintained | roadmap, measures, heading)

@@ -12,7 +12,12 @@ from mobee_drake.mobee.params import Dissertation
 from mobee_drake.planning.explorers import MissShares
 from mobee_drake.planning.supervisor import ExploreAttractor, ExploringAgent
 from mobee_drake.scenario import BuildScenario, ResumableConfiguration, Scenario
-from mobee_drake.station.checkpoint import HasCheckpoint, LoadCheckpoint, SaveCheckpoint
+from mobee_drake.station.checkpoint import (
+    HasCheckpoint,
+    LoadCheckpoint,
+    SaveCheckpoint,
+    SavedWallSeconds,
+)
 from mobee_drake.station.runner import Advance
 from mobee_drake.station.world_events import MakeSimulator
 
@@ -34,7 +39,7 @@ class ExplorationRun:
         coverage: After every chunk: the actions done by all, then per agent its state-actions
             tried at least once.
         simulated_seconds: Simulated time at the end.
-        wall_seconds: Wall time of the run (since it resumed).
+        wall_seconds: Wall time of the run (over its resumptions, when it is checkpointed).
         penetrating_steps: Control periods in which two solids penetrated.
         labels: The experiment's setting of the run (e.g. ``gamma`` and ``run``).
         table_contacts: Ch. 7.4 only: per agent, the contact samples of each state-action.
@@ -118,7 +123,8 @@ def Explore(
 
     With ``checkpoint`` (a checkpoint folder), the run resumes from the checkpoint there, saves
     one after every chunk in which an action was completed, and keeps the final one (the learned
-    models, for a planner to reuse); the data returned then covers the run since it resumed.
+    models, for a planner to reuse); the data returned then covers the run since it resumed,
+    but for its wall time, which the checkpoint carries over.
     ``observer(station)``, if given, returns a callable run on the root context after every
     chunk of the simulation and a function giving the run's ``table_contacts``; ``progress(n)``, if
     given, is told the number of actions done after every chunk; ``should_stop()``, if given, is
@@ -130,19 +136,26 @@ def Explore(
     records = supervisor.Records(supervisor_context)
     saved = sum(r.actions_done for r in records)
     observe, observed = observer(station) if observer else (None, lambda: None)
-    taken, coverage, start = {}, [], time.perf_counter()
+    resumed = SavedWallSeconds(checkpoint) if checkpoint is not None else 0.0
+    taken, coverage, start = {}, [], time.perf_counter() - resumed
+
+    def Save() -> None:
+        SaveCheckpoint(
+            station, context, checkpoint, configuration, wall_seconds=time.perf_counter() - start
+        )
+
     while not stop(records):  # (A resumed run that was done stops at once.)
         Advance(station, simulator, context.get_time() + chunk, after_chunk=observe)
         records = supervisor.Records(supervisor_context)
         done = sum(r.actions_done for r in records)
         if checkpoint is not None and done > saved:
-            SaveCheckpoint(station, context, checkpoint, configuration)
+            Save()
             saved = done
         if progress is not None:
             progress(done)
         if should_stop is not None and should_stop():
             if checkpoint is not None:
-                SaveCheckpoint(station, context, checkpoint, configuration)
+                Save()
             raise JobStopped(f"stopped after {done} actions")
         coverage.append([done] + [int((r.explorer.tries > 0).sum()) for r in records])
         for count in snapshots:
@@ -152,7 +165,7 @@ def Explore(
                     values=records[0].explorer.Values()[0].tolist(),
                 )
     if checkpoint is not None and not HasCheckpoint(checkpoint):  # (No action was completed.)
-        SaveCheckpoint(station, context, checkpoint, configuration)
+        Save()
     report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
     return ExplorationRun(
         agents=supervisor.agent_names,

@@ -197,6 +197,9 @@ class Maintenance:
         self.chains = np.zeros((num_states, num_states), dtype=int)
         # The start and the end of the last action, if it arrived (else -1, -1).
         self._previous, self._arrival = -1, -1
+        # Per state, whether an action started or ended there: kept through `drop`, which
+        # forgets the model's counts of the transitions it removes (never pruned).
+        self.entered = np.zeros(num_states, dtype=bool)
         self.changes: list[SpaceChange] = []
         # The (start, goal) centres of every transition dropped (no shortcut brings one back).
         self._dropped: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
@@ -205,6 +208,7 @@ class Maintenance:
         """Notes an action's outcome (the agent's model observes it separately). A chain is
         two arriving actions, the second from where the first arrived (a reach, or a new
         problem's target pushing the arm, may leave the robot elsewhere)."""
+        self.entered[[state, outcome]] = True
         arrived = outcome == space.action_goal[state_action]
         chained = self._previous >= 0 and state == self._arrival
         if arrived and chained and self._previous != outcome:
@@ -228,7 +232,8 @@ class Maintenance:
         space = explorer.space
         pruned = []
         if "prune" in self.config.rules:
-            pruned = _Prunable(explorer, self.config, [state, *visited])
+            kept = [state, *visited, *np.flatnonzero(self.entered)]
+            pruned = _Prunable(explorer, self.config, kept)
         while True:
             changes = self._Changes(explorer, pruned, actions_done, favoured)
             if not changes:
@@ -255,6 +260,9 @@ class Maintenance:
                 self.chains[change.states] = 0
         self._dropped += [_Pair(space, *c.states) for c in changes if c.rule == "drop"]
         self.chains = _Moved(self.chains, edit.state_index, edit.space.num_states)
+        entered = np.zeros(edit.space.num_states, dtype=bool)
+        entered[edit.state_index[self.entered & (edit.state_index >= 0)]] = True
+        self.entered = entered
         self._previous, self._arrival = (
             int(edit.state_index[s]) if s >= 0 else -1 for s in (self._previous, self._arrival)
         )
@@ -312,7 +320,8 @@ class Maintenance:
         """(the chain counts, the rest as JSON-able data), for a checkpoint."""
         changes = [dc.asdict(c) for c in self.changes]
         previous, arrival = int(self._previous), int(self._arrival)
-        data = dict(previous=previous, arrival=arrival, changes=changes)
+        entered = np.flatnonzero(self.entered).tolist()
+        data = dict(previous=previous, arrival=arrival, changes=changes, entered=entered)
         return self.chains.copy(), data | dict(dropped=self._dropped)
 
     @classmethod
@@ -323,6 +332,8 @@ class Maintenance:
         maintenance._previous = data["previous"]
         # (-1 from a checkpoint from before the arrival was kept: the next chain starts afresh)
         maintenance._arrival = data.get("arrival", -1)
+        # (none from a checkpoint from before they were kept: the model's counts alone)
+        maintenance.entered[data.get("entered", [])] = True
         maintenance.changes = [
             SpaceChange(**dict(c, states=tuple(c["states"]), centre=tuple(c["centre"])))
             for c in data["changes"]

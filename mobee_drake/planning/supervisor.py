@@ -57,6 +57,9 @@ class AgentRecord:
     # The maintenance of a space that reshapes itself (ch. 9.4.5; None: a fixed space). The
     # explorer's space is the agent's space now.
     maintenance: Maintenance | None = None
+    # Where each action ended: the agent's joints, fractions of their ranges (a measure of
+    # where the arm has been that does not depend on how the space is cut).
+    settled: tuple[tuple[float, ...], ...] = ()
 
     def __deepcopy__(self, memo) -> "AgentRecord":
         return self
@@ -220,6 +223,7 @@ class ExplorationSupervisor(LeafSystem):
         time: float,
         actions_done: int,
         maintenance: Maintenance | None,
+        settled: tuple[tuple[float, ...], ...] = (),
     ) -> AgentRecord:
         state = self._StateOf(explorer.space, columns, q)
         return AgentRecord(
@@ -230,6 +234,7 @@ class ExplorationSupervisor(LeafSystem):
             slow_since=np.inf,
             actions_done=actions_done,
             maintenance=maintenance,
+            settled=settled,
         )
 
     def _Start(self, context, state) -> None:
@@ -270,6 +275,11 @@ class ExplorationSupervisor(LeafSystem):
                 outcome = self._StateOf(explorer.space, columns, q)
                 explorer.Observe(record.state_action, outcome)
                 explorer, maintenance = self._Maintain(record, explorer, outcome)
+                lower, upper = self._lower[columns], self._upper[columns]
+                settled = (
+                    *record.settled,
+                    tuple(((q[columns] - lower) / (upper - lower)).tolist()),
+                )
                 if explorer.seeks_goal and outcome == explorer.config.goal_state:
                     records[i] = dc.replace(
                         record,
@@ -277,10 +287,11 @@ class ExplorationSupervisor(LeafSystem):
                         state=outcome,
                         actions_done=record.actions_done + 1,
                         arrived=True,
+                        settled=settled,
                     )  # (a goal-seeking agent's space is not maintained)
                 else:
                     records[i] = self._Begin(
-                        columns, explorer, q, now, record.actions_done + 1, maintenance
+                        columns, explorer, q, now, record.actions_done + 1, maintenance, settled
                     )
                 changed = True
             elif slow_since != record.slow_since:
@@ -357,6 +368,7 @@ class ExplorationSupervisor(LeafSystem):
                 context.get_time(),
                 records[i].actions_done,
                 records[i].maintenance,
+                records[i].settled,
             )
         self.SetRecords(context, tuple(records))
 
@@ -396,13 +408,15 @@ class ExplorationSupervisor(LeafSystem):
     def WriteCheckpoint(self, context, folder: pathlib.Path) -> None:
         """Writes ``<agent>.npz`` (the learned model) and ``<agent>.json`` (its configuration,
         its generator's state and the action in flight) for every agent."""
-        for name, record in zip(self.agent_names, self.Records(context)):
+        records = self.Records(context)
+        for name, record, columns in zip(self.agent_names, records, self._columns):
             arrays, data = ExplorerToArrays(record.explorer)
             data["record"] = {
                 field.name: getattr(record, field.name)
                 for field in dc.fields(record)
-                if field.name not in ("explorer", "maintenance")
+                if field.name not in ("explorer", "maintenance", "settled")
             }
+            arrays["settled"] = np.reshape(record.settled, (len(record.settled), len(columns)))
             if record.maintenance is not None:
                 arrays["maintenance_chains"], data["maintenance"] = record.maintenance.ToData()
             np.savez(folder / f"{name}.npz", **arrays)
@@ -424,19 +438,36 @@ class ExplorationSupervisor(LeafSystem):
                 maintenance = Maintenance.FromData(
                     agent.maintenance, arrays["maintenance_chains"], data["maintenance"]
                 )
-            records.append(AgentRecord(explorer=explorer, maintenance=maintenance, **record))
+            # (none from a checkpoint from before they were kept)
+            settled = tuple(map(tuple, arrays["settled"].tolist())) if "settled" in arrays else ()
+            records.append(
+                AgentRecord(explorer=explorer, maintenance=maintenance, settled=settled, **record)
+            )
         self.SetRecords(context, tuple(records))
+
+
+def _SavedAgent(folder: str, name: str) -> pathlib.Path:
+    """Agent ``name``'s files in a checkpoint folder (its newest generation, or the folder's
+    own files), without their suffix."""
+    return (CurrentGeneration(folder) or pathlib.Path(folder)) / name
 
 
 def SavedMaintenance(folder: str, name: str, config: MaintenanceConfig) -> Maintenance | None:
     """The maintenance agent ``name`` saved in a checkpoint folder (its newest generation, or
     the folder's own files), under ``config``; None if its space was not maintained."""
-    base = (CurrentGeneration(folder) or pathlib.Path(folder)) / name
+    base = _SavedAgent(folder, name)
     data = json.loads(base.with_suffix(".json").read_text())
     if not data.get("maintenance"):
         return None
     chains = np.load(base.with_suffix(".npz"))["maintenance_chains"]
     return Maintenance.FromData(config, chains, data["maintenance"])
+
+
+def SavedSettled(folder: str, name: str) -> np.ndarray:
+    """(actions, joints): where each action of agent ``name`` saved in a checkpoint folder
+    ended (:attr:`AgentRecord.settled`); none from a checkpoint from before they were kept."""
+    arrays = np.load(_SavedAgent(folder, name).with_suffix(".npz"))
+    return arrays["settled"] if "settled" in arrays else np.zeros((0, 0))
 
 
 def RoadmapStateSpace(

@@ -37,6 +37,8 @@ class CheckpointError(ValueError):
 CONFIGURATION = "configuration.yaml"
 # How many of the data log's segments a generation covers.
 LOG_SEGMENTS = "log_segments.txt"
+# The wall time (s) the run had taken when the generation was saved, over its resumptions.
+WALL_SECONDS = "wall_seconds.txt"
 # Systems whose state only serves the viewer: a checkpoint may have them or not.
 _VIEWER_SYSTEMS = ("trail",)
 
@@ -128,16 +130,19 @@ def SaveCheckpoint(
     folder: str | pathlib.Path,
     configuration: str = "",
     log_segments: int = 0,
+    wall_seconds: float = 0.0,
 ) -> None:
     """Saves the state of ``context`` (the diagram's root context) as the newest generation of
     ``folder`` (see :func:`~mobee_drake.atomic_files.WriteGeneration`), with the
-    ``configuration`` it was run with (YAML text; see :func:`LoadCheckpoint`) and how many of
-    the data log's segments it covers (:class:`~mobee_drake.station.data_log.CheckpointedLog`)."""
+    ``configuration`` it was run with (YAML text; see :func:`LoadCheckpoint`), how many of
+    the data log's segments it covers (:class:`~mobee_drake.station.data_log.CheckpointedLog`)
+    and the wall time the run has taken so far (s; :func:`SavedWallSeconds`)."""
 
     def Write(staging: pathlib.Path) -> None:
         WriteCheckpointFiles(station, context, staging)
         (staging / CONFIGURATION).write_text(configuration)
         (staging / LOG_SEGMENTS).write_text(str(log_segments))
+        (staging / WALL_SECONDS).write_text(repr(float(wall_seconds)))
 
     WriteGeneration(folder, Write)
 
@@ -183,3 +188,16 @@ def LogSegments(folder: str | pathlib.Path) -> int:
         return int(path.read_text()) if path.is_file() else 0
     except ValueError:
         raise CheckpointError(f"{path}: a damaged checkpoint (not a count)") from None
+
+
+def SavedWallSeconds(folder: str | pathlib.Path) -> float:
+    """The wall time (s) the run had taken when the newest checkpoint in ``folder`` was saved
+    (0: none saved, or one from before it was kept)."""
+    generation = CurrentGeneration(folder)
+    path = None if generation is None else generation / WALL_SECONDS
+    if path is None or not path.is_file():
+        return 0.0
+    try:
+        return float(path.read_text())
+    except ValueError:
+        raise CheckpointError(f"{path}: a damaged checkpoint (not a number of seconds)") from None
