@@ -248,7 +248,7 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         for run in runs:
             with self.subTest(condition=run.condition, seed=run.seed):
                 self.assertEqual(run.stage, 8)
-                self.assertGreater(run.robot_hours, 0)
+                self.assertTrue(0 < run.exploring_hours < run.robot_hours)
                 self.assertEqual(run.states > 81, run.condition == "maintained")
                 self.assertEqual(sum(run.changes.values()) > 0, run.condition == "maintained")
         report = (output / "report.md").read_text()
@@ -330,15 +330,18 @@ class TestTheReachLearnersSpace(unittest.TestCase):
 
     def test_the_report_compares_the_roadmap_with_the_lattice(self):
         """Constructed runs: trm's fixed runs reach 1.5 more than the lattice's, seed by seed
-        (0.5 apart from seed to seed), and take 0.25 robot hours less exploring (the evaluations
-        0.5 h in each); trm's maintained runs reach 2.5 more than the fixed lattice's (1.0 more
-        than fixed trm's). What was learned and what it cost are two families."""
+        (0.5 apart from seed to seed), and take 0.25 robot hours less exploring (their
+        evaluations 0.3 h more than the lattice's, so 0.05 h more in all); trm's maintained
+        runs reach 2.5 more than the fixed lattice's (1.0 more than fixed trm's). What was
+        learned and what it cost are two families."""
         from mobee_drake.experiments.adaptive_space_reaching import AdaptiveReachRun, Report
+
+        evaluating = {"rank3": 0.5, "trm": 0.8}  # (robot hours)
 
         def Run(space, seed, reward, hours, condition="fixed"):
             return AdaptiveReachRun(
                 strategy="greedy", condition=condition, seed=seed, stage=8, reward=reward,
-                reward_without_penalties=reward, robot_hours=hours + 0.5, states=81,
+                reward_without_penalties=reward, robot_hours=hours + evaluating[space], states=81,
                 transitions=351, changes={}, penetrating_steps=0, wall_seconds=1.0, space=space,
                 exploring_hours=hours,
             )  # fmt: skip

@@ -36,8 +36,10 @@ Per run, at the end:
   time per action, the wall time and the penetrating periods.
 
 Maintained minus fixed on each space, and the roadmap, fixed and maintained, minus the fixed
-rank-4 lattice, are compared paired by seed, Holm-corrected over all of them and the four
-measures (coverage, dispersion, prediction error, state-actions tried). No round is made at the
+rank-4 lattice, are compared paired by seed in two families, each Holm-corrected over its
+comparisons: what was learned (coverage, dispersion, prediction error, state-actions tried, in
+percentage points or % of range) and what it cost (robot seconds per action, wall seconds per
+run). No round is made at the
 run's last action count (``MaintenanceConfig.until``): the measures see the space the agent
 explored in its last ``--every`` actions, not one just reshaped. The report names a PNG and, per
 arm, a Meshcat scene of the first seed's maintained runs
@@ -343,8 +345,8 @@ def _Parser() -> CommandParser:
         "--radius",
         type=PositiveFloat,
         default=0.25,
-        help="coverage: a valid configuration this near (fractions of range) an arrived-in "
-        "state's centre counts as covered",
+        help="coverage: a valid configuration this near (fractions of range) a configuration "
+        "in which an action ended counts as covered",
     )
     reaching_part.AddArguments(parser.add_argument_group("reaching (ch. 8)"))
     _AddMaintenanceArguments(parser.add_argument_group("maintenance"))

@@ -17,11 +17,13 @@ differ by the maintenance only. With ``--mdp simultaneous`` no MDP is learned fi
 runs' setting).
 
 Per run, at the last stage: the evaluations' summed reward (ch. 8.3.3, with the -10 of every
-failed transition and without), the robot's simulated hours, the space's size and its changes,
-and the penetrating periods (:mod:`~mobee_drake.reaching.appearance`'s split). Maintained minus
-fixed on each space, and the roadmap, fixed and maintained, minus the fixed lattice, are
-compared paired by seed, Holm-corrected over them all (the robots, spaces, strategies and the
-two measures: reward with penalties, robot hours)."""
+failed transition and without), the robot's simulated hours (in all, and of the exploration
+alone: an evaluation's walk to its start depends on the space), the space's size and its
+changes, and the penetrating periods (:mod:`~mobee_drake.reaching.appearance`'s split).
+Maintained minus fixed on each space, and the roadmap, fixed and maintained, minus the fixed
+lattice, are compared paired by seed in two families, each Holm-corrected over its comparisons
+(the robots, spaces and strategies): what was learned (the summed reward with penalties) and
+what it cost (the robot hours of the exploration, the wall seconds)."""
 
 import dataclasses as dc
 

@@ -13,7 +13,8 @@ about a state-action that stays is lost, and new ones start as the agent's first
 The rules (:class:`MaintenanceConfig` holds their parameters):
 
 - ``prune``: a state the robot was never in (no action arrived in it, none was tried from it,
-  nor does its learner say it was there), after ``prune_after`` tries of the actions into it,
+  as the model shows or as :attr:`Maintenance.entered` saw it, nor does its learner say it was
+  there), after ``prune_after`` tries of the actions into it,
   is dropped with every action into or out of it (the lattice's states beyond the shoulder's
   cable constraints, ch. 7.3). The state the robot is in is never dropped.
 - ``drop``: a transition tried ``drop_after`` times that missed its goal on at least

@@ -130,19 +130,20 @@ def SaveCheckpoint(
     folder: str | pathlib.Path,
     configuration: str = "",
     log_segments: int = 0,
-    wall_seconds: float = 0.0,
+    wall_seconds: float | None = None,
 ) -> None:
     """Saves the state of ``context`` (the diagram's root context) as the newest generation of
     ``folder`` (see :func:`~mobee_drake.atomic_files.WriteGeneration`), with the
     ``configuration`` it was run with (YAML text; see :func:`LoadCheckpoint`), how many of
     the data log's segments it covers (:class:`~mobee_drake.station.data_log.CheckpointedLog`)
-    and the wall time the run has taken so far (s; :func:`SavedWallSeconds`)."""
+    and, if given, the wall time the run has taken so far (s; :func:`SavedWallSeconds`)."""
 
     def Write(staging: pathlib.Path) -> None:
         WriteCheckpointFiles(station, context, staging)
         (staging / CONFIGURATION).write_text(configuration)
         (staging / LOG_SEGMENTS).write_text(str(log_segments))
-        (staging / WALL_SECONDS).write_text(repr(float(wall_seconds)))
+        if wall_seconds is not None:
+            (staging / WALL_SECONDS).write_text(repr(float(wall_seconds)))
 
     WriteGeneration(folder, Write)
 
