@@ -393,6 +393,46 @@ class TestSupervisor(unittest.TestCase):
         with self.assertRaisesRegex(ValueError, "unknown agent 'leg'"):
             dut.SetPlannerGoal(context, "leg", 1)
 
+    def test_where_each_action_ended_is_kept(self):
+        """An agent on joints c and a (of a, b, c, each with its own limits) keeps, per
+        action, where its joints were when the action ended, in fractions of their ranges and
+        in its own joint order: through a planner's arrival and a new goal."""
+        from mobee_drake.planning.supervisor import ActionTiming, Agent, ExplorationSupervisor
+
+        space = Lattice([0.25, 0.75], 2)
+        agent = Agent(
+            name="arm",
+            joints=["c", "a"],
+            space=space,
+            explorer=ExplorerConfig(strategy="planner", goal_state=3),
+        )
+        dut = ExplorationSupervisor(
+            agents=[agent], joints=["a", "b", "c"], lower=np.array([-1.0, 0.0, 2.0]),
+            upper=np.array([1.0, 2.0, 4.0]), home=np.array([0.0, 1.0, 3.0]),
+            timing=ActionTiming(settle_time=0.0, min_duration=0.0),
+        )  # fmt: skip
+        context = dut.CreateDefaultContext()
+
+        def At(c: float, a: float) -> None:  # (fractions of the ranges; at rest)
+            q = [-1.0 + 2.0 * a, 1.0, 2.0 + 2.0 * c]
+            dut.GetInputPort("robot_state").FixValue(context, q + [0.0] * 3)
+
+        At(0.25, 0.75)  # state 1; the goal, 3, is one action away
+        dut.ExecuteInitializationEvents(context)
+        self.assertEqual(dut.Records(context)[0].settled, ())
+        At(0.7, 0.8)
+        context.SetTime(0.2)
+        dut.CalcForcedUnrestrictedUpdate(context, context.get_mutable_state())
+        (record,) = dut.Records(context)
+        self.assertTrue(record.arrived)
+        np.testing.assert_allclose(record.settled, [[0.7, 0.8]])
+        dut.SetPlannerGoal(context, "arm", 0)
+        np.testing.assert_allclose(dut.Records(context)[0].settled, [[0.7, 0.8]])
+        At(0.2, 0.3)
+        context.SetTime(0.4)
+        dut.CalcForcedUnrestrictedUpdate(context, context.get_mutable_state())
+        np.testing.assert_allclose(dut.Records(context)[0].settled, [[0.7, 0.8], [0.2, 0.3]])
+
     def test_bad_agents(self):
         from mobee_drake.planning.supervisor import Agent, ExplorationSupervisor
 
