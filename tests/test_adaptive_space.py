@@ -42,6 +42,23 @@ class TestMeasures(unittest.TestCase):
                 self.assertTrue(np.all((valid >= 0) & (valid <= 1)))
 
 
+class TestTheBatterysOrder(unittest.TestCase):
+    def test_the_reach_runs_go_seed_by_seed(self):
+        """Every setting's seed 0 before any seed 1: a battery of days stopped early reports on
+        every robot and space alike."""
+        from mobee_drake.experiments.adaptive_space_reaching import Stages
+        from mobee_drake.planning.space_maintenance import MaintenanceConfig
+
+        args = adaptive_space._Parser().parse_args(
+            ["--part", "reaching", "--robots", "icub", "katana", "--seeds", "2"]
+        )
+        stages = Stages(args, MaintenanceConfig())
+        self.assertEqual([d for d, _ in stages][-1], "adaptive reaching")
+        seeds = [job.kwargs["seed"] for job in stages[-1][1]]
+        settings = 2 * 2 * 3 * 2  # robots x spaces x strategies x conditions
+        self.assertEqual(seeds, [0] * settings + [1] * settings)
+
+
 class TestReachTargets(unittest.TestCase):
     def test_the_icub_has_the_sources_grid_and_the_katana_one_in_front_of_it(self):
         """The iCub's targets are its file's; the Katana's are a 3 x 3 x 3 grid of increasing

@@ -179,8 +179,8 @@ def AddArguments(reaching) -> None:
 def Stages(args, maintenance: MaintenanceConfig) -> list[tuple[str, list[Job]]]:
     """The battery's jobs in the order they must finish, each stage (its description, its
     jobs) before the next begins: the "trm" spaces' roadmaps, the MDPs learned first on each
-    space (unless ``--mdp simultaneous``), then the runs. The iCub's lattice jobs keep the names
-    and arguments they had before there was a choice of robot or space."""
+    space (unless ``--mdp simultaneous``), then the runs, seed by seed. The iCub's lattice
+    jobs keep the names and arguments they had before there was a choice of robot or space."""
     roadmaps, mdps, runs = [], [], []
     for robot in args.robots:
         if "trm" in args.reach_spaces:
@@ -193,6 +193,8 @@ def Stages(args, maintenance: MaintenanceConfig) -> list[tuple[str, list[Job]]]:
                 name = MdpName(MDP_TRIES, robot=robot, space=space)
                 mdps.append(Job(name, MdpJob, mdp))
             runs += _RunJobs(args, maintenance, robot, space)
+    # Seed-major: a battery stopped early has about as many seeds of every setting.
+    runs.sort(key=lambda job: job.kwargs["seed"])
     stages = [("trm spaces", roadmaps), ("the MDPs (actions)", mdps), ("adaptive reaching", runs)]
     return [(description, jobs) for description, jobs in stages if jobs]
 
