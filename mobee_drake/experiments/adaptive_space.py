@@ -26,10 +26,9 @@ Per run, at the end:
 - *prediction error*: ``--tests`` state-actions of states the robot was in (an action started
   or ended there: as the model shows, and as the maintenance saw it where ``drop`` made the
   model forget; :attr:`~mobee_drake.planning.space_maintenance.Maintenance.entered`), drawn at
-  random,
-  run once each on a fresh robot (put in the state's centre first; skipped if it does not get
-  there): one minus the probability the learned model gave the outcome (held out: the model
-  does not learn from them);
+  random, run once each on a fresh robot (put in the state's centre first; skipped if it does
+  not get there): one minus the probability the learned model gave the outcome (held out: the
+  model does not learn from them);
 - *state-actions tried*: the share of the space's state-actions tried at least once (ch. 7.2's
   coverage, of the space as it ended);
 - the space's states and state-actions at the end, its changes by rule, the robot's simulated
@@ -39,11 +38,10 @@ Maintained minus fixed on each space, and the roadmap, fixed and maintained, min
 rank-4 lattice, are compared paired by seed in two families, each Holm-corrected over its
 comparisons: what was learned (coverage, dispersion, prediction error, state-actions tried, in
 percentage points or % of range) and what it cost (robot seconds per action, wall seconds per
-run). No round is made at the
-run's last action count (``MaintenanceConfig.until``): the measures see the space the agent
-explored in its last ``--every`` actions, not one just reshaped. The report names a PNG and, per
-arm, a Meshcat scene of the first seed's maintained runs
-(:mod:`mobee_drake.experiments.adaptive_space_figures`).
+run). No round is made at the run's last action count (``MaintenanceConfig.until``): the
+measures see the space the agent explored in its last ``--every`` actions, not one just
+reshaped. The report names a PNG and, per arm, a Meshcat scene of the first seed's maintained
+runs (:mod:`mobee_drake.experiments.adaptive_space_figures`).
 
 Run: ``mobee-drake experiment adaptive-space [--robots icub katana] [--seeds 10] [--actions 2000]
 [--output results/adaptive_space] [--doc docs/adaptive_space.md]``.
