@@ -266,6 +266,15 @@ class TestClaims(unittest.TestCase):
             [greedy, intrinsic, difference], [0.3 * PROBLEMS, 0, 0.3 * PROBLEMS]
         )
         self.assertTrue(0 < low <= difference <= high, evidence)
+        # Each unit's mean: greedy's 0.3 x 27 lower in the coarser unit, intrinsic's the same.
+        means = re.search(
+            r"mean sums, greedy / intrinsic: 0.03 m ([-+][\d.]+) / ([-+][\d.]+), "
+            r"0.1 m ([-+][\d.]+) / ([-+][\d.]+)$",
+            evidence,
+        )
+        greedy_fine, intrinsic_fine, greedy_coarse, intrinsic_coarse = map(float, means.groups())
+        self.assertAlmostEqual(greedy_coarse - greedy_fine, -0.3 * PROBLEMS, places=1)
+        self.assertAlmostEqual(intrinsic_coarse, intrinsic_fine, places=2)
         reversed_ = (
             Swept(0.03, 0.0)
             + [r for r in Swept(0.1, 0.0) if r.strategy == "greedy"]

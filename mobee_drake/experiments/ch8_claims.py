@@ -326,25 +326,28 @@ def _UnitSpread(groups: list[np.ndarray]) -> float:
     return float(max(means) - min(means))
 
 
-def _UnitGroups(runs: list[ReachRun]) -> list[np.ndarray] | None:
-    """Per distance unit, the runs' sums at their last common stage (the source's sum); None
-    with fewer than 2 units of 2 runs."""
+def _UnitGroups(runs: list[ReachRun]) -> dict[float, np.ndarray] | None:
+    """Per distance unit (m, in order), the runs' sums at their last common stage (the source's
+    sum); None with fewer than 2 units of 2 runs."""
     stage = (
         max(set.intersection(*(set(r.evaluations) for r in runs)), default=None) if runs else None
     )
     if stage is None:
         return None
     units = sorted({r.settings.distance_unit for r in runs})
-    groups = [
-        RunSums([r for r in runs if r.settings.distance_unit == u], stage, True) for u in units
-    ]
-    return groups if len(groups) > 1 and min(len(g) for g in groups) > 1 else None
+    groups = {
+        u: RunSums([r for r in runs if r.settings.distance_unit == u], stage, True) for u in units
+    }
+    return groups if len(groups) > 1 and min(len(g) for g in groups.values()) > 1 else None
 
 
 def _LessTuningIn(runs: list[ReachRun]) -> tuple[str, str]:
-    groups = {s: _UnitGroups([r for r in runs if r.strategy == s]) for s in ("greedy", "intrinsic")}
-    if None in groups.values():
+    by_unit = {
+        s: _UnitGroups([r for r in runs if r.strategy == s]) for s in ("greedy", "intrinsic")
+    }
+    if None in by_unit.values():
         return NOT_TESTABLE, "needs greedy and intrinsic runs over at least 2 distance units"
+    groups = {s: list(g.values()) for s, g in by_unit.items()}
     eta = {s: _EtaSquared(g) for s, g in groups.items()}
     spread = {s: _UnitSpread(g) for s, g in groups.items()}
     greedy_p = float(stats.f_oneway(*groups["greedy"]).pvalue)
@@ -369,6 +372,12 @@ def _LessTuningIn(runs: list[ReachRun]) -> tuple[str, str]:
         f"units' mean sums (not marked): greedy {spread['greedy']:.2f}, intrinsic "
         f"{spread['intrinsic']:.2f}, greedy minus intrinsic "
         f"{spread['greedy'] - spread['intrinsic']:+.2f} [{spread_low:+.2f}, {spread_high:+.2f}]"
+        "; the units' mean sums, greedy / intrinsic: "
+        + ", ".join(
+            f"{unit:g} m {g.mean():+.2f} / {by_unit['intrinsic'][unit].mean():+.2f}"
+            for unit, g in by_unit["greedy"].items()
+            if unit in by_unit["intrinsic"]
+        )
     )
     return (REPRODUCED if held else NOT_REPRODUCED), evidence
 
