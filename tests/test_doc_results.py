@@ -16,6 +16,8 @@ ROOT = pathlib.Path(__file__).parents[1]
 _CH8_KEPT = re.compile(r"^mobee-drake experiment ch8 --report-only --output (docs/results/\S+) ")
 # A ratio with its interval, as the prose quotes one: "1.43 [1.40, 1.46]".
 _RATIO = re.compile(r"(\d+\.\d+) \[(\d+\.\d+), (\d+\.\d+)\]")
+# A difference with its interval, signed: "-0.01 [-0.12, +0.11]".
+_DIFFERENCE = re.compile(r"[+-]\d+\.\d+ \[[+-]\d+\.\d+, [+-]\d+\.\d+\]")
 
 
 def _Folded(text: str) -> str:
@@ -39,8 +41,8 @@ class TestKeptBatteries(unittest.TestCase):
 
     def test_the_ratios_the_prose_quotes_are_its_generated_blocks(self):
         """docs/reaching.md's prose quotes random's robot time over the others' from its
-        generated blocks (R times [low, high]); a block written again from new runs fails the
-        prose that still quotes the old figures."""
+        generated blocks (R times [low, high]), and any difference with its interval; a block
+        written again from new runs fails the prose that still quotes the old figures."""
         doc = ROOT / "docs" / "reaching.md"
         prose, tables = doc.read_text(), []
         for _, _, table in GeneratedBlocks(doc):
@@ -51,6 +53,10 @@ class TestKeptBatteries(unittest.TestCase):
         for ratio, low, high in quoted:
             with self.subTest(ratio=ratio):
                 self.assertIn(f"{ratio} times [{low}, {high}]", " ".join(tables))
+        # And every difference it quotes with its interval (ch. 8.5's among them).
+        for difference in _DIFFERENCE.findall(_Folded(prose)):
+            with self.subTest(difference=difference):
+                self.assertIn(difference, " ".join(tables))
 
 
 def _Rows(table: str) -> dict[str, list[str]]:
