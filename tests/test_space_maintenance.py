@@ -177,6 +177,25 @@ class TestTheRules(unittest.TestCase):
         restored = Maintenance.FromData(config, *maintenance.ToData())
         np.testing.assert_array_equal(restored.entered, maintenance.entered)
 
+    def test_the_tries_of_a_dropped_transition_still_count_for_prune(self):
+        """1 -> 3 stays in 1 five times: round 1 drops it (state 3, 5 tries into it, is not yet
+        prunable at 6). One more try into 3, 2 -> 3, staying in 2: round 2 prunes state 3,
+        its 6 tries counted."""
+        config = MaintenanceConfig(rules=["prune", "drop"], prune_after=6)
+        explorer, maintenance = Explorer(SQUARE), Maintenance(config, 4)
+        _Tried(explorer, _Action(SQUARE, 1, 3), 1, 5)
+        explorer, _ = maintenance.Apply(explorer, 0, 5)
+        self.assertEqual([(c.rule, c.states) for c in maintenance.changes], [("drop", (1, 3))])
+        np.testing.assert_array_equal(maintenance.dropped_tries, [0, 0, 0, 5])
+        restored = Maintenance.FromData(config, *maintenance.ToData())
+        np.testing.assert_array_equal(restored.dropped_tries, [0, 0, 0, 5])
+        _Tried(explorer, _Action(explorer.space, 2, 3), 2, 1)
+        explorer, _ = maintenance.Apply(explorer, 0, 6)
+        self.assertEqual(maintenance.changes[-1].rule, "prune")
+        self.assertEqual(maintenance.changes[-1].states, (3,))
+        self.assertEqual(explorer.space.num_states, 3)
+        np.testing.assert_array_equal(maintenance.dropped_tries, [0, 0, 0])
+
     def test_an_often_infeasible_transition_is_dropped_but_not_a_states_last(self):
         """0 -> 1 missed 4 of 5: dropped. 2's both actions missed every time: the one that
         missed least stays."""

@@ -14,7 +14,7 @@ The rules (:class:`MaintenanceConfig` holds their parameters):
 
 - ``prune``: a state the robot was never in (no action arrived in it, none was tried from it,
   as the model shows or as :attr:`Maintenance.entered` saw it, nor does its learner say it was
-  there), after ``prune_after`` tries of the actions into it,
+  there), after ``prune_after`` tries of the actions into it (those ``drop`` removed included),
   is dropped with every action into or out of it (the lattice's states beyond the shoulder's
   cable constraints, ch. 7.3). The state the robot is in is never dropped.
 - ``drop``: a transition tried ``drop_after`` times that missed its goal on at least
@@ -201,6 +201,9 @@ class Maintenance:
         # Per state, whether an action started or ended there: kept through `drop`, which
         # forgets the model's counts of the transitions it removes (never pruned).
         self.entered = np.zeros(num_states, dtype=bool)
+        # Per state, the tries of the transitions into it that `drop` removed (for `prune`,
+        # which counts every try into a state).
+        self.dropped_tries = np.zeros(num_states, dtype=int)
         self.changes: list[SpaceChange] = []
         # The (start, goal) centres of every transition dropped (no shortcut brings one back).
         self._dropped: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
@@ -234,7 +237,7 @@ class Maintenance:
         pruned = []
         if "prune" in self.config.rules:
             kept = [state, *visited, *np.flatnonzero(self.entered)]
-            pruned = _Prunable(explorer, self.config, kept)
+            pruned = _Prunable(explorer, self.config, kept, self.dropped_tries)
         while True:
             changes = self._Changes(explorer, pruned, actions_done, favoured)
             if not changes:
@@ -259,11 +262,17 @@ class Maintenance:
         for change in changes:
             if change.rule == "shortcut":  # (an action now: no chain to count)
                 self.chains[change.states] = 0
+        for change in changes:
+            if change.rule == "drop":
+                self.dropped_tries[change.states[1]] += int(
+                    explorer.tries[_ActionOf(space, *change.states)]
+                )
         self._dropped += [_Pair(space, *c.states) for c in changes if c.rule == "drop"]
         self.chains = _Moved(self.chains, edit.state_index, edit.space.num_states)
-        entered = np.zeros(edit.space.num_states, dtype=bool)
-        entered[edit.state_index[self.entered & (edit.state_index >= 0)]] = True
-        self.entered = entered
+        self.entered = _MovedPerState(self.entered, edit.state_index, edit.space.num_states)
+        self.dropped_tries = _MovedPerState(
+            self.dropped_tries, edit.state_index, edit.space.num_states
+        )
         self._previous, self._arrival = (
             int(edit.state_index[s]) if s >= 0 else -1 for s in (self._previous, self._arrival)
         )
@@ -323,6 +332,7 @@ class Maintenance:
         previous, arrival = int(self._previous), int(self._arrival)
         entered = np.flatnonzero(self.entered).tolist()
         data = dict(previous=previous, arrival=arrival, changes=changes, entered=entered)
+        data["dropped_tries"] = self.dropped_tries.tolist()
         return self.chains.copy(), data | dict(dropped=self._dropped)
 
     @classmethod
@@ -335,6 +345,8 @@ class Maintenance:
         maintenance._arrival = data.get("arrival", -1)
         # (none from a checkpoint from before they were kept: the model's counts alone)
         maintenance.entered[data.get("entered", [])] = True
+        if "dropped_tries" in data:
+            maintenance.dropped_tries = np.array(data["dropped_tries"], dtype=int)
         maintenance.changes = [
             SpaceChange(**dict(c, states=tuple(c["states"]), centre=tuple(c["centre"])))
             for c in data["changes"]
@@ -389,11 +401,15 @@ def VisitedStates(explorer: Explorer) -> np.ndarray:
     return arrived | (np.bincount(space.action_state, weights=explorer.tries, minlength=m) > 0)
 
 
-def _Prunable(explorer: Explorer, config: MaintenanceConfig, kept) -> list[int]:
+def _Prunable(
+    explorer: Explorer, config: MaintenanceConfig, kept, dropped_tries: np.ndarray
+) -> list[int]:
     """States the robot was never in (:func:`VisitedStates`, nor ``kept``: where it is, and
-    where its learner saw it) whose incoming actions were tried ``prune_after`` times."""
+    where its learner saw it) whose incoming actions were tried ``prune_after`` times (those
+    ``drop`` removed included: ``dropped_tries``, per state)."""
     space = explorer.space
     tried_into = np.bincount(space.action_goal, weights=explorer.tries, minlength=space.num_states)
+    tried_into += dropped_tries
     prunable = ~VisitedStates(explorer) & (tried_into >= config.prune_after)
     prunable[list(kept)] = False
     return np.flatnonzero(prunable).tolist()
@@ -463,6 +479,15 @@ def _NewActions(space: StateActionSpace, changes: list[SpaceChange]) -> list[tup
         near = np.flatnonzero(np.linalg.norm(centres - centres[new], axis=1) <= reach)
         pairs += [(new, int(o)) for o in near if o != new] + [(int(o), new) for o in near]
     return pairs
+
+
+def _MovedPerState(values: np.ndarray, state_index: np.ndarray, num_states: int) -> np.ndarray:
+    """A per-state array's values of the states that stay, in their new indices (new states:
+    zero)."""
+    moved = np.zeros(num_states, dtype=values.dtype)
+    kept = np.flatnonzero(state_index >= 0)
+    moved[state_index[kept]] = values[kept]
+    return moved
 
 
 def _Moved(chains: np.ndarray, state_index: np.ndarray, num_states: int) -> np.ndarray:
