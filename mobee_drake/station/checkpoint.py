@@ -184,21 +184,23 @@ def LoadCheckpoint(
 
 def LogSegments(folder: str | pathlib.Path) -> int:
     """How many data-log segments the newest checkpoint in ``folder`` covers (0: none saved)."""
-    path = CurrentGeneration(folder) / LOG_SEGMENTS
-    try:
-        return int(path.read_text()) if path.is_file() else 0
-    except ValueError:
-        raise CheckpointError(f"{path}: a damaged checkpoint (not a count)") from None
+    return _SavedNumber(folder, LOG_SEGMENTS, int, "a count")
 
 
 def SavedWallSeconds(folder: str | pathlib.Path) -> float:
     """The wall time (s) the run had taken when the newest checkpoint in ``folder`` was saved
     (0: none saved, or one from before it was kept)."""
+    return _SavedNumber(folder, WALL_SECONDS, float, "a number of seconds")
+
+
+def _SavedNumber(folder: str | pathlib.Path, name: str, parse, what: str):
+    """The number in file ``name`` of the newest checkpoint in ``folder`` (0 if there is
+    none); CheckpointError naming the file if it holds no ``what``."""
     generation = CurrentGeneration(folder)
-    path = None if generation is None else generation / WALL_SECONDS
+    path = None if generation is None else generation / name
     if path is None or not path.is_file():
-        return 0.0
+        return parse("0")
     try:
-        return float(path.read_text())
+        return parse(path.read_text())
     except ValueError:
-        raise CheckpointError(f"{path}: a damaged checkpoint (not a number of seconds)") from None
+        raise CheckpointError(f"{path}: a damaged checkpoint (not {what})") from None
