@@ -20,6 +20,7 @@ import unittest
 from unittest import mock
 
 from battery_jobs import Count, DefaultSigint, FullDisk, Nan, Walk
+import numpy as np
 
 from mobee_drake.experiments import battery, saggriac
 from mobee_drake.experiments.battery import (
@@ -36,6 +37,7 @@ from mobee_drake.experiments.battery import (
 )
 
 TESTS = str(pathlib.Path(__file__).parent)
+ROOT = pathlib.Path(__file__).resolve().parents[1]
 HAVE_RAY = importlib.util.find_spec("ray") is not None
 
 
@@ -390,6 +392,38 @@ class NoOrphansTest(TemporaryFolder):
     @unittest.skipUnless(HAVE_RAY, "needs ray")
     def test_sigint_stops_ray(self):
         self.AssertInterruptsCleanly("ray", signal.SIGINT, 30)
+
+
+class CompressResultsTest(TemporaryFolder):
+    """scripts/compress_results.py: the finished runs' arrays compressed, the same arrays."""
+
+    def test_finished_runs_are_compressed_and_running_ones_left_alone(self):
+        spec = importlib.util.spec_from_file_location(
+            "compress_results", ROOT / "scripts" / "compress_results.py"
+        )
+        script = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(script)
+        counts = np.zeros((300, 80))
+        counts[::7, ::3] = 5.0
+        for run in ("finished", "running"):
+            generation = self.folder / "runs" / run / "model" / "g000001"
+            generation.mkdir(parents=True)
+            np.savez(generation / "arm.npz", counts=counts, tries=np.arange(300))
+        (self.folder / "runs" / "finished" / battery.RESULT).write_text("{}")
+        finished = self.folder / "runs/finished/model/g000001/arm.npz"
+        running = self.folder / "runs/running/model/g000001/arm.npz"
+        unchanged = running.read_bytes()
+
+        before, after = script.CompressFinishedRuns(self.folder)
+        self.assertEqual(before, len(unchanged))
+        self.assertLess(after, before / 10)
+        self.assertTrue(script.IsCompressed(finished))
+        self.assertFalse(script.IsCompressed(running))
+        self.assertEqual(running.read_bytes(), unchanged)
+        with np.load(finished) as saved:
+            np.testing.assert_array_equal(saved["counts"], counts)
+            np.testing.assert_array_equal(saved["tries"], np.arange(300))
+        self.assertEqual(script.CompressFinishedRuns(self.folder), (0, 0))
 
 
 if __name__ == "__main__":

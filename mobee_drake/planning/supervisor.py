@@ -419,7 +419,7 @@ class ExplorationSupervisor(LeafSystem):
             arrays["settled"] = np.reshape(record.settled, (len(record.settled), len(columns)))
             if record.maintenance is not None:
                 arrays["maintenance_chains"], data["maintenance"] = record.maintenance.ToData()
-            np.savez(folder / f"{name}.npz", **arrays)
+            np.savez_compressed(folder / f"{name}.npz", **arrays)
             # Not slow (inf) is written null: JSON has no infinity.
             slow = float(record.slow_since)
             data["record"]["slow_since"] = slow if np.isfinite(slow) else None

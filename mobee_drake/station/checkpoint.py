@@ -54,7 +54,7 @@ def _DiscreteStates(station: Station, context):
 def WriteCheckpointFiles(station: Station, context, folder: pathlib.Path) -> None:
     """Writes the state of ``context`` (the diagram's root context) into the existing
     ``folder``: the files of one checkpoint (see the module)."""
-    np.savez(
+    np.savez_compressed(
         folder / "simulation.npz",
         time=context.get_time(),
         **{key: value for key, value in _DiscreteStates(station, context)},

@@ -112,7 +112,7 @@ class TaskRelevantRoadmap:
         (see :func:`~mobee_drake.atomic_files.WriteGeneration`)."""
 
         def Write(staging: pathlib.Path) -> None:
-            np.savez(
+            np.savez_compressed(
                 staging / "roadmap.npz",
                 q=self.q,
                 y=self.y,
