@@ -329,8 +329,45 @@ class TestPairedAndFamilies(unittest.TestCase):
         p = Holm([expected.t_p] * 2)[0]
         self.assertEqual(lines[3], f"- arm, value: {expected.Text(p)}")
         self.assertTrue(lines[4].startswith(f"- arm, double: {2 * expected.difference:+.2f} "))
-        self.assertEqual(len(lines), 5)
-        self.assertEqual(PairedBySeed({"": (on[:1], off)}, measures, "On minus off"), [])
+        self.assertEqual(
+            lines[5:], ["", "Not compared (fewer than two seeds on both sides): alone."]
+        )
+        self.assertEqual(
+            PairedBySeed({"": (on[:1], off)}, measures, "On minus off"),
+            ["", "On minus off: Not compared (fewer than two seeds on both sides)."],
+        )
+        self.assertEqual(PairedBySeed({}, measures, "On minus off"), [])
+
+    def test_paired_by_seed_without_spread_or_values(self):
+        """A comparison equal in every pair is not tested (nor counted by Holm); one differing
+        by the same in every pair gets Wilcoxon's exact p; a pair without a value is left out
+        of its comparison alone; ties are counted."""
+        Run = collections.namedtuple("Run", "seed value same shifted")
+        rng = np.random.default_rng(3)
+        control = rng.normal(0, 1, 6)
+        treated = control + 1.0 + rng.normal(0, 0.2, 6)
+        treated[4] = np.nan
+        treated[5] = control[5]  # a tie
+        on = [Run(s, v, 1.0, 3.0) for s, v in enumerate(treated)]
+        off = [Run(s, v, 1.0, 2.5) for s, v in enumerate(control)]
+        measures = {m: lambda r, m=m: getattr(r, m) for m in ("value", "same", "shifted")}
+        lines = PairedBySeed({"arm": (on, off)}, measures, "On minus off")
+        self.assertEqual(lines[1], "On minus off, paired by seed (Holm over the 2):")
+        kept = np.isfinite(treated)
+        value = ComparePaired(treated[kept], control[kept], np.zeros(5))
+        shifted = ComparePaired(np.full(6, 3.0), np.full(6, 2.5), np.zeros(6))
+        self.assertAlmostEqual(shifted.wilcoxon_p, 2 / 2**6)
+        p_value, p_shifted = Holm([value.t_p, shifted.wilcoxon_p])
+        self.assertEqual(
+            lines[3],
+            f"- arm, value: {value.Text(p_value)}; 1 tied; 1 pairs without a value left out",
+        )
+        self.assertEqual(
+            lines[4],
+            f"- arm, shifted: {shifted.Text(p_shifted)}; Wilcoxon's p: every pair differs by "
+            "the same",
+        )
+        self.assertEqual(lines[5:], ["", "Equal in every pair, not tested: arm, same."])
 
     def test_ratio_of_means_and_its_interval(self):
         a, b = np.array([2.0, 4.0, 6.0, 8.0]), np.array([1.0, 2.0, 3.0, 4.0])

@@ -81,7 +81,7 @@ from mobee_drake.experiments.battery import (
     RunFolder,
 )
 from mobee_drake.experiments.ch7_model_learning import ExploreJob, Stop
-from mobee_drake.experiments.ch8_reaching import ReachRobot
+from mobee_drake.experiments.ch8_reaching import MdpName, ReachRobot
 from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.experiments.exploration import ExplorationRun
 from mobee_drake.owned_folders import OwnedFolder
@@ -218,13 +218,14 @@ def AdaptiveSpaceJob(
     )
 
 
-# What a run learned (in percentage points, or % of range), and what it cost: each a family of
-# comparisons of its own.
+# What a run learned, and what it cost: each a family of comparisons of its own. The shares'
+# differences in percentage points; dispersion's (a distance in the joints' fractions of range,
+# the table's unit) in hundredths of it.
 _MEASURES = {
-    "coverage (%)": lambda r: 100 * r.coverage,
-    "dispersion (% of range)": lambda r: 100 * r.dispersion,
-    "prediction error (%)": lambda r: 100 * r.prediction_error,
-    "state-actions tried (%)": lambda r: 100 * r.tried_share,
+    "coverage (percentage points)": lambda r: 100 * r.coverage,
+    "dispersion (hundredths of range)": lambda r: 100 * r.dispersion,
+    "prediction error (percentage points)": lambda r: 100 * r.prediction_error,
+    "state-actions tried (percentage points)": lambda r: 100 * r.tried_share,
 }
 _COSTS = {
     "robot s per action": lambda r: r.robot_seconds_per_action,
@@ -449,6 +450,12 @@ def _ReachingReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, 
         reaching_part.AdaptiveReachRun(**r) for n, r in results.items() if n.startswith("reach_")
     ]
     roadmaps = {r: results[RoadmapJobName(r)] for r in args.robots if RoadmapJobName(r) in results}
+    mdps = {
+        f"{robot} {space}": results[name]
+        for robot in args.robots
+        for space in args.reach_spaces
+        if (name := MdpName(reaching_part.MDP_TRIES, robot=robot, space=space)) in results
+    }
     arms, targets = Arms(), {}
     for robot in args.robots:
         targets[robot] = (ReachTargets(arms[robot]), {})
@@ -456,7 +463,7 @@ def _ReachingReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, 
             centres = _ReachCentres(arms[robot], robot, space, output)
             if centres is not None:
                 targets[robot][1][space] = TargetGaps(arms[robot], centres)
-    report = reaching_part.Report(runs, command, targets, roadmaps)
+    report = reaching_part.Report(runs, command, targets, roadmaps, mdps)
     with OwnedFolder(output, "battery"):
         histories = ReachSpaceHistories(runs, output)
         figures = WriteSpaceFigures(histories, output, "adaptive_space_reaching")

@@ -246,6 +246,7 @@ def Report(
     command: str,
     targets: dict | None = None,
     roadmaps: dict | None = None,
+    mdps: dict | None = None,
 ) -> str:
     """The report's table, the "trm" spaces' roadmaps (``roadmaps``: per robot, its roadmap
     job's result), the paired comparisons and, with ``targets`` (per robot, its
@@ -278,9 +279,18 @@ def Report(
         "wall s per run": lambda r: r.wall_seconds,
     }
     lines += RoadmapLines(roadmaps or {})
-    lines += SpaceComparisons(
-        group, "rank3", {"summed reward": lambda r: r.reward}, "what was learned"
-    )
+    if mdps:
+        learned = "; ".join(f"{setting}, {r['actions']} actions" for setting, r in mdps.items())
+        lines += [
+            "",
+            f"The MDPs learned first ({MDP_TRIES} tries of every state-action): {learned}.",
+        ]
+    # The sum without the -10s too: dropping transitions that often fail spares penalties.
+    learned = {
+        "summed reward": lambda r: r.reward,
+        "without the -10s": lambda r: r.reward_without_penalties,
+    }
+    lines += SpaceComparisons(group, "rank3", learned, "what was learned")
     lines += SpaceComparisons(group, "rank3", costs, "what it cost")
     for robot, (grid, gaps) in (targets or {}).items():
         levels = ", ".join(f"{axis} {'/'.join(f'{v:.2f}' for v in getattr(grid, axis))}"

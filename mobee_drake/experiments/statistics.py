@@ -467,24 +467,57 @@ def _OverBlocks(groups: list[np.ndarray], within: float) -> float:
 def PairedBySeed(families: dict, measures: dict, heading: str) -> list[str]:
     """Report lines: for each of ``families`` (a name: the runs with a treatment and the runs
     without, each run with a ``seed``), treatment minus control on each of ``measures`` (a name:
-    run -> value), paired by seed (:func:`ComparePaired`, one block), Holm over every comparison.
-    A family with fewer than two pairs is left out; no lines when none is left."""
-    compared = {}
+    run -> value), paired by seed (:func:`ComparePaired`, one block), Holm over the comparisons
+    tested. "k of n pairs" counts the pairs in which the treatment's value is the larger ("t
+    tied" follows if any are). A pair without a finite value is left out of its comparison (the
+    line says how many). A comparison whose every pair differs by the same amount has no spread
+    for the t-test: if by nothing, it is not tested (the lines end by naming it), else
+    Wilcoxon's exact p stands in. A family (or one of its measures) with fewer than two pairs is
+    named as not compared; no lines when there were no families."""
+    compared, notes, uncompared = {}, {}, []
     for family, (treated, control) in families.items():
         seeds = sorted({r.seed for r in treated} & {r.seed for r in control})
         if len(seeds) < 2:
+            uncompared.append(family)
             continue
         treated, control = (sorted((r for r in rs if r.seed in seeds), key=lambda r: r.seed)
                             for rs in (treated, control))  # fmt: skip
         for name, f in measures.items():
-            compared[f"{family}, {name}" if family else name] = ComparePaired(
-                [f(r) for r in treated], [f(r) for r in control], [0] * len(seeds)
+            a = np.array([f(r) for r in treated], dtype=float)
+            b = np.array([f(r) for r in control], dtype=float)
+            kept = np.isfinite(a) & np.isfinite(b)
+            label = f"{family}, {name}" if family else name
+            if np.sum(kept) < 2:
+                uncompared.append(label)
+                continue
+            compared[label] = c = ComparePaired(a[kept], b[kept], np.zeros(np.sum(kept)))
+            tied = int(np.sum(a[kept] == b[kept]))
+            notes[label] = (
+                ("; Wilcoxon's p: every pair differs by the same" if c.sd == 0 else "")
+                + (f"; {tied} tied" if tied else "")
+                + (f"; {np.sum(~kept)} pairs without a value left out" if not kept.all() else "")
             )
     if not compared:
-        return []
-    adjusted = Holm([c.t_p for c in compared.values()])
-    lines = ["", f"{heading}, paired by seed (Holm over the {len(compared)}):", ""]
-    return lines + [f"- {name}: {c.Text(p)}" for (name, c), p in zip(compared.items(), adjusted)]
+        return ["", f"{heading}: {_NotCompared(uncompared)}"] if uncompared else []
+    equal = [label for label, c in compared.items() if c.sd == 0 and c.difference == 0]
+    adjusted = Holm([c.t_p if c.sd > 0 else c.wilcoxon_p for c in compared.values()])
+    tested = int(np.sum(np.isfinite(adjusted)))
+    lines = ["", f"{heading}, paired by seed (Holm over the {tested}):", ""]
+    lines += [
+        f"- {label}: {c.Text(p)}{notes[label]}"
+        for (label, c), p in zip(compared.items(), adjusted)
+        if label not in equal
+    ]
+    if equal:
+        lines += ["", f"Equal in every pair, not tested: {'; '.join(equal)}."]
+    if uncompared:
+        lines += ["", _NotCompared(uncompared)]
+    return lines
+
+
+def _NotCompared(labels: list[str]) -> str:
+    named = "; ".join(label for label in labels if label)
+    return "Not compared (fewer than two seeds on both sides)" + (f": {named}." if named else ".")
 
 
 def RatioOfMeans(a, b, blocks, resamples: int = BOOTSTRAP_RESAMPLES) -> tuple[float, float, float]:
