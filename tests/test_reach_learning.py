@@ -314,7 +314,7 @@ class TestBattery(unittest.TestCase):
         self.assertEqual(sum(r.penetrating_steps for r in runs), 0)
         report = (output / "report.md").read_text()
         self.assertIn("| outside | on | 2 |", report)
-        self.assertIn("outside targets, share reached:", report)
+        self.assertIn("outside targets, share reached", report)  # (tested, or equal in every pair)
         # The outside targets are the inside ones moved 10 cm from the shoulder.
         learner, grid = LoadTrainedLearner(learner_dir)
         robot = torso_reach.TorsoReachRobot(learner, grid.radius, torso=False)

@@ -368,6 +368,10 @@ class TestPairedAndFamilies(unittest.TestCase):
             "the same",
         )
         self.assertEqual(lines[5:], ["", "Equal in every pair, not tested: arm, same."])
+        self.assertEqual(
+            PairedBySeed({"arm": (on, off)}, {"same": measures["same"]}, "On minus off"),
+            ["", "On minus off, paired by seed: equal in every pair, not tested: arm, same."],
+        )
 
     def test_ratio_of_means_and_its_interval(self):
         a, b = np.array([2.0, 4.0, 6.0, 8.0]), np.array([1.0, 2.0, 3.0, 4.0])

@@ -502,14 +502,15 @@ def PairedBySeed(families: dict, measures: dict, heading: str) -> list[str]:
     equal = [label for label, c in compared.items() if c.sd == 0 and c.difference == 0]
     adjusted = Holm([c.t_p if c.sd > 0 else c.wilcoxon_p for c in compared.values()])
     tested = int(np.sum(np.isfinite(adjusted)))
-    lines = ["", f"{heading}, paired by seed (Holm over the {tested}):", ""]
+    lines = ["", f"{heading}, paired by seed (Holm over the {tested}):", ""] if tested else []
     lines += [
         f"- {label}: {c.Text(p)}{notes[label]}"
         for (label, c), p in zip(compared.items(), adjusted)
         if label not in equal
     ]
     if equal:
-        lines += ["", f"Equal in every pair, not tested: {'; '.join(equal)}."]
+        lead = "Equal" if tested else f"{heading}, paired by seed: equal"
+        lines += ["", f"{lead} in every pair, not tested: {'; '.join(equal)}."]
     if uncompared:
         lines += ["", _NotCompared(uncompared)]
     return lines
