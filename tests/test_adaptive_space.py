@@ -143,6 +143,12 @@ class TestSpaceHistory(unittest.TestCase):
             History("icub, test", arm, initial, [dict(changes[1], centre=[0.1] * 4)])
 
 
+def _KeptReport(report: str) -> str:
+    """What :func:`adaptive_space.KeptReport` gives for the command ``report`` names."""
+    command = report.split("Command: `")[1].split("`")[0]
+    return adaptive_space.KeptReport(command, pathlib.Path("/"))
+
+
 class TestSmokeBattery(FigureTest):
     def setUp(self):
         self.output = pathlib.Path(tempfile.mkdtemp()) / "adaptive"
@@ -204,6 +210,7 @@ class TestSmokeBattery(FigureTest):
                     changes = adaptive_space.SpaceChanges(folder / "model", "right_arm")
                     self.assertLessEqual({c["actions_done"] for c in changes}, {5, 10, 15, 20, 25})
         report = (self.output / "report.md").read_text()
+        self.assertEqual(_KeptReport(report), report.split("\n\nFigures (")[0])
         maintained = [r for r in runs if r.condition == "maintained"]
         states = np.mean([r.states for r in maintained])
         self.assertRegex(
@@ -292,6 +299,7 @@ class TestTheReachLearnersSpace(unittest.TestCase):
             self.assertEqual(len(history.targets), 27)
             self.assertTrue((output / f"adaptive_space_reaching_{robot}.html").is_file())
         self.assertIn("adaptive_space_reaching.png", report)
+        self.assertEqual(_KeptReport(report), report.split("\n\nFigures (")[0])
         # The report of the finished runs alone, a third seed's runs not started.
         self._Reaching(output, 3, 8, *arms, "--report-only")
         self.assertFalse(list(output.glob("runs/*seed2")))

@@ -6,6 +6,7 @@ import pathlib
 import re
 import unittest
 
+from mobee_drake.experiments.adaptive_space import KeptReport
 from mobee_drake.experiments.ch8_claims import ClaimsTables
 from mobee_drake.experiments.ch8_reaching import StoredResults
 from mobee_drake.experiments.doc_tables import GeneratedBlocks
@@ -14,6 +15,10 @@ ROOT = pathlib.Path(__file__).parents[1]
 
 # The command of a block written by the ch. 8 report of a kept battery.
 _CH8_KEPT = re.compile(r"^mobee-drake experiment ch8 --report-only --output (docs/results/\S+) ")
+# The command of a block written by the adaptive-space report of a battery kept here.
+_ADAPTIVE_KEPT = re.compile(
+    r"^mobee-drake experiment adaptive-space .*--output docs/results/\S+ .*--report-only"
+)
 # A ratio with its interval, as the prose quotes one: "1.43 [1.40, 1.46]".
 _RATIO = re.compile(r"(\d+\.\d+) \[(\d+\.\d+), (\d+\.\d+)\]")
 # A difference with its interval, signed: "-0.01 [-0.12, +0.11]".
@@ -38,6 +43,23 @@ class TestKeptBatteries(unittest.TestCase):
                 results = StoredResults(folder)
                 self.assertTrue(results, f"{folder}: no finished runs")
                 self.assertEqual(table.rstrip(), "\n".join(ClaimsTables(results)).rstrip())
+
+    def test_every_adaptive_space_report_is_what_its_kept_runs_give(self):
+        """docs/adaptive_space.md's two blocks: each, once written by its battery's
+        ``--report-only`` from a folder kept here, is what that command gives now (its figures'
+        line aside); until then it says it has not been run."""
+        blocks = GeneratedBlocks(ROOT / "docs" / "adaptive_space.md")
+        names = {"adaptive-space", "adaptive-space-reaching"}
+        self.assertEqual({name for name, _, _ in blocks} & names, names)
+        for name, command, text in blocks:
+            if name not in names:
+                continue
+            with self.subTest(block=name):
+                if command == "(not yet run)":
+                    self.assertEqual(text, "")
+                    continue
+                self.assertRegex(command, _ADAPTIVE_KEPT)
+                self.assertEqual(text.split("\n\nFigures (")[0].rstrip(), KeptReport(command, ROOT))
 
     def test_the_ratios_the_prose_quotes_are_its_generated_blocks(self):
         """docs/reaching.md's prose quotes random's robot time over the others' from its

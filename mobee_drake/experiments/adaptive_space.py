@@ -51,6 +51,7 @@ Run: ``mobee-drake experiment adaptive-space [--robots icub katana] [--seeds 10]
 import collections
 import dataclasses as dc
 import pathlib
+import shlex
 
 import numpy as np
 import scipy.spatial
@@ -394,21 +395,27 @@ def SpaceChanges(checkpoint: pathlib.Path, name: str) -> list[dict]:
     return [dc.asdict(c) for c in maintenance.changes] if maintenance else []
 
 
-def _Results(args, jobs: list[Job], output: pathlib.Path, description: str) -> dict[str, dict]:
+def _Results(
+    args, jobs: list[Job], output: pathlib.Path, description: str, kept: bool
+) -> dict[str, dict]:
     """The jobs' results: those missing run first, or with ``--report-only`` the finished ones
-    alone."""
+    alone; ``kept``: the finished ones read without the folder's lock (see :func:`KeptReport`)."""
+    if kept:
+        return FinishedResults(jobs, output)
     if not args.report_only:
         return RunBattery(jobs, output, backend=BackendOf(args), description=description)
     with OwnedFolder(output, "battery"):
         return FinishedResults(jobs, output)
 
 
-def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, command):
-    """Runs the exploration part's battery; its report."""
+def _ExplorationReport(
+    args, maintenance: MaintenanceConfig, output: pathlib.Path, command: str, kept: bool = False
+):
+    """Runs the exploration part's battery; its report (``kept``: :func:`KeptReport`'s)."""
     built = {}
     if "trm" in args.spaces:  # (the roadmaps first: the trm runs read them)
         roadmaps = [RoadmapJobOf(r, args.trm_spacing, args.trm_states) for r in args.robots]
-        built = _Results(args, roadmaps, output, "trm spaces")
+        built = _Results(args, roadmaps, output, "trm spaces", kept)
         built = {r: built[RoadmapJobName(r)] for r in args.robots if RoadmapJobName(r) in built}
     jobs = [
         Job(
@@ -431,21 +438,26 @@ def _ExplorationReport(args, maintenance: MaintenanceConfig, output: pathlib.Pat
         for space in args.spaces
         for condition in CONDITIONS
     ]
-    results = _Results(args, jobs, output, "adaptive space")
+    results = _Results(args, jobs, output, "adaptive space", kept)
     runs = [AdaptiveSpaceRun(**r) for r in results.values()]
+    report = Report(runs, built, command)
+    if kept:
+        return report
     with OwnedFolder(output, "battery"):
         figures = WriteSpaceFigures(SpaceHistories(runs, output), output, "adaptive_space")
-    report = Report(runs, built, command)
     if figures:
         report += f"\n\nFigures (the first seed's maintained runs): {', '.join(figures)}."
     return report
 
 
-def _ReachingReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, command):
-    """Runs the reaching part's battery, stage by stage; its report."""
+def _ReachingReport(
+    args, maintenance: MaintenanceConfig, output: pathlib.Path, command: str, kept: bool = False
+):
+    """Runs the reaching part's battery, stage by stage; its report (``kept``:
+    :func:`KeptReport`'s)."""
     results = {}
     for description, jobs in reaching_part.Stages(args, maintenance):
-        results.update(_Results(args, jobs, output, description))
+        results.update(_Results(args, jobs, output, description, kept))
     runs = [
         reaching_part.AdaptiveReachRun(**r) for n, r in results.items() if n.startswith("reach_")
     ]
@@ -464,6 +476,8 @@ def _ReachingReport(args, maintenance: MaintenanceConfig, output: pathlib.Path, 
             if centres is not None:
                 targets[robot][1][space] = TargetGaps(arms[robot], centres)
     report = reaching_part.Report(runs, command, targets, roadmaps, mdps)
+    if kept:
+        return report
     with OwnedFolder(output, "battery"):
         histories = ReachSpaceHistories(runs, output)
         figures = WriteSpaceFigures(histories, output, "adaptive_space_reaching")
@@ -506,34 +520,55 @@ def _ReachCentres(arm: Arm, robot: str, space: str, output: pathlib.Path):
     return _InitialCentres(arm, robot, space, output) if space in LATTICES or built else None
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = _Parser()
-    args = parser.parse_args(argv)
+_BLOCKS = {"exploration": "adaptive-space", "reaching": "adaptive-space-reaching"}
+_REPORTS = {"exploration": _ExplorationReport, "reaching": _ReachingReport}
+
+
+def _Maintenance(parser, args) -> MaintenanceConfig:
+    """The rounds' configuration the arguments give (the rules by default each part's)."""
     exploring = args.part == "exploration"
-    block = "adaptive-space" if exploring else "adaptive-space-reaching"
-    CheckDocBlocks(parser, args.doc, block)
     rules = args.rules or (MaintenanceConfig().rules if exploring else list(RULES))
     if exploring and "develop" in rules:
         parser.error(
             "--rules develop: the exploration part's agent favours no states "
             "(the rule is the reach learner's: --part reaching)"
         )
-    maintenance = MaintenanceConfig(
+    return MaintenanceConfig(
         every=args.every,
         rules=list(rules),
         prune_after=args.prune_after,
         develop_min_targets=args.develop_min_targets,
         max_states=args.max_states or 0,
     )
-    output = pathlib.Path(
-        args.output
-        or ("results/adaptive_space" if exploring else "results/adaptive_space_reaching")
-    )
+
+
+def _Output(args) -> pathlib.Path:
+    default = "results/adaptive_space" + ("" if args.part == "exploration" else "_reaching")
+    return pathlib.Path(args.output or default)
+
+
+def KeptReport(command: str, root: pathlib.Path) -> str:
+    """The report that ``command`` (a ``--report-only`` command as a doc's generated block
+    names it, its paths relative to ``root``) gives from the runs finished in its folder now,
+    without its figures' line: read without the folder's lock, writing nothing
+    (tests/test_doc_results.py holds the docs to it)."""
+    parser = _Parser()
+    args = parser.parse_args(shlex.split(command)[3:])  # (after "mobee-drake experiment ...")
+    output = root / _Output(args)
+    return _REPORTS[args.part](args, _Maintenance(parser, args), output, command, kept=True)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = _Parser()
+    args = parser.parse_args(argv)
+    block = _BLOCKS[args.part]
+    CheckDocBlocks(parser, args.doc, block)
+    maintenance = _Maintenance(parser, args)
+    output = _Output(args)
     if args.report_only and not any(output.glob("runs/*/result.json")):
         parser.error(f"--report-only: no finished runs in {output / 'runs'}")
     command = ("mobee-drake experiment adaptive-space " + " ".join(argv or [])).strip()
-    run = _ExplorationReport if exploring else _ReachingReport
-    report = run(args, maintenance, output, command)
+    report = _REPORTS[args.part](args, maintenance, output, command)
     with OwnedFolder(output, "battery"):
         (output / "report.md").write_text(report + "\n")
     if args.doc:
