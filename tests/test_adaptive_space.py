@@ -14,7 +14,7 @@ from test_figures import FigureTest
 
 from mobee_drake.experiments import adaptive_space
 from mobee_drake.experiments.adaptive_space_figures import Figure
-from mobee_drake.experiments.arms import Arms, ReachTargets, ValidConfigurations
+from mobee_drake.experiments.arms import Arms, ReachTargets, TargetGaps, ValidConfigurations
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.reaching.targets import LoadTargetGrid
 
@@ -283,7 +283,19 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         for robot in ("icub", "katana"):
             self.assertIn(f"| {robot} | rank3 | greedy | maintained | 2 | 8 |", report)
             self.assertIn(f"{robot} rank3 greedy, maintained minus fixed, summed reward:", report)
-            self.assertRegex(report, rf"{robot}: targets of radius .* rank3: a median \d+\.\d cm")
+            self.assertRegex(
+                report,
+                rf"{robot}: targets of radius .* rank3: a median \d+\.\d cm \(at most "
+                r"\d+\.\d cm\), and at the maintained runs' end a median \d+\.\d cm \(mean over 2 "
+                r"runs; at most \d+\.\d cm\)",
+            )
+            # (the spaces the maintained runs ended with, each grown beyond the lattice)
+            ended = adaptive_space.EndedSpaces(runs, output, robot, "rank3")
+            maintained = [r for r in runs if (r.robot, r.condition) == (robot, "maintained")]
+            self.assertEqual([len(c) for c in ended], [r.states for r in maintained])
+            gaps = [TargetGaps(Arms()[robot], c) for c in ended]
+            median = 100 * np.mean([np.median(g) for g in gaps])
+            self.assertIn(f"at the maintained runs' end a median {median:.1f} cm", report)
         # The figures: the first seed's maintained space as it grew, with the arm's targets.
         histories = adaptive_space.ReachSpaceHistories(runs, output)
         for robot in ("icub", "katana"):

@@ -56,6 +56,7 @@ import shlex
 import numpy as np
 import scipy.spatial
 
+from mobee_drake.atomic_files import CurrentGeneration
 from mobee_drake.experiments import adaptive_space_reaching as reaching_part
 from mobee_drake.experiments.adaptive_space_figures import History, WriteSpaceFigures
 from mobee_drake.experiments.adaptive_space_report import BySetting, ChangesCell, SpaceComparisons
@@ -470,11 +471,14 @@ def _ReachingReport(
     }
     arms, targets = Arms(), {}
     for robot in args.robots:
-        targets[robot] = (ReachTargets(arms[robot]), {})
+        targets[robot] = (ReachTargets(arms[robot]), {}, {})
         for space in args.reach_spaces:
             centres = _ReachCentres(arms[robot], robot, space, output)
             if centres is not None:
                 targets[robot][1][space] = TargetGaps(arms[robot], centres)
+            targets[robot][2][space] = [
+                TargetGaps(arms[robot], ended) for ended in EndedSpaces(runs, output, robot, space)
+            ]
     report = reaching_part.Report(runs, command, targets, roadmaps, mdps)
     if kept:
         return report
@@ -487,6 +491,19 @@ def _ReachingReport(
             f"where it ran): {', '.join(figures)}."
         )
     return report
+
+
+def EndedSpaces(runs: list, output: pathlib.Path, robot: str, space: str) -> list[np.ndarray]:
+    """The centres of the space each maintained run of ``robot`` that began on ``space`` ended
+    with (its checkpoint's; fractions of range)."""
+    ended = []
+    for r in runs:
+        if (r.robot, r.space, r.condition) == (robot, space, "maintained"):
+            name = reaching_part.RunName(robot, space, r.strategy, "maintained", r.seed)
+            generation = CurrentGeneration(output / "runs" / name / "checkpoint")
+            with np.load(generation / "learner.npz") as saved:
+                ended.append(saved["space_centres"])
+    return ended
 
 
 def ReachSpaceHistories(runs: list, output: pathlib.Path) -> dict[str, list]:

@@ -241,6 +241,19 @@ def _Mean(values) -> str:
     return "-" if any(v is None for v in values) else f"{np.mean(values):.2f}"
 
 
+def _GapsText(space: str, gaps: np.ndarray, ended: list[np.ndarray]) -> str:
+    """How near a space's valid states put the marker to the targets (``gaps``, m, per target)
+    and, if any ran, how near the maintained runs' spaces did at their end (``ended``, per run)."""
+    text = f"{space}: a median {100 * np.median(gaps):.1f} cm (at most {100 * gaps.max():.1f} cm)"
+    if ended:
+        medians = 100 * np.mean([np.median(g) for g in ended])
+        text += (
+            f", and at the maintained runs' end a median {medians:.1f} cm (mean over "
+            f"{len(ended)} runs; at most {100 * max(g.max() for g in ended):.1f} cm)"
+        )
+    return text
+
+
 def Report(
     runs: list[AdaptiveReachRun],
     command: str,
@@ -249,10 +262,12 @@ def Report(
     mdps: dict | None = None,
 ) -> str:
     """The report's table, the "trm" spaces' roadmaps (``roadmaps``: per robot, its roadmap
-    job's result), the paired comparisons and, with ``targets`` (per robot, its
-    :class:`~mobee_drake.reaching.targets.TargetGrid` and, per space, each target's distance to
-    the nearest state's marker, :func:`~mobee_drake.experiments.arms.TargetGaps`), the targets
-    and how near each space comes to them (markdown)."""
+    job's result), the MDPs learned first (``mdps``: per robot and space, its job's result),
+    the paired comparisons and, with ``targets`` (per robot, its
+    :class:`~mobee_drake.reaching.targets.TargetGrid`; per space, each target's distance to the
+    nearest state's marker, :func:`~mobee_drake.experiments.arms.TargetGaps`; and per space,
+    the same on the space each maintained run ended with), the targets and how near each space
+    comes to them (markdown)."""
     group = BySetting(runs, ("robot", "space", "strategy", "condition"))
     lines = [
         "| robot | space | strategy | condition | runs | problem-tries | summed reward | without "
@@ -292,14 +307,10 @@ def Report(
     }
     lines += SpaceComparisons(group, "rank3", learned, "what was learned")
     lines += SpaceComparisons(group, "rank3", costs, "what it cost")
-    for robot, (grid, gaps) in (targets or {}).items():
+    for robot, (grid, gaps, ended) in (targets or {}).items():
         levels = ", ".join(f"{axis} {'/'.join(f'{v:.2f}' for v in getattr(grid, axis))}"
                            for axis in "xyz")  # fmt: skip
-        nearest = "; ".join(
-            f"{space}: a median {100 * np.median(g):.1f} cm (at most {100 * g.max():.1f} cm)"
-            for space, g in gaps.items()
-        )
+        nearest = "; ".join(_GapsText(space, g, ended.get(space, [])) for space, g in gaps.items())
         lines += ["", f"{robot}: targets of radius {grid.radius:g} m at {levels} m; the valid "
-                  f"state nearest each puts the marker, before the reach, {nearest} from "
-                  "it."]  # fmt: skip
+                  f"state nearest each puts the marker, before the reach, {nearest}."]  # fmt: skip
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
