@@ -295,10 +295,10 @@ def Report(
     }
     lines += RoadmapLines(roadmaps or {})
     if mdps:
-        learned = "; ".join(f"{setting}, {r['actions']} actions" for setting, r in mdps.items())
+        actions = "; ".join(f"{setting}, {r['actions']} actions" for setting, r in mdps.items())
         lines += [
             "",
-            f"The MDPs learned first ({MDP_TRIES} tries of every state-action): {learned}.",
+            f"The MDPs learned first ({MDP_TRIES} tries of every state-action): {actions}.",
         ]
     # The sum without the -10s too: dropping transitions that often fail spares penalties.
     learned = {
@@ -312,5 +312,6 @@ def Report(
                            for axis in "xyz")  # fmt: skip
         nearest = "; ".join(_GapsText(space, g, ended.get(space, [])) for space, g in gaps.items())
         lines += ["", f"{robot}: targets of radius {grid.radius:g} m at {levels} m; the valid "
-                  f"state nearest each puts the marker, before the reach, {nearest}."]  # fmt: skip
+                  f"state nearest each puts the marker, before the reach, {nearest} from "
+                  "it."]  # fmt: skip
     return "\n".join(lines) + f"\n\nCommand: `{command}`."
