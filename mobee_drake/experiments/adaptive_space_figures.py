@@ -221,7 +221,7 @@ def WriteSpaceFigures(
             meshcat.SetObject(f"targets/{k}", Sphere(shown.target_radius), _RGBA["target"])
             meshcat.SetTransform(f"targets/{k}", RigidTransform(centre))
         centre = np.vstack([h.points for h in robot_histories]).mean(axis=0)
-        meshcat.SetCameraPose(centre + [-0.9, 0.5, 0.45], centre)
+        meshcat.SetCameraPose(centre + [-0.55, 0.3, 0.3], centre)
         written.append(f"{stem}_{robot}.html")
         WriteTextAtomically(output / written[-1], meshcat.StaticHtml())
     return written
