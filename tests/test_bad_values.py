@@ -6,6 +6,7 @@ import pathlib
 import shutil
 import tempfile
 import unittest
+import zipfile
 
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -220,6 +221,18 @@ class TestDamagedCheckpoints(unittest.TestCase):
             data = (generation / "simulation.npz").read_bytes()
             (generation / "simulation.npz").write_bytes(data[: len(data) // 2])
 
+        def DamagedStream(generation):
+            """The start of the model's first array's deflate stream overwritten."""
+            path = generation / "right_arm.npz"
+            data = bytearray(path.read_bytes())
+            with zipfile.ZipFile(path) as saved:
+                offset = saved.infolist()[0].header_offset
+            name, extra = (int.from_bytes(data[offset + k : offset + k + 2], "little")
+                           for k in (26, 28))  # fmt: skip
+            start = offset + 30 + name + extra
+            data[start : start + 16] = b"\xff" * 16
+            path.write_bytes(data)
+
         def Nan(generation):
             saved = dict(np.load(generation / "simulation.npz"))
             saved["time"] = np.array(np.nan)
@@ -238,6 +251,7 @@ class TestDamagedCheckpoints(unittest.TestCase):
 
         cases = {
             "truncated": (Truncate, "damaged checkpoint"),
+            "damaged stream": (DamagedStream, "damaged checkpoint \\(zlib.error: "),
             "nan": (Nan, "'time' holds NaN"),
             "no world": (lambda g: (g / "world.json").unlink(), "damaged checkpoint"),
             "broken json": (

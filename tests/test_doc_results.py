@@ -17,7 +17,7 @@ ROOT = pathlib.Path(__file__).parents[1]
 _CH8_KEPT = re.compile(r"^mobee-drake experiment ch8 --report-only --output (docs/results/\S+) ")
 # The command of a block written by the adaptive-space report of a battery kept here.
 _ADAPTIVE_KEPT = re.compile(
-    r"^mobee-drake experiment adaptive-space .*--output docs/results/\S+ .*--report-only"
+    r"^mobee-drake experiment adaptive-space (?=.*--report-only)(?=.*--output docs/results/\S)"
 )
 # A ratio with its interval, as the prose quotes one: "1.43 [1.40, 1.46]".
 _RATIO = re.compile(r"(\d+\.\d+) \[(\d+\.\d+), (\d+\.\d+)\]")

@@ -334,7 +334,7 @@ class TestPairedAndFamilies(unittest.TestCase):
         )
         self.assertEqual(
             PairedBySeed({"": (on[:1], off)}, measures, "On minus off"),
-            ["", "On minus off: Not compared (fewer than two seeds on both sides)."],
+            ["", "On minus off: not compared (fewer than two seeds on both sides)."],
         )
         self.assertEqual(PairedBySeed({}, measures, "On minus off"), [])
 
@@ -342,20 +342,27 @@ class TestPairedAndFamilies(unittest.TestCase):
         """A comparison equal in every pair is not tested (nor counted by Holm); one differing
         by the same in every pair gets Wilcoxon's exact p; a pair without a value is left out
         of its comparison alone; ties are counted."""
-        Run = collections.namedtuple("Run", "seed value same shifted")
+        Run = collections.namedtuple("Run", "seed value same shifted sparse")
         rng = np.random.default_rng(3)
         control = rng.normal(0, 1, 6)
         treated = control + 1.0 + rng.normal(0, 0.2, 6)
         treated[4] = np.nan
         treated[5] = control[5]  # a tie
-        on = [Run(s, v, 1.0, 3.0) for s, v in enumerate(treated)]
-        off = [Run(s, v, 1.0, 2.5) for s, v in enumerate(control)]
-        measures = {m: lambda r, m=m: getattr(r, m) for m in ("value", "same", "shifted")}
+        # (0.2 more in every pair but for rounding: 0.19999999999999996, 0.20000000000000007)
+        shifted = [0.6, 0.8, 1.0, 1.2, 1.4, 1.6]
+        on = [Run(s, v, 1.0, shifted[s], 1.0) for s, v in enumerate(treated)]
+        off = [Run(s, v, 1.0, shifted[s] - 0.2, np.nan if s else 0.0)
+               for s, v in enumerate(control)]  # fmt: skip
+        names = ("value", "same", "shifted", "sparse")
+        measures = {m: lambda r, m=m: getattr(r, m) for m in names}
         lines = PairedBySeed({"arm": (on, off)}, measures, "On minus off")
         self.assertEqual(lines[1], "On minus off, paired by seed (Holm over the 2):")
         kept = np.isfinite(treated)
         value = ComparePaired(treated[kept], control[kept], np.zeros(5))
-        shifted = ComparePaired(np.full(6, 3.0), np.full(6, 2.5), np.zeros(6))
+        shifted = ComparePaired(np.array(shifted), np.array(shifted) - 0.2, np.zeros(6))
+        self.assertEqual(shifted.sd, 0.0)
+        np.testing.assert_allclose([shifted.low, shifted.high], 0.2)
+        self.assertTrue(math.isnan(shifted.t_p) and math.isnan(shifted.d_z))
         self.assertAlmostEqual(shifted.wilcoxon_p, 2 / 2**6)
         p_value, p_shifted = Holm([value.t_p, shifted.wilcoxon_p])
         self.assertEqual(
@@ -367,7 +374,11 @@ class TestPairedAndFamilies(unittest.TestCase):
             f"- arm, shifted: {shifted.Text(p_shifted)}; Wilcoxon's p: every pair differs by "
             "the same",
         )
-        self.assertEqual(lines[5:], ["", "Equal in every pair, not tested: arm, same."])
+        self.assertEqual(
+            lines[5:],
+            ["", "Equal in every pair, not tested: arm, same.", "",
+             "Not compared (fewer than two pairs with values): arm, sparse."],
+        )  # fmt: skip
         self.assertEqual(
             PairedBySeed({"arm": (on, off)}, {"same": measures["same"]}, "On minus off"),
             ["", "On minus off, paired by seed: equal in every pair, not tested: arm, same."],

@@ -584,7 +584,7 @@ def main(argv: list[str] | None = None) -> None:
     output = _Output(args)
     if args.report_only and not any(output.glob("runs/*/result.json")):
         parser.error(f"--report-only: no finished runs in {output / 'runs'}")
-    command = ("mobee-drake experiment adaptive-space " + " ".join(argv or [])).strip()
+    command = ("mobee-drake experiment adaptive-space " + shlex.join(argv or [])).strip()
     report = _REPORTS[args.part](args, maintenance, output, command)
     with OwnedFolder(output, "battery"):
         (output / "report.md").write_text(report + "\n")

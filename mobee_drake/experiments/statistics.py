@@ -432,6 +432,9 @@ def ComparePaired(a, b, blocks) -> PairedComparison:
         raise ValueError(f"a paired test needs more pairs than blocks, got {n} in {j}")
     mean, sd = float(d.mean()), float(d.std(ddof=1))
     within = math.sqrt(sum(np.sum((g - g.mean()) ** 2) for g in groups) / (n - j))
+    # The same difference in every pair but for rounding: no spread (not a t of 1e15).
+    if np.ptp(d) <= 1e-9 * max(1.0, float(np.abs(d).max())):
+        sd = within = 0.0
     se = within / math.sqrt(n)
     half = stats.t.ppf(0.975, n - j) * se
     varied = j > 1 and all(g.size > 1 for g in groups) and within > 0
@@ -470,15 +473,20 @@ def PairedBySeed(families: dict, measures: dict, heading: str) -> list[str]:
     run -> value), paired by seed (:func:`ComparePaired`, one block), Holm over the comparisons
     tested. "k of n pairs" counts the pairs in which the treatment's value is the larger ("t
     tied" follows if any are). A pair without a finite value is left out of its comparison (the
-    line says how many). A comparison whose every pair differs by the same amount has no spread
-    for the t-test: if by nothing, it is not tested (the lines end by naming it), else
-    Wilcoxon's exact p stands in. A family (or one of its measures) with fewer than two pairs is
-    named as not compared; no lines when there were no families."""
-    compared, notes, uncompared = {}, {}, []
+    line says how many). A comparison equal in every pair is not tested (the lines end by
+    naming it); one whose every pair differs by the same amount has no spread for the t-test,
+    and Wilcoxon's p stands in. A family with fewer than two seeds on both sides, or a
+    comparison with fewer than two pairs with values, is named as not compared; no lines when
+    there were no families."""
+    compared, notes, equal = {}, {}, []
+    not_compared = {
+        "fewer than two seeds on both sides": [],
+        "fewer than two pairs with values": [],
+    }
     for family, (treated, control) in families.items():
         seeds = sorted({r.seed for r in treated} & {r.seed for r in control})
         if len(seeds) < 2:
-            uncompared.append(family)
+            not_compared["fewer than two seeds on both sides"].append(family)
             continue
         treated, control = (sorted((r for r in rs if r.seed in seeds), key=lambda r: r.seed)
                             for rs in (treated, control))  # fmt: skip
@@ -487,38 +495,37 @@ def PairedBySeed(families: dict, measures: dict, heading: str) -> list[str]:
             b = np.array([f(r) for r in control], dtype=float)
             kept = np.isfinite(a) & np.isfinite(b)
             label = f"{family}, {name}" if family else name
+            tied = int(np.sum(np.isclose(a[kept], b[kept], rtol=1e-9, atol=0.0)))
             if np.sum(kept) < 2:
-                uncompared.append(label)
-                continue
-            compared[label] = c = ComparePaired(a[kept], b[kept], np.zeros(np.sum(kept)))
-            tied = int(np.sum(a[kept] == b[kept]))
-            notes[label] = (
-                ("; Wilcoxon's p: every pair differs by the same" if c.sd == 0 else "")
-                + (f"; {tied} tied" if tied else "")
-                + (f"; {np.sum(~kept)} pairs without a value left out" if not kept.all() else "")
-            )
-    if not compared:
-        return ["", f"{heading}: {_NotCompared(uncompared)}"] if uncompared else []
-    equal = [label for label, c in compared.items() if c.sd == 0 and c.difference == 0]
+                not_compared["fewer than two pairs with values"].append(label)
+            elif tied == np.sum(kept):
+                equal.append(label)
+            else:
+                compared[label] = c = ComparePaired(a[kept], b[kept], np.zeros(np.sum(kept)))
+                notes[label] = (
+                    ("; Wilcoxon's p: every pair differs by the same" if c.sd == 0 else "")
+                    + (f"; {tied} tied" if tied else "")
+                    + (
+                        f"; {np.sum(~kept)} pairs without a value left out"
+                        if not kept.all()
+                        else ""
+                    )
+                )
     adjusted = Holm([c.t_p if c.sd > 0 else c.wilcoxon_p for c in compared.values()])
-    tested = int(np.sum(np.isfinite(adjusted)))
-    lines = ["", f"{heading}, paired by seed (Holm over the {tested}):", ""] if tested else []
-    lines += [
-        f"- {label}: {c.Text(p)}{notes[label]}"
-        for (label, c), p in zip(compared.items(), adjusted)
-        if label not in equal
-    ]
+    lines = []
+    if compared:
+        lines += ["", f"{heading}, paired by seed (Holm over the {len(compared)}):", ""]
+        lines += [f"- {label}: {c.Text(p)}{notes[label]}"
+                  for (label, c), p in zip(compared.items(), adjusted)]  # fmt: skip
     if equal:
-        lead = "Equal" if tested else f"{heading}, paired by seed: equal"
+        lead = "Equal" if compared else f"{heading}, paired by seed: equal"
         lines += ["", f"{lead} in every pair, not tested: {'; '.join(equal)}."]
-    if uncompared:
-        lines += ["", _NotCompared(uncompared)]
+    for reason, labels in not_compared.items():
+        if labels:
+            lead = "Not compared" if compared or equal else f"{heading}: not compared"
+            named = "; ".join(label for label in labels if label)
+            lines += ["", f"{lead} ({reason})" + (f": {named}." if named else ".")]
     return lines
-
-
-def _NotCompared(labels: list[str]) -> str:
-    named = "; ".join(label for label in labels if label)
-    return "Not compared (fewer than two seeds on both sides)" + (f": {named}." if named else ".")
 
 
 def RatioOfMeans(a, b, blocks, resamples: int = BOOTSTRAP_RESAMPLES) -> tuple[float, float, float]:

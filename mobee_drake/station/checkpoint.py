@@ -20,7 +20,9 @@ saved.
 
 import json
 import pathlib
+from tokenize import TokenError
 import zipfile
+import zlib
 
 import numpy as np
 
@@ -41,6 +43,9 @@ LOG_SEGMENTS = "log_segments.txt"
 WALL_SECONDS = "wall_seconds.txt"
 # Systems whose state only serves the viewer: a checkpoint may have them or not.
 _VIEWER_SYSTEMS = ("trail",)
+# What reading a damaged .npz raises: a truncated or altered zip, and (the arrays are
+# compressed) a damaged deflate stream or a damaged array header inside it.
+_DAMAGED = (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error, SyntaxError, TokenError)
 
 
 def _DiscreteStates(station: Station, context):
@@ -78,10 +83,11 @@ def ReadCheckpointFiles(station: Station, context, folder: pathlib.Path) -> None
         _ReadFiles(station, context, folder)
     except CheckpointError:
         raise
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as error:
-        raise CheckpointError(
-            f"{folder}: a damaged checkpoint ({type(error).__name__}: {error})"
-        ) from None
+    except (*_DAMAGED, KeyError) as error:
+        kind = type(error).__qualname__
+        if type(error).__module__ != "builtins":  # (zlib.error, zipfile.BadZipFile)
+            kind = f"{type(error).__module__}.{kind}"
+        raise CheckpointError(f"{folder}: a damaged checkpoint ({kind}: {error})") from None
 
 
 def _CheckNoNan(path: pathlib.Path) -> dict:
