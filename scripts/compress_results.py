@@ -26,6 +26,13 @@ def IsCompressed(path: pathlib.Path) -> bool:
         return all(m.compress_type != zipfile.ZIP_STORED for m in archive.infolist())
 
 
+def _OfArrays(path: pathlib.Path) -> bool:
+    """Whether every member of the zip file ``path`` is an array (``.npy``), as np.savez writes
+    them; another member would come back an array of bytes."""
+    with zipfile.ZipFile(path) as archive:
+        return all(m.filename.endswith(".npy") for m in archive.infolist())
+
+
 def Compress(path: pathlib.Path) -> None:
     """Writes the ``.npz`` file ``path`` again, compressed, through a staging file."""
     with np.load(path, allow_pickle=False) as saved:
@@ -38,18 +45,26 @@ def Compress(path: pathlib.Path) -> None:
     WriteFileAtomically(path, Write)
 
 
-def CompressFinishedRuns(folder: pathlib.Path) -> tuple[int, int]:
+def CompressFinishedRuns(folder: pathlib.Path) -> tuple[int, int, list[str]]:
     """Compresses the uncompressed ``.npz`` files of ``folder``'s finished runs; their bytes
-    before and after."""
-    before = after = 0
+    before and after, and the files left as they were, each with why (not arrays alone, or
+    unreadable)."""
+    before, after, left = 0, 0, []
     for result in sorted(folder.glob(f"runs/*/{RESULT}")):
         for path in sorted(result.parent.rglob("*.npz")):
-            if IsCompressed(path):
+            try:
+                if IsCompressed(path):
+                    continue
+                if not _OfArrays(path):
+                    left.append(f"{path}: not arrays alone")
+                    continue
+                size = path.stat().st_size
+                Compress(path)
+            except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
+                left.append(f"{path}: {error}")
                 continue
-            before += path.stat().st_size
-            Compress(path)
-            after += path.stat().st_size
-    return before, after
+            before, after = before + size, after + path.stat().st_size
+    return before, after, left
 
 
 def main() -> None:
@@ -59,8 +74,10 @@ def main() -> None:
     for folder in args.folders:
         if not (folder / "runs").is_dir():
             parser.error(f"{folder}: not a battery folder (no runs/)")
-        before, after = CompressFinishedRuns(folder)
+        before, after, left = CompressFinishedRuns(folder)
         print(f"{folder}: {before / 1e6:.1f} MB of uncompressed arrays now {after / 1e6:.1f} MB")
+        for line in left:
+            print(f"left as it was: {line}")
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ import tempfile
 import time
 import unittest
 from unittest import mock
+import zipfile
 
 from battery_jobs import Count, DefaultSigint, FullDisk, Nan, Walk
 import numpy as np
@@ -414,7 +415,14 @@ class CompressResultsTest(TemporaryFolder):
         running = self.folder / "runs/running/model/g000001/arm.npz"
         unchanged = running.read_bytes()
 
-        before, after = script.CompressFinishedRuns(self.folder)
+        other = self.folder / "runs" / "finished" / "other.npz"
+        with zipfile.ZipFile(other, "w") as archive:
+            archive.writestr("notes.txt", "not an array")
+        (self.folder / "runs" / "finished" / "damaged.npz").write_bytes(b"PK\x03\x04 cut")
+        before, after, left = script.CompressFinishedRuns(self.folder)
+        self.assertEqual(len(left), 2)
+        self.assertTrue(left[0].startswith(f"{self.folder}/runs/finished/damaged.npz: "))
+        self.assertEqual(left[1], f"{other}: not arrays alone")
         self.assertEqual(before, len(unchanged))
         self.assertLess(after, before / 10)
         self.assertTrue(script.IsCompressed(finished))
@@ -423,7 +431,7 @@ class CompressResultsTest(TemporaryFolder):
         with np.load(finished) as saved:
             np.testing.assert_array_equal(saved["counts"], counts)
             np.testing.assert_array_equal(saved["tries"], np.arange(300))
-        self.assertEqual(script.CompressFinishedRuns(self.folder), (0, 0))
+        self.assertEqual(script.CompressFinishedRuns(self.folder)[:2], (0, 0))
 
 
 if __name__ == "__main__":

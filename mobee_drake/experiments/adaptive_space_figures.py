@@ -220,8 +220,11 @@ def WriteSpaceFigures(
         for k, centre in enumerate(shown.targets):
             meshcat.SetObject(f"targets/{k}", Sphere(shown.target_radius), _RGBA["target"])
             meshcat.SetTransform(f"targets/{k}", RigidTransform(centre))
-        centre = np.vstack([h.points for h in robot_histories]).mean(axis=0)
-        meshcat.SetCameraPose(centre + [-0.55, 0.3, 0.3], centre)
+        points = np.vstack([h.points for h in robot_histories])
+        centre = points.mean(axis=0)
+        spread = np.linalg.norm(points - centre, axis=1).max()  # (all in view: 1.5 times it)
+        direction = np.array([-0.9, 0.5, 0.45]) / np.linalg.norm([-0.9, 0.5, 0.45])
+        meshcat.SetCameraPose(centre + max(1.5 * spread, 0.3) * direction, centre)
         written.append(f"{stem}_{robot}.html")
         WriteTextAtomically(output / written[-1], meshcat.StaticHtml())
     return written
