@@ -29,6 +29,16 @@ def _Folded(text: str) -> str:
     return " ".join(text.split())
 
 
+def _ProseAndBlocks(doc: pathlib.Path) -> tuple[str, str]:
+    """``doc``'s text without its generated blocks, and the blocks' (each folded to one
+    line, joined)."""
+    prose, tables = doc.read_text(), []
+    for _, _, table in GeneratedBlocks(doc):
+        prose = prose.replace(table, "")
+        tables.append(_Folded(table))
+    return _Folded(prose), " ".join(tables)
+
+
 class TestKeptBatteries(unittest.TestCase):
     def test_every_ch8_claims_table_is_what_its_kept_runs_give(self):
         blocks = [
@@ -61,24 +71,27 @@ class TestKeptBatteries(unittest.TestCase):
                 self.assertRegex(command, _ADAPTIVE_KEPT)
                 self.assertEqual(text.split("\n\nFigures (")[0].rstrip(), KeptReport(command, ROOT))
 
+    def _CheckQuotedDifferences(self, prose: str, tables: str) -> None:
+        for difference in _DIFFERENCE.findall(prose):
+            with self.subTest(difference=difference):
+                self.assertIn(difference, tables)
+
     def test_the_ratios_the_prose_quotes_are_its_generated_blocks(self):
         """docs/reaching.md's prose quotes random's robot time over the others' from its
         generated blocks (R times [low, high]), and any difference with its interval; a block
         written again from new runs fails the prose that still quotes the old figures."""
-        doc = ROOT / "docs" / "reaching.md"
-        prose, tables = doc.read_text(), []
-        for _, _, table in GeneratedBlocks(doc):
-            prose = prose.replace(table, "")
-            tables.append(_Folded(table))
-        quoted = _RATIO.findall(_Folded(prose))
+        prose, tables = _ProseAndBlocks(ROOT / "docs" / "reaching.md")
+        quoted = _RATIO.findall(prose)
         self.assertTrue(quoted)
         for ratio, low, high in quoted:
             with self.subTest(ratio=ratio):
-                self.assertIn(f"{ratio} times [{low}, {high}]", " ".join(tables))
-        # And every difference it quotes with its interval (ch. 8.5's among them).
-        for difference in _DIFFERENCE.findall(_Folded(prose)):
-            with self.subTest(difference=difference):
-                self.assertIn(difference, " ".join(tables))
+                self.assertIn(f"{ratio} times [{low}, {high}]", tables)
+        self._CheckQuotedDifferences(prose, tables)  # (ch. 8.5's among them)
+
+    def test_the_differences_adaptive_space_quotes_are_its_blocks(self):
+        """docs/adaptive_space.md's verdict quotes differences with their intervals from its
+        generated blocks ("+1.23 [+0.45, +2.01]"): each must be in a block."""
+        self._CheckQuotedDifferences(*_ProseAndBlocks(ROOT / "docs" / "adaptive_space.md"))
 
 
 def _Rows(table: str) -> dict[str, list[str]]:
