@@ -279,7 +279,7 @@ _BENCHMARKS = {
 }
 _EXPERIMENTS = {
     "adaptive-space": (
-        "adaptive_space",
+        "adaptive_space_command",
         "a state-action space that reshapes itself as the curious agent learns (ch. 9.4.5)",
     ),
     "ch7": ("ch7_command", "the model-learning experiments of ch. 7 (the curious agent)"),

@@ -12,7 +12,7 @@ import unittest
 import numpy as np
 from test_figures import FigureTest
 
-from mobee_drake.experiments import adaptive_space
+from mobee_drake.experiments import adaptive_space, adaptive_space_command
 from mobee_drake.experiments.adaptive_space_figures import Figure
 from mobee_drake.experiments.arms import Arms, ReachTargets, TargetGaps, ValidConfigurations
 from mobee_drake.planning.state_space import Lattice
@@ -49,7 +49,7 @@ class TestTheBatterysOrder(unittest.TestCase):
         from mobee_drake.experiments.adaptive_space_reaching import Stages
         from mobee_drake.planning.space_maintenance import MaintenanceConfig
 
-        args = adaptive_space._Parser().parse_args(
+        args = adaptive_space_command._Parser().parse_args(
             ["--part", "reaching", "--robots", "icub", "katana", "--seeds", "2"]
         )
         stages = Stages(args, MaintenanceConfig())
@@ -144,9 +144,9 @@ class TestSpaceHistory(unittest.TestCase):
 
 
 def _KeptReport(report: str) -> str:
-    """What :func:`adaptive_space.KeptReport` gives for the command ``report`` names."""
+    """What :func:`adaptive_space_command.KeptReport` gives for the command ``report`` names."""
     command = report.split("Command: `")[1].split("`")[0]
-    return adaptive_space.KeptReport(command, pathlib.Path("/"))
+    return adaptive_space_command.KeptReport(command, pathlib.Path("/"))
 
 
 class TestSmokeBattery(FigureTest):
@@ -158,7 +158,7 @@ class TestSmokeBattery(FigureTest):
         """Its agent favours no states: ``develop`` would do nothing (exit code 2, one line)."""
         stderr = io.StringIO()
         with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit) as exit:
-            adaptive_space.main(
+            adaptive_space_command.main(
                 ["--rules", "prune", "develop", "--report-only", "--output", str(self.output)]
             )
         self.assertEqual(exit.exception.code, 2)
@@ -171,7 +171,7 @@ class TestSmokeBattery(FigureTest):
         round at the end: every run reports; on the lattice only the maintained ones change
         their space, and its size in the report is what the runs ended with; no penetration."""
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-            adaptive_space.main(
+            adaptive_space_command.main(
                 ["--seeds", "2", "--actions", "30", "--tests", "3", "--every", "5",
                  "--prune-after", "1", "--spaces", "rank4", "trm", "--trm-spacing", "0.6",
                  "--trm-states", "12", "--robots", "icub", "katana", "--output",
@@ -207,7 +207,7 @@ class TestSmokeBattery(FigureTest):
                 self.assertEqual(run.states != 256, maintained)
                 if maintained:  # (rounds at 5, 10, ... 25, none at the run's end: 30)
                     folder = self.output / "runs" / f"icub_rank4_maintained_seed{run.seed}"
-                    changes = adaptive_space.SpaceChanges(folder / "model", "right_arm")
+                    changes = adaptive_space_command.SpaceChanges(folder / "model", "right_arm")
                     self.assertLessEqual({c["actions_done"] for c in changes}, {5, 10, 15, 20, 25})
         report = (self.output / "report.md").read_text()
         self.assertEqual(_KeptReport(report), report.split("\n\nFigures (")[0])
@@ -231,7 +231,7 @@ class TestSmokeBattery(FigureTest):
         self.assertIn("The trm spaces: icub, 12 states and", report)
         # The figures of the first seed's maintained runs: each state of the final space is kept
         # or added, and one is removed per prune.
-        histories = adaptive_space.SpaceHistories(everything, self.output)["icub"]
+        histories = adaptive_space_command.SpaceHistories(everything, self.output)["icub"]
         self.assertEqual([h.title for h in histories], ["icub, rank4", "icub, trm"])
         rank4 = [r for r in runs if r.condition == "maintained" and r.seed == 0][0]
         self.assertEqual(len(histories[0].removed), rank4.changes["prune"])
@@ -252,7 +252,7 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         """The reaching part, greedy, with the MDP learned with the reaches and ``develop`` (a
         target recorded enough) a round at half the run, quietly."""
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-            adaptive_space.main(
+            adaptive_space_command.main(
                 ["--part", "reaching", "--mdp", "simultaneous", "--strategies", "greedy",
                  "--seeds", str(seeds), "--problem-tries", str(tries), "--stages", str(tries),
                  "--evaluations", "1", "--every", str(tries // 2), "--rules", "develop",
@@ -290,14 +290,14 @@ class TestTheReachLearnersSpace(unittest.TestCase):
                 r"runs; at most \d+\.\d cm\)",
             )
             # (the spaces the maintained runs ended with, each grown beyond the lattice)
-            ended = adaptive_space.EndedSpaces(runs, output, robot, "rank3")
+            ended = adaptive_space_command.EndedSpaces(runs, output, robot, "rank3")
             maintained = [r for r in runs if (r.robot, r.condition) == (robot, "maintained")]
             self.assertEqual([len(c) for c in ended], [r.states for r in maintained])
             gaps = [TargetGaps(Arms()[robot], c) for c in ended]
             median = 100 * np.mean([np.median(g) for g in gaps])
             self.assertIn(f"at the maintained runs' end a median {median:.1f} cm", report)
         # The figures: the first seed's maintained space as it grew, with the arm's targets.
-        histories = adaptive_space.ReachSpaceHistories(runs, output)
+        histories = adaptive_space_command.ReachSpaceHistories(runs, output)
         for robot in ("icub", "katana"):
             (history,) = histories[robot]
             (first,) = [

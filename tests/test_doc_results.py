@@ -6,7 +6,7 @@ import pathlib
 import re
 import unittest
 
-from mobee_drake.experiments.adaptive_space import KeptReport
+from mobee_drake.experiments.adaptive_space_command import KeptReport
 from mobee_drake.experiments.ch8_claims import ClaimsTables
 from mobee_drake.experiments.ch8_reaching import StoredResults
 from mobee_drake.experiments.doc_tables import GeneratedBlocks
