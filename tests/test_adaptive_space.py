@@ -211,6 +211,13 @@ class TestSmokeBattery(FigureTest):
                     self.assertLessEqual({c["actions_done"] for c in changes}, {5, 10, 15, 20, 25})
         report = (self.output / "report.md").read_text()
         self.assertEqual(_KeptReport(report), report.split("\n\nFigures (")[0])
+        # How near the lattice's states lie to the arm's valid configurations.
+        valid = ValidConfigurations(Arms()["icub"])
+        lattice = Lattice(adaptive_space.LATTICES["rank4"], 4).centres
+        near = np.mean(adaptive_space.Nearest(lattice, valid))
+        self.assertRegex(
+            report, rf"valid configurations .*: icub, rank4 {near:.3f}, trm 0\.\d{{3}};"
+        )
         maintained = [r for r in runs if r.condition == "maintained"]
         states = np.mean([r.states for r in maintained])
         self.assertRegex(

@@ -50,7 +50,12 @@ import dataclasses as dc
 import numpy as np
 import scipy.spatial
 
-from mobee_drake.experiments.adaptive_space_report import BySetting, ChangesCell, SpaceComparisons
+from mobee_drake.experiments.adaptive_space_report import (
+    BySetting,
+    ChangesCell,
+    NearnessLines,
+    SpaceComparisons,
+)
 from mobee_drake.experiments.arms import (
     TARGET_RADIUS,
     Arms,
@@ -229,9 +234,16 @@ def _Row(key: tuple, rs: list[AdaptiveSpaceRun]) -> str:
     )
 
 
-def Report(runs: list[AdaptiveSpaceRun], roadmaps: dict[str, dict], command: str) -> str:
+def Report(
+    runs: list[AdaptiveSpaceRun],
+    roadmaps: dict[str, dict],
+    command: str,
+    nearness: dict[str, dict[str, float]] | None = None,
+) -> str:
     """The report's table, the trm spaces' roadmaps (``roadmaps``: per robot, its roadmap
-    job's result) and the paired comparisons (markdown)."""
+    job's result), how near each space's states lie to the valid configurations
+    (``nearness``, see :func:`~mobee_drake.experiments.adaptive_space_report.NearnessLines`)
+    and the paired comparisons (markdown)."""
     group = BySetting(runs, SETTING)
     lines = [
         "| robot | space | condition | runs | actions | coverage | dispersion "
@@ -241,7 +253,7 @@ def Report(runs: list[AdaptiveSpaceRun], roadmaps: dict[str, dict], command: str
         "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|",
         *(_Row(key, rs) for key, rs in group.items()),
     ]
-    lines += RoadmapLines(roadmaps)
+    lines += RoadmapLines(roadmaps) + NearnessLines(nearness or {})
     lines += SpaceComparisons(group, "rank4", _MEASURES, "what was learned")
     lines += SpaceComparisons(group, "rank4", _COSTS, "what it cost")
     return "\n".join(lines) + f"\n\nCommand: `{command}`."

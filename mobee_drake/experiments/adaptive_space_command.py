@@ -31,6 +31,7 @@ from mobee_drake.experiments.adaptive_space import (
     SPACES,
     AdaptiveSpaceJob,
     AdaptiveSpaceRun,
+    Nearest,
     Report,
 )
 from mobee_drake.experiments.adaptive_space_figures import History, WriteSpaceFigures
@@ -45,6 +46,7 @@ from mobee_drake.experiments.arms import (
     RoadmapJobOf,
     RoadmapSpace,
     TargetGaps,
+    ValidConfigurations,
 )
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
@@ -229,7 +231,7 @@ def _ExplorationReport(
     ]
     results = _Results(args, jobs, output, "adaptive space", kept)
     runs = [AdaptiveSpaceRun(**r) for r in results.values()]
-    report = Report(runs, built, command)
+    report = Report(runs, built, command, _Nearness(args.robots, args.spaces, output))
     if kept:
         return report
     with OwnedFolder(output, "battery"):
@@ -261,13 +263,14 @@ def _ReachingReport(
     for robot in args.robots:
         targets[robot] = (ReachTargets(arms[robot]), {}, {})
         for space in args.reach_spaces:
-            centres = _ReachCentres(arms[robot], robot, space, output)
+            centres = _BuiltCentres(arms[robot], robot, space, output)
             if centres is not None:
                 targets[robot][1][space] = TargetGaps(arms[robot], centres)
             targets[robot][2][space] = [
                 TargetGaps(arms[robot], ended) for ended in EndedSpaces(runs, output, robot, space)
             ]
-    report = reaching_part.Report(runs, command, targets, roadmaps, mdps)
+    nearness = _Nearness(args.robots, args.reach_spaces, output)
+    report = reaching_part.Report(runs, command, targets, roadmaps, mdps, nearness)
     if kept:
         return report
     with OwnedFolder(output, "battery"):
@@ -307,7 +310,7 @@ def ReachSpaceHistories(runs: list, output: pathlib.Path) -> dict[str, list]:
         strategy = "intrinsic" if "intrinsic" in strategies else strategies[0]
         seed = min(r.seed for r in rs if r.strategy == strategy)
         name = reaching_part.RunName(robot, space, strategy, "maintained", seed)
-        initial = _ReachCentres(arms[robot], robot, space, output)
+        initial = _BuiltCentres(arms[robot], robot, space, output)
         if initial is None:  # (its roadmap is not there: nothing to draw it from)
             continue
         changes = SpaceChanges(output / "runs" / name / "checkpoint", "learner")
@@ -318,11 +321,24 @@ def ReachSpaceHistories(runs: list, output: pathlib.Path) -> dict[str, list]:
     return dict(histories)
 
 
-def _ReachCentres(arm: Arm, robot: str, space: str, output: pathlib.Path):
-    """The centres the reaching part's ``space`` begins with (fractions of range; its rank-3
-    lattice is ch. 8's); None for a roadmap not yet built."""
+def _BuiltCentres(arm: Arm, robot: str, space: str, output: pathlib.Path):
+    """The centres ``space`` begins with (fractions of range; the rank-3 lattice is ch. 8's);
+    None for a roadmap not yet built."""
     built = RoadmapFolder(output / "runs", robot).is_dir()
     return _InitialCentres(arm, robot, space, output) if space in LATTICES or built else None
+
+
+def _Nearness(robots: list[str], spaces: list[str], output: pathlib.Path) -> dict:
+    """Per robot and space (those built), the mean distance from the arm's valid
+    configurations to the nearest of the space's initial states (fractions of range)."""
+    arms, nearness = Arms(), {}
+    for robot in robots:
+        valid = ValidConfigurations(arms[robot])
+        for space in spaces:
+            centres = _BuiltCentres(arms[robot], robot, space, output)
+            if centres is not None:
+                nearness.setdefault(robot, {})[space] = float(np.mean(Nearest(centres, valid)))
+    return nearness
 
 
 _BLOCKS = {"exploration": "adaptive-space", "reaching": "adaptive-space-reaching"}

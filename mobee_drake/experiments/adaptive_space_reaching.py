@@ -29,7 +29,12 @@ import dataclasses as dc
 
 import numpy as np
 
-from mobee_drake.experiments.adaptive_space_report import BySetting, ChangesCell, SpaceComparisons
+from mobee_drake.experiments.adaptive_space_report import (
+    BySetting,
+    ChangesCell,
+    NearnessLines,
+    SpaceComparisons,
+)
 from mobee_drake.experiments.arguments import PositiveFloat, PositiveInt
 from mobee_drake.experiments.arms import RoadmapFolder, RoadmapJobOf, RoadmapLines
 from mobee_drake.experiments.battery import Job, RunFolder, StopRequested
@@ -260,9 +265,12 @@ def Report(
     targets: dict | None = None,
     roadmaps: dict | None = None,
     mdps: dict | None = None,
+    nearness: dict | None = None,
 ) -> str:
     """The report's table, the "trm" spaces' roadmaps (``roadmaps``: per robot, its roadmap
-    job's result), the MDPs learned first (``mdps``: per robot and space, its job's result),
+    job's result), how near each space's states lie to the valid configurations
+    (``nearness``, see :func:`~mobee_drake.experiments.adaptive_space_report.NearnessLines`),
+    the MDPs learned first (``mdps``: per robot and space, its job's result),
     the paired comparisons and, with ``targets`` (per robot, its
     :class:`~mobee_drake.reaching.targets.TargetGrid`; per space, each target's distance to the
     nearest state's marker, :func:`~mobee_drake.experiments.arms.TargetGaps`; and per space,
@@ -293,7 +301,7 @@ def Report(
         ),
         "wall s per run": lambda r: r.wall_seconds,
     }
-    lines += RoadmapLines(roadmaps or {})
+    lines += RoadmapLines(roadmaps or {}) + NearnessLines(nearness or {})
     if mdps:
         actions = "; ".join(f"{setting}, {r['actions']} actions" for setting, r in mdps.items())
         lines += [

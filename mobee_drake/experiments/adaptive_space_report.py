@@ -25,6 +25,24 @@ def ChangesCell(runs: list) -> str:
     return "/".join(f"{np.mean([r.changes.get(rule, 0) for r in runs]):.0f}" for rule in RULES)
 
 
+def NearnessLines(nearness: dict[str, dict[str, float]]) -> list[str]:
+    """Report lines: how near each space's states, as it began, lie to the arm's valid
+    configurations (``nearness``: per robot and space, the valid configurations' mean distance
+    to the nearest state's centre, fractions of range: the dispersion of the states
+    themselves); none without any."""
+    if not nearness:
+        return []
+    spaces = "; ".join(
+        f"{robot}, " + ", ".join(f"{space} {d:.3f}" for space, d in by_space.items())
+        for robot, by_space in nearness.items()
+    )
+    return [
+        "",
+        "How near the spaces' states, as they began, lie to the arm's valid configurations (the "
+        f"mean distance from them to the nearest state, fractions of range): {spaces}.",
+    ]
+
+
 def SpaceComparisons(
     groups: dict[tuple, list], lattice: str, measures: dict, family: str = ""
 ) -> list[str]:
