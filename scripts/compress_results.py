@@ -1,6 +1,7 @@
 """Stores the arrays of a battery's finished runs compressed: every ``.npz`` file under a
 ``runs/<job>/`` folder that has its ``result.json`` and holds an uncompressed member is
-written again with ``np.savez_compressed`` (the same arrays; ``np.load`` reads either).
+written again as :func:`~mobee_drake.array_files.WriteArrays` writes them, deflated (the same
+arrays; ``np.load`` reads either).
 
 Runs written before the checkpoints were compressed hold their learned models' dense counts
 as they are in memory (a rank-4 maintained exploration's 8.8 MB against 0.09 MB compressed).
@@ -16,6 +17,7 @@ import zipfile
 
 import numpy as np
 
+from mobee_drake.array_files import WriteArrays
 from mobee_drake.atomic_files import WriteFileAtomically
 from mobee_drake.experiments.battery import RESULT
 
@@ -38,11 +40,7 @@ def Compress(path: pathlib.Path) -> None:
     with np.load(path, allow_pickle=False) as saved:
         arrays = {name: saved[name] for name in saved.files}
 
-    def Write(staging) -> None:
-        with open(staging, "wb") as file:  # A path would get ".npz" appended.
-            np.savez_compressed(file, **arrays)
-
-    WriteFileAtomically(path, Write)
+    WriteFileAtomically(path, lambda staging: WriteArrays(staging, **arrays))
 
 
 def CompressFinishedRuns(folder: pathlib.Path) -> tuple[int, int, list[str]]:

@@ -16,11 +16,13 @@ import tempfile
 import textwrap
 import time
 import unittest
+import zipfile
 
 from battery_jobs import Count, DefaultSigint, StopWalk
 import numpy as np
 
 from mobee_drake import cli
+from mobee_drake.array_files import WriteArrays
 from mobee_drake.atomic_files import (
     CurrentGeneration,
     WriteFileAtomically,
@@ -99,6 +101,25 @@ class TestGenerations(TemporaryFolder):
     def test_an_empty_folder_holds_no_generation(self):
         self.assertIsNone(CurrentGeneration(self.folder / "none"))
         self.assertIsNone(CurrentGeneration(self.folder))
+
+
+class TestArrayFiles(TemporaryFolder):
+    def test_arrays_are_deflated_and_read_back_as_written(self):
+        counts = np.zeros((300, 80))
+        counts[::7, ::3] = 5.0
+        arrays = dict(counts=counts, tries=np.arange(300), time=3.5, names=np.array(["a", "b"]))
+        WriteArrays(self.folder / "model.npz", **arrays)
+        with zipfile.ZipFile(self.folder / "model.npz") as saved:
+            members = {m.filename: m for m in saved.infolist()}
+        self.assertEqual(set(members), {f"{name}.npy" for name in arrays})
+        self.assertTrue(all(m.compress_type == zipfile.ZIP_DEFLATED for m in members.values()))
+        self.assertLess(members["counts.npy"].compress_size, counts.nbytes / 20)
+        with np.load(self.folder / "model.npz") as loaded:
+            for name, value in arrays.items():
+                np.testing.assert_array_equal(loaded[name], value)
+                self.assertEqual(loaded[name].dtype, np.asarray(value).dtype)
+        with self.assertRaises(ValueError):
+            WriteArrays(self.folder / "objects.npz", mixed=np.array([1, "a", None], dtype=object))
 
 
 class TestAtomicFiles(TemporaryFolder):

@@ -55,6 +55,7 @@ import time
 
 import numpy as np
 
+from mobee_drake.array_files import WriteArrays
 from mobee_drake.atomic_files import (
     CurrentGeneration,
     StrictJson,
@@ -396,7 +397,7 @@ def _Checkpoint(
         if keeper is not None:
             space_arrays, saved["maintenance"] = keeper.ToArrays(learner)
             arrays.update(space_arrays)
-        np.savez_compressed(staging / "learner.npz", **arrays)
+        WriteArrays(staging / "learner.npz", **arrays)
         (staging / "learner.json").write_text(StrictJson(saved))
 
     WriteGeneration(folder, Write)
@@ -439,7 +440,7 @@ def _LearnedMdp(run_dir: pathlib.Path, learner: ReachLearner, model: Explorer) -
     """Saves the MDP learned with the reaches (``mdp.npz``); the state-actions it learned about
     and their learned chance of reaching their goal."""
     counts = learner.model.counts
-    np.savez_compressed(run_dir / "mdp.npz", counts=counts)
+    WriteArrays(run_dir / "mdp.npz", counts=counts)
     updated = np.flatnonzero(np.any(counts != model.transitions.counts, axis=1))
     success = learner.model.Probabilities()[updated, model.space.action_goal[updated]]
     return dict(

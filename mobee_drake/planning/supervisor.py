@@ -25,6 +25,7 @@ import numpy as np
 from pydrake.common.value import AbstractValue
 from pydrake.systems.framework import LeafSystem
 
+from mobee_drake.array_files import WriteArrays
 from mobee_drake.atomic_files import CurrentGeneration, StrictJson
 from mobee_drake.planning.actuation_noise import NoisyPosture, ValidateNoise
 from mobee_drake.planning.explorers import (
@@ -419,7 +420,7 @@ class ExplorationSupervisor(LeafSystem):
             arrays["settled"] = np.reshape(record.settled, (len(record.settled), len(columns)))
             if record.maintenance is not None:
                 arrays["maintenance_chains"], data["maintenance"] = record.maintenance.ToData()
-            np.savez_compressed(folder / f"{name}.npz", **arrays)
+            WriteArrays(folder / f"{name}.npz", **arrays)
             # Not slow (inf) is written null: JSON has no infinity.
             slow = float(record.slow_since)
             data["record"]["slow_since"] = slow if np.isfinite(slow) else None

@@ -26,6 +26,7 @@ import zlib
 
 import numpy as np
 
+from mobee_drake.array_files import WriteArrays
 from mobee_drake.atomic_files import CurrentGeneration, StrictJson, WriteGeneration
 from mobee_drake.station.builder import Station
 from mobee_drake.yaml_io import YamlDifferences
@@ -59,7 +60,7 @@ def _DiscreteStates(station: Station, context):
 def WriteCheckpointFiles(station: Station, context, folder: pathlib.Path) -> None:
     """Writes the state of ``context`` (the diagram's root context) into the existing
     ``folder``: the files of one checkpoint (see the module)."""
-    np.savez_compressed(
+    WriteArrays(
         folder / "simulation.npz",
         time=context.get_time(),
         **{key: value for key, value in _DiscreteStates(station, context)},

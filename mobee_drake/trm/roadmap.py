@@ -29,6 +29,7 @@ import time
 
 import numpy as np
 
+from mobee_drake.array_files import WriteArrays
 from mobee_drake.atomic_files import CurrentGeneration, StrictJson, WriteGeneration
 from mobee_drake.ngik.nes import Minimize, NesConfig
 from mobee_drake.ngik.solver import IkProblem
@@ -112,7 +113,7 @@ class TaskRelevantRoadmap:
         (see :func:`~mobee_drake.atomic_files.WriteGeneration`)."""
 
         def Write(staging: pathlib.Path) -> None:
-            np.savez_compressed(
+            WriteArrays(
                 staging / "roadmap.npz",
                 q=self.q,
                 y=self.y,

@@ -1,0 +1,22 @@
+"""The ``.npz`` files of checkpoints, learned models and roadmaps: :func:`WriteArrays`.
+
+A learned model's transition counts are a dense array of mostly zeros (a rank-4 exploration's
+1536 state-actions by 256 states), rewritten after almost every action. Deflated at level 1
+they take about a fiftieth of the space for a little more time than an uncompressed write
+(zlib's default level takes about three times as long for a fifth less), so a run's folders
+stay small without slowing the run. ``np.load`` reads them as it reads ``np.savez``'s.
+"""
+
+import zipfile
+
+import numpy as np
+
+
+def WriteArrays(file, **arrays) -> None:
+    """Writes ``arrays`` (name: array) to ``file`` (a path or a binary file object) as an
+    ``.npz``, each array a member ``<name>.npy`` deflated at level 1. Object arrays are refused
+    (ValueError), as ``np.load`` refuses them by default."""
+    with zipfile.ZipFile(file, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=1) as archive:
+        for name, value in arrays.items():
+            with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
+                np.lib.format.write_array(member, np.asanyarray(value), allow_pickle=False)
