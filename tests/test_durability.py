@@ -281,11 +281,16 @@ class TestExplorationCheckpoints(TemporaryFolder):
     """An exploration (the ch. 8 MDP's training, ch. 7.4.1's) interrupted after a checkpoint
     resumes to the model an uninterrupted one learns, and counts the wall time before."""
 
-    def _Explore(self, folder: pathlib.Path, interrupt_at: int | None = None):
-        """(the saved model's arrays, the run's wall time)."""
+    def _Explore(
+        self, folder: pathlib.Path, interrupt_at: int | None = None, every: int = 1, seen=None
+    ):
+        """(the saved model's arrays, the run's wall time); a checkpoint every ``every``
+        actions, each chunk's actions done and newest checkpoint appended to ``seen``."""
         agent = ExploringAgent(name="arm", joints=list(RIGHT_SHOULDER_ELBOW_JOINTS))
 
         def Progress(done: int) -> None:  # Told after the chunk's checkpoint.
+            if seen is not None:
+                seen.append((done, CurrentGeneration(folder)))
             if interrupt_at is not None and done >= interrupt_at:
                 raise KeyboardInterrupt
 
@@ -294,8 +299,25 @@ class TestExplorationCheckpoints(TemporaryFolder):
             stop=Stop(actions=12),
             checkpoint=folder,
             progress=Progress,
+            checkpoint_every=every,
         )
         return dict(np.load(CurrentGeneration(folder) / "arm.npz")), run.wall_seconds
+
+    def test_a_checkpoint_every_so_many_actions_and_the_last(self):
+        """Every 5 actions (a checkpoint costs time), and the final model saved at the end."""
+        whole, _ = self._Explore(self.folder / "whole")
+        seen = []
+        sparse, _ = self._Explore(self.folder / "sparse", every=5, seen=seen)
+        np.testing.assert_array_equal(sparse["counts"], whole["counts"])
+        self.assertEqual(len(sparse["settled"]), 12)  # (the last one: all 12 actions)
+        saved_at, last = 0, None
+        for done, generation in seen:
+            if generation != last:  # (a checkpoint was written after this chunk)
+                self.assertGreaterEqual(done, saved_at + 5)
+                saved_at, last = done, generation
+            else:
+                self.assertLess(done, saved_at + 5)
+        self.assertEqual(len({g for _, g in seen if g is not None}), 2)  # (at 5-6 and 10-11)
 
     def test_an_interrupted_exploration_resumes_exactly(self):
         whole, _ = self._Explore(self.folder / "whole")

@@ -21,6 +21,10 @@ from mobee_drake.station.checkpoint import (
 from mobee_drake.station.runner import Advance
 from mobee_drake.station.world_events import MakeSimulator
 
+# Actions between an exploration's checkpoints (a fifth of a rank-4 lattice run's time went to
+# writing them when one was written after almost every action).
+CHECKPOINT_EVERY = 20
+
 
 @dataclasses.dataclass
 class ExplorationRun:
@@ -118,11 +122,13 @@ def Explore(
     observer=None,
     progress=None,
     should_stop=None,
+    checkpoint_every: int = CHECKPOINT_EVERY,
 ) -> ExplorationRun:
     """Runs until ``stop(records)``; returns what the agents learned and did.
 
     With ``checkpoint`` (a checkpoint folder), the run resumes from the checkpoint there, saves
-    one after every chunk in which an action was completed, and keeps the final one (the learned
+    one after the chunk in which ``checkpoint_every`` more actions were done, and keeps the
+    final one (the learned
     models, for a planner to reuse); the data returned then covers the whole run (the model,
     its actions, simulated time and penetrations are in the checkpoint, and its wall time),
     but for ``coverage`` and ``snapshots``, which begin where it resumed.
@@ -135,7 +141,7 @@ def Explore(
     context = simulator.get_context()
     configuration = ResumableConfiguration(scenario) if checkpoint is not None else ""
     records = supervisor.Records(supervisor_context)
-    saved = sum(r.actions_done for r in records)
+    saved = done = sum(r.actions_done for r in records)
     observe, observed = observer(station) if observer else (None, lambda: None)
     resumed = SavedWallSeconds(checkpoint) if checkpoint is not None else 0.0
     taken, coverage, start = {}, [], time.perf_counter() - resumed
@@ -149,7 +155,7 @@ def Explore(
         Advance(station, simulator, context.get_time() + chunk, after_chunk=observe)
         records = supervisor.Records(supervisor_context)
         done = sum(r.actions_done for r in records)
-        if checkpoint is not None and done > saved:
+        if checkpoint is not None and done >= saved + checkpoint_every:
             Save()
             saved = done
         if progress is not None:
@@ -165,8 +171,8 @@ def Explore(
                     tries=records[0].explorer.tries.tolist(),
                     values=records[0].explorer.Values()[0].tolist(),
                 )
-    if checkpoint is not None and not HasCheckpoint(checkpoint):  # (No action was completed.)
-        Save()
+    if checkpoint is not None and (done > saved or not HasCheckpoint(checkpoint)):
+        Save()  # (the final model; or none was completed)
     report = station.monitor.Report(station.monitor.GetMyContextFromRoot(context))
     return ExplorationRun(
         agents=supervisor.agent_names,
