@@ -1,15 +1,22 @@
 """The ``.npz`` files of checkpoints, learned models and roadmaps: :func:`WriteArrays`.
 
 A learned model's transition counts are a dense array of mostly zeros (a rank-4 exploration's
-1536 state-actions by 256 states), rewritten after almost every action. Deflated at level 1
-they take about a fiftieth of the space for a little more time than an uncompressed write
-(zlib's default level takes about three times as long for a fifth less), so a run's folders
-stay small without slowing the run. ``np.load`` reads them as it reads ``np.savez``'s.
+1536 state-actions by 256 states), rewritten with every checkpoint. Deflated at level 1 they
+take about a fortieth of the space (a lattice's or a roadmap's model) for a little more time
+than an uncompressed write (zlib's default level takes about three times as long for a fifth
+less), so a run's folders stay small without slowing the run. ``np.load`` reads them as it
+reads ``np.savez``'s.
 """
 
+from tokenize import TokenError
 import zipfile
+import zlib
 
 import numpy as np
+
+# What reading a damaged .npz raises: a truncated or altered zip, a damaged deflate stream, or a
+# damaged array header.
+DAMAGED = (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error, SyntaxError, TokenError)
 
 
 def WriteArrays(file, **arrays) -> None:

@@ -4,7 +4,7 @@ written again as :func:`~mobee_drake.array_files.WriteArrays` writes them, defla
 arrays; ``np.load`` reads either).
 
 Runs written before the checkpoints were compressed hold their learned models' dense counts
-as they are in memory (a rank-4 maintained exploration's 8.8 MB against 0.09 MB compressed).
+as they are in memory (a rank-4 maintained exploration's 8.8 MB against 0.13 MB deflated).
 Running and pending runs are left alone: their battery may be writing them.
 
 Run: ``python scripts/compress_results.py FOLDER [FOLDER ...]`` (battery folders, e.g.
@@ -17,7 +17,7 @@ import zipfile
 
 import numpy as np
 
-from mobee_drake.array_files import WriteArrays
+from mobee_drake.array_files import DAMAGED, WriteArrays
 from mobee_drake.atomic_files import WriteFileAtomically
 from mobee_drake.experiments.battery import RESULT
 
@@ -58,7 +58,7 @@ def CompressFinishedRuns(folder: pathlib.Path) -> tuple[int, int, list[str]]:
                     continue
                 size = path.stat().st_size
                 Compress(path)
-            except (OSError, ValueError, EOFError, zipfile.BadZipFile) as error:
+            except DAMAGED as error:
                 left.append(f"{path}: {error}")
                 continue
             before, after = before + size, after + path.stat().st_size

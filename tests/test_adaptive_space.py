@@ -14,7 +14,13 @@ from test_figures import FigureTest
 
 from mobee_drake.experiments import adaptive_space, adaptive_space_command
 from mobee_drake.experiments.adaptive_space_figures import Figure
-from mobee_drake.experiments.arms import Arms, ReachTargets, TargetGaps, ValidConfigurations
+from mobee_drake.experiments.arms import (
+    Arms,
+    ReachTargets,
+    RoadmapSpace,
+    TargetGaps,
+    ValidConfigurations,
+)
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.reaching.targets import LoadTargetGrid
 
@@ -214,9 +220,12 @@ class TestSmokeBattery(FigureTest):
         # How near the lattice's states lie to the arm's valid configurations.
         valid = ValidConfigurations(Arms()["icub"])
         lattice = Lattice(adaptive_space.LATTICES["rank4"], 4).centres
-        near = np.mean(adaptive_space.Nearest(lattice, valid))
-        self.assertRegex(
-            report, rf"valid configurations .*: icub, rank4 {near:.3f}, trm 0\.\d{{3}};"
+        roadmap = RoadmapSpace(Arms()["icub"], self.output / "runs" / "icub_roadmap" / "roadmap")
+        near = [np.mean(adaptive_space.Nearest(c, valid)) for c in (lattice, roadmap.centres)]
+        self.assertIn(
+            "configurations (the mean distance from them to the nearest state, fractions of "
+            f"range): icub, rank4 {near[0]:.3f}, trm {near[1]:.3f};",
+            report,
         )
         maintained = [r for r in runs if r.condition == "maintained"]
         states = np.mean([r.states for r in maintained])
@@ -300,6 +309,10 @@ class TestTheReachLearnersSpace(unittest.TestCase):
             ended = adaptive_space_command.EndedSpaces(runs, output, robot, "rank3")
             maintained = [r for r in runs if (r.robot, r.condition) == (robot, "maintained")]
             self.assertEqual([len(c) for c in ended], [r.states for r in maintained])
+            lattice = Lattice(adaptive_space.LATTICES["rank3"], 4).centres
+            valid = ValidConfigurations(Arms()[robot])
+            near = np.mean(adaptive_space.Nearest(lattice, valid))
+            self.assertRegex(report, rf"valid configurations .*\b{robot}, rank3 {near:.3f}\b")
             gaps = [TargetGaps(Arms()[robot], c) for c in ended]
             median = 100 * np.mean([np.median(g) for g in gaps])
             self.assertIn(f"at the maintained runs' end a median {median:.1f} cm", report)
@@ -357,7 +370,7 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         """A roadmap of spacing 1.5 (a few states) and the MDP learned on it until every
         state-action was tried once: the model's states are the roadmap's vertices, its
         transitions the roadmap's edges both ways."""
-        from mobee_drake.experiments.arms import RoadmapJob, RoadmapSpace
+        from mobee_drake.experiments.arms import RoadmapJob
         from mobee_drake.experiments.battery import RunFolder
         from mobee_drake.experiments.ch8_reaching import AGENT, MdpJob, MdpName
         from mobee_drake.planning.explorers import ExplorerConfig, LoadAgentModel

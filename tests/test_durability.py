@@ -318,6 +318,15 @@ class TestExplorationCheckpoints(TemporaryFolder):
             else:
                 self.assertLess(done, saved_at + 5)
         self.assertEqual(len({g for _, g in seen if g is not None}), 2)  # (at 5-6 and 10-11)
+        # Killed between checkpoints (at 8, the last at 5 or 6): it resumes from the last and
+        # ends where the whole run ends.
+        with self.assertRaises(KeyboardInterrupt):
+            self._Explore(self.folder / "killed", interrupt_at=8, every=5)
+        saved = dict(np.load(CurrentGeneration(self.folder / "killed") / "arm.npz"))
+        self.assertLess(len(saved["settled"]), 8)
+        resumed, _ = self._Explore(self.folder / "killed", every=5)
+        for key in ("counts", "rewards", "tries", "settled"):
+            np.testing.assert_array_equal(resumed[key], whole[key], key)
 
     def test_an_interrupted_exploration_resumes_exactly(self):
         whole, _ = self._Explore(self.folder / "whole")

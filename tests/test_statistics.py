@@ -363,6 +363,10 @@ class TestPairedAndFamilies(unittest.TestCase):
         self.assertEqual(shifted.sd, 0.0)
         np.testing.assert_allclose([shifted.low, shifted.high], 0.2)
         self.assertTrue(math.isnan(shifted.t_p) and math.isnan(shifted.d_z))
+        # (and the same in every pair of each block: no spread within the blocks to test by)
+        x = np.array([0.6, 0.8, 1.0, 1.2, 1.4, 1.6])
+        blocked = ComparePaired(x + [0.2, 0.2, 0.2, 0.5, 0.5, 0.5], x, [0, 0, 0, 1, 1, 1])
+        self.assertTrue(math.isnan(blocked.t_p))
         self.assertAlmostEqual(shifted.wilcoxon_p, 2 / 2**6)
         p_value, p_shifted = Holm([value.t_p, shifted.wilcoxon_p])
         self.assertEqual(

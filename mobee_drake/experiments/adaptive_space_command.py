@@ -105,7 +105,8 @@ def _Parser() -> CommandParser:
         "--part",
         choices=("exploration", "reaching"),
         default="exploration",
-        help="the curious agent of ch. 7 (this module) or the reach learner of ch. 8 "
+        help="the curious agent of ch. 7 (mobee_drake.experiments.adaptive_space) or the reach "
+        "learner of ch. 8 "
         "(mobee_drake.experiments.adaptive_space_reaching)",
     )
     parser.add_argument("--seeds", type=PositiveInt, default=10, help="runs per setting")

@@ -432,9 +432,11 @@ def ComparePaired(a, b, blocks) -> PairedComparison:
         raise ValueError(f"a paired test needs more pairs than blocks, got {n} in {j}")
     mean, sd = float(d.mean()), float(d.std(ddof=1))
     within = math.sqrt(sum(np.sum((g - g.mean()) ** 2) for g in groups) / (n - j))
-    # The same difference in every pair but for rounding: no spread (not a t of 1e15).
-    if np.ptp(d) <= 1e-9 * max(1.0, float(np.abs(d).max())):
-        sd = within = 0.0
+    # The same difference in every pair (or in every pair of each block) but for rounding: no
+    # spread (not a t of 1e15).
+    rounding = 1e-9 * max(1.0, float(np.abs(d).max()))
+    sd = 0.0 if np.ptp(d) <= rounding else sd
+    within = 0.0 if within <= rounding else within
     se = within / math.sqrt(n)
     half = stats.t.ppf(0.975, n - j) * se
     varied = j > 1 and all(g.size > 1 for g in groups) and within > 0
@@ -495,10 +497,10 @@ def PairedBySeed(families: dict, measures: dict, heading: str) -> list[str]:
             b = np.array([f(r) for r in control], dtype=float)
             kept = np.isfinite(a) & np.isfinite(b)
             label = f"{family}, {name}" if family else name
-            tied = int(np.sum(np.isclose(a[kept], b[kept], rtol=1e-9, atol=0.0)))
+            tied = int(np.sum(a[kept] == b[kept]))  # (as ComparePaired's a_larger: d > 0)
             if np.sum(kept) < 2:
                 not_compared["fewer than two pairs with values"].append(label)
-            elif tied == np.sum(kept):
+            elif np.allclose(a[kept], b[kept], rtol=1e-9, atol=0.0):
                 equal.append(label)
             else:
                 compared[label] = c = ComparePaired(a[kept], b[kept], np.zeros(np.sum(kept)))

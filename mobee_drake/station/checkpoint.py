@@ -20,13 +20,10 @@ saved.
 
 import json
 import pathlib
-from tokenize import TokenError
-import zipfile
-import zlib
 
 import numpy as np
 
-from mobee_drake.array_files import WriteArrays
+from mobee_drake.array_files import DAMAGED, WriteArrays
 from mobee_drake.atomic_files import CurrentGeneration, StrictJson, WriteGeneration
 from mobee_drake.station.builder import Station
 from mobee_drake.yaml_io import YamlDifferences
@@ -44,9 +41,6 @@ LOG_SEGMENTS = "log_segments.txt"
 WALL_SECONDS = "wall_seconds.txt"
 # Systems whose state only serves the viewer: a checkpoint may have them or not.
 _VIEWER_SYSTEMS = ("trail",)
-# What reading a damaged .npz raises: a truncated or altered zip, and (the arrays are
-# compressed) a damaged deflate stream or a damaged array header inside it.
-_DAMAGED = (OSError, ValueError, EOFError, zipfile.BadZipFile, zlib.error, SyntaxError, TokenError)
 
 
 def _DiscreteStates(station: Station, context):
@@ -84,7 +78,7 @@ def ReadCheckpointFiles(station: Station, context, folder: pathlib.Path) -> None
         _ReadFiles(station, context, folder)
     except CheckpointError:
         raise
-    except (*_DAMAGED, KeyError) as error:
+    except (*DAMAGED, KeyError) as error:
         kind = type(error).__qualname__
         if type(error).__module__ != "builtins":  # (zlib.error, zipfile.BadZipFile)
             kind = f"{type(error).__module__}.{kind}"
