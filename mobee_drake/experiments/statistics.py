@@ -432,11 +432,6 @@ def ComparePaired(a, b, blocks) -> PairedComparison:
         raise ValueError(f"a paired test needs more pairs than blocks, got {n} in {j}")
     mean, sd = float(d.mean()), float(d.std(ddof=1))
     within = math.sqrt(sum(np.sum((g - g.mean()) ** 2) for g in groups) / (n - j))
-    # The same difference in every pair (or in every pair of each block) but for rounding: no
-    # spread (not a t of 1e15).
-    rounding = 1e-9 * max(1.0, float(np.abs(d).max()))
-    sd = 0.0 if np.ptp(d) <= rounding else sd
-    within = 0.0 if within <= rounding else within
     se = within / math.sqrt(n)
     half = stats.t.ppf(0.975, n - j) * se
     varied = j > 1 and all(g.size > 1 for g in groups) and within > 0
@@ -467,6 +462,16 @@ def _OverBlocks(groups: list[np.ndarray], within: float) -> float:
         return math.nan
     se = math.sqrt(max(means.var(ddof=1) / j, within**2 / n))
     return float(2 * stats.t.sf(abs(means.mean()) / se, j - 1)) if se > 0 else math.nan
+
+
+def _Compared(a: np.ndarray, b: np.ndarray) -> PairedComparison:
+    """:func:`ComparePaired` in one block, but a difference the same in every pair (also but
+    for rounding) has no spread: no d_z, no t-test (Wilcoxon's test stands), not a t of 1e15."""
+    c = ComparePaired(a, b, np.zeros(a.size))
+    d = a - b
+    if np.ptp(d) > 1e-9 * max(1.0, float(np.abs(d).max())):
+        return c
+    return dc.replace(c, sd=0.0, d_z=math.nan, t_p=math.nan, low=c.difference, high=c.difference)
 
 
 def PairedBySeed(families: dict, measures: dict, heading: str) -> list[str]:
@@ -503,7 +508,7 @@ def PairedBySeed(families: dict, measures: dict, heading: str) -> list[str]:
             elif np.allclose(a[kept], b[kept], rtol=1e-9, atol=0.0):
                 equal.append(label)
             else:
-                compared[label] = c = ComparePaired(a[kept], b[kept], np.zeros(np.sum(kept)))
+                compared[label] = c = _Compared(a[kept], b[kept])
                 notes[label] = (
                     ("; Wilcoxon's p: every pair differs by the same" if c.sd == 0 else "")
                     + (f"; {tied} tied" if tied else "")
