@@ -128,10 +128,9 @@ def Explore(
 
     With ``checkpoint`` (a checkpoint folder), the run resumes from the checkpoint there, saves
     one after the chunk in which ``checkpoint_every`` more actions were done, and keeps the
-    final one (the learned
-    models, for a planner to reuse); the data returned then covers the whole run (the model,
-    its actions, simulated time and penetrations are in the checkpoint, and its wall time),
-    but for ``coverage`` and ``snapshots``, which begin where it resumed.
+    final one (the learned models, for a planner to reuse); the data returned then covers the
+    whole run (the model, its actions, simulated time and penetrations are in the checkpoint,
+    and its wall time), but for ``coverage`` and ``snapshots``, which begin where it resumed.
     ``observer(station)``, if given, returns a callable run on the root context after every
     chunk of the simulation and a function giving the run's ``table_contacts``; ``progress(n)``, if
     given, is told the number of actions done after every chunk; ``should_stop()``, if given, is
