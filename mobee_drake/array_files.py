@@ -2,7 +2,8 @@
 
 A learned model's transition counts are a dense array of mostly zeros (a rank-4 exploration's
 1536 state-actions by 256 states), rewritten with every checkpoint. Deflated at level 1 they
-take about a fortieth of the space (a lattice's or a roadmap's model) for a little more time
+take about a fortieth of the space (a rank-4 lattice's or a roadmap's model; a rank-3
+lattice's, smaller and denser, about a seventh) for a little more time
 than an uncompressed write (zlib's default level takes about three times as long for a fifth
 less), so a run's folders stay small without slowing the run. ``np.load`` reads them as it
 reads ``np.savez``'s.
