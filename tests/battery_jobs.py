@@ -14,6 +14,7 @@ import numpy as np
 
 from mobee_drake.atomic_files import WriteJsonAtomically, WriteTextAtomically
 from mobee_drake.experiments.battery import (
+    BLAS_THREADS,
     Job,
     JobStopped,
     LocalProcesses,
@@ -42,6 +43,11 @@ def FullDisk(run, calls: str) -> dict:
     with open(calls, "a") as stream:
         stream.write(run.path.name + "\n")
     raise OSError(errno.ENOSPC, "No space left on device", str(run.path / "result.json"))
+
+
+def BlasThreads(run) -> dict:
+    """The BLAS thread counts the worker's environment names."""
+    return {name: os.environ.get(name) for name in BLAS_THREADS}
 
 
 def Nan(run) -> dict:

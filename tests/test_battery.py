@@ -20,7 +20,7 @@ import unittest
 from unittest import mock
 import zipfile
 
-from battery_jobs import Count, DefaultSigint, FullDisk, Nan, Walk
+from battery_jobs import BlasThreads, Count, DefaultSigint, FullDisk, Nan, Walk
 import numpy as np
 
 from mobee_drake.experiments import battery, saggriac
@@ -157,6 +157,20 @@ class LocalBatteryTest(TemporaryFolder):
             with mock.patch.object(battery.time, "monotonic", return_value=time.monotonic() + 1):
                 run.Progress(1000)
             self.assertEqual(write.call_args.args[1], {"done": 1000})
+
+    def test_local_workers_get_one_blas_thread_unless_the_environment_says(self):
+        names = battery.BLAS_THREADS
+        jobs = [Job("threads", BlasThreads, {})]
+        with mock.patch.dict(os.environ):
+            for name in names:
+                os.environ.pop(name, None)
+            ran = RunBattery(jobs, self.folder / "one", workers=1, progress=False)
+            self.assertEqual(ran["threads"], dict.fromkeys(names, "1"))
+            self.assertFalse(set(names) & set(os.environ))  # (the parent's as it was)
+            os.environ["OPENBLAS_NUM_THREADS"] = "2"
+            ran = RunBattery(jobs, self.folder / "two", workers=1, progress=False)
+            self.assertEqual(ran["threads"]["OPENBLAS_NUM_THREADS"], "2")
+            self.assertEqual(ran["threads"]["OMP_NUM_THREADS"], "1")
 
     def test_bad_jobs_are_refused(self):
         with self.assertRaisesRegex(TypeError, "job 'local'"):

@@ -25,10 +25,8 @@ a folder of the user's is refused, and so is a second battery on the same folder
 returned, keyed by job name in job order, as parsed from their files, so a
 result computed now and one loaded later are equal. Jobs are deterministic functions of their
 kwargs and the runner adds nothing to their results, so a job gives the same bytes on every
-backend, and a battery interrupted on one backend finishes on another. (The environment is the
-job's business: a job whose numbers depend on the count of BLAS threads should be run with
-``OMP_NUM_THREADS`` set by the command.) A job that fails does not stop the others; when all are
-done, :class:`BatteryError` names those that failed.
+backend, and a battery interrupted on one backend finishes on another. A job that fails does not
+stop the others; when all are done, :class:`BatteryError` names those that failed.
 
 Backends (``Session()`` gives a ``submit(job, output)`` that returns a
 :class:`concurrent.futures.Future` of the result's JSON text; ``capacity`` is how many jobs the
@@ -37,7 +35,12 @@ parent keeps submitted):
 - :class:`LocalProcesses`, the default: a pool of ``workers`` spawned processes. Each worker asks
   Linux for SIGKILL when its parent dies (``prctl(PR_SET_PDEATHSIG)``; it checks right after that
   the parent is still the one that started it) and ignores SIGINT, so a Ctrl-C in a terminal reaches
-  only the parent. The parent then stops the queue, asks the running jobs to stop (SIGUSR1:
+  only the parent. The workers are the battery's parallelism, so each gets one BLAS thread
+  (:data:`BLAS_THREADS`, unless the command's environment sets them): OpenBLAS threads a
+  product of a 1800-row matrix and up (a 256-state roadmap's model of 2028 state-actions), and
+  on cores the other workers keep busy its threads wait for one another, which made the curious
+  agent's value iteration on a roadmap 30 to 100 times slower on two cores. The parent then
+  stops the queue, asks the running jobs to stop (SIGUSR1:
   :func:`StopRequested` turns True, and a job that checkpoints saves and stops at its next safe
   point), waits for them up to :data:`STOP_SECONDS`, kills the workers and re-raises. During a
   battery, SIGTERM raises :class:`KeyboardInterrupt` in the parent as SIGINT does, so the same
@@ -266,6 +269,24 @@ def DieWithParent(parent: int) -> None:
             os._exit(1)
 
 
+# The thread counts of the BLAS libraries numpy and scipy may load, set to 1 in the local
+# workers' environment unless set already (a library reads its count when it loads).
+BLAS_THREADS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+@contextlib.contextmanager
+def _OneBlasThread():
+    """Within it, the processes this one starts get one BLAS thread (:data:`BLAS_THREADS`)
+    unless its environment names their count; on leaving, the environment is as it was."""
+    unset = [name for name in BLAS_THREADS if name not in os.environ]
+    os.environ.update(dict.fromkeys(unset, "1"))
+    try:
+        yield
+    finally:
+        for name in unset:
+            os.environ.pop(name, None)
+
+
 def _DieWithParent(parent: int) -> None:
     """The local workers' initializer: SIGKILL when the parent dies; no SIGINT; SIGUSR1 asks
     the job to stop (see :func:`StopRequested`)."""
@@ -286,35 +307,36 @@ class LocalProcesses:
 
     @contextlib.contextmanager
     def Session(self):
-        pool = concurrent.futures.ProcessPoolExecutor(
-            self.workers,
-            mp_context=multiprocessing.get_context("spawn"),
-            initializer=_DieWithParent,
-            initargs=(os.getpid(),),
-        )
-        submitted = []
+        with _OneBlasThread():
+            pool = concurrent.futures.ProcessPoolExecutor(
+                self.workers,
+                mp_context=multiprocessing.get_context("spawn"),
+                initializer=_DieWithParent,
+                initargs=(os.getpid(),),
+            )
+            submitted = []
 
-        def Submit(job: Job, output: pathlib.Path) -> concurrent.futures.Future:
-            submitted.append(pool.submit(_RunJob, job, output))
-            return submitted[-1]
+            def Submit(job: Job, output: pathlib.Path) -> concurrent.futures.Future:
+                submitted.append(pool.submit(_RunJob, job, output))
+                return submitted[-1]
 
-        try:
-            yield Submit
-        except BaseException:
-            # Interrupted: the queue stops, the running jobs are asked to save and stop, and
-            # after STOP_SECONDS no worker outlives the battery (Python 3.11 has no public way).
-            for future in submitted:
-                future.cancel()
-            processes = list(pool._processes.values())
-            for process in processes:
-                with contextlib.suppress(ProcessLookupError):
-                    os.kill(process.pid, signal.SIGUSR1)
-            concurrent.futures.wait(submitted, STOP_SECONDS)
-            for process in processes:
-                process.kill()
-            raise
-        finally:
-            pool.shutdown(cancel_futures=True)
+            try:
+                yield Submit
+            except BaseException:
+                # Interrupted: the queue stops, the running jobs are asked to save and stop, and
+                # after STOP_SECONDS no worker outlives the battery (Python 3.11 has no public way).
+                for future in submitted:
+                    future.cancel()
+                processes = list(pool._processes.values())
+                for process in processes:
+                    with contextlib.suppress(ProcessLookupError):
+                        os.kill(process.pid, signal.SIGUSR1)
+                concurrent.futures.wait(submitted, STOP_SECONDS)
+                for process in processes:
+                    process.kill()
+                raise
+            finally:
+                pool.shutdown(cancel_futures=True)
 
 
 def _ProcessTable() -> dict[int, tuple[int, int]]:
