@@ -21,6 +21,7 @@ from mobee_drake.experiments.arms import (
     TargetGaps,
     ValidConfigurations,
 )
+from mobee_drake.experiments.doc_tables import GeneratedBlocks
 from mobee_drake.planning.state_space import Lattice
 from mobee_drake.reaching.targets import LoadTargetGrid
 
@@ -176,13 +177,12 @@ class TestSmokeBattery(FigureTest):
         arms, fixed and maintained every 5 actions (a state pruned after one try into it), no
         round at the end: every run reports; on the lattice only the maintained ones change
         their space, and its size in the report is what the runs ended with; no penetration."""
+        arguments = ["--seeds", "2", "--actions", "30", "--tests", "3", "--every", "5",
+                     "--prune-after", "1", "--spaces", "rank4", "trm", "--trm-spacing", "0.6",
+                     "--trm-states", "12", "--robots", "icub", "katana", "--output",
+                     str(self.output)]  # fmt: skip
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
-            adaptive_space_command.main(
-                ["--seeds", "2", "--actions", "30", "--tests", "3", "--every", "5",
-                 "--prune-after", "1", "--spaces", "rank4", "trm", "--trm-spacing", "0.6",
-                 "--trm-states", "12", "--robots", "icub", "katana", "--output",
-                 str(self.output), "--workers", "2"]
-            )  # fmt: skip
+            adaptive_space_command.main([*arguments, "--workers", "2"])
         runs = [
             adaptive_space.AdaptiveSpaceRun(**json.loads(path.read_text()))
             for path in self.output.glob("runs/*_seed*/result.json")
@@ -256,6 +256,18 @@ class TestSmokeBattery(FigureTest):
         for name in ("adaptive_space.png", "adaptive_space_icub.html"):
             self.assertTrue((self.output / name).is_file(), name)
         self.assertIn("Figures (the first seed's maintained runs)", report)
+        # --doc-block: the report into another block of a doc, the part's own left alone.
+        doc = self.output.parent / "doc.md"
+        doc.write_text("".join(f"<!-- generated: {name}, by x -->\n<!-- end generated: {name} -->\n"
+                               for name in ("adaptive-space", "other")))  # fmt: skip
+        with contextlib.redirect_stdout(io.StringIO()):
+            adaptive_space_command.main(
+                [*arguments, "--report-only", "--doc", str(doc), "--doc-block", "other"]
+            )
+        blocks = {name: text for name, _, text in GeneratedBlocks(doc)}
+        self.assertEqual(blocks["adaptive-space"], "")
+        self.assertIn("--doc-block other`.", blocks["other"])
+        self.assertEqual(blocks["other"], (self.output / "report.md").read_text())
 
 
 class TestTheReachLearnersSpace(unittest.TestCase):

@@ -152,6 +152,9 @@ def _Parser() -> CommandParser:
         "the report",
     )
     parser.add_argument(
+        "--doc-block", help="the generated block of --doc that gets the report, if another"
+    )
+    parser.add_argument(
         "--report-only",
         action="store_true",
         help="run nothing: the report of the runs in --output that have finished",
@@ -383,7 +386,7 @@ def KeptReport(command: str, root: pathlib.Path) -> str:
 def main(argv: list[str] | None = None) -> None:
     parser = _Parser()
     args = parser.parse_args(argv)
-    block = _BLOCKS[args.part]
+    block = args.doc_block or _BLOCKS[args.part]
     CheckDocBlocks(parser, args.doc, block)
     maintenance = _Maintenance(parser, args)
     output = _Output(args)
