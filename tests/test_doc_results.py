@@ -2,6 +2,7 @@
 report gives from the kept result files now: a table edited by hand, or left behind by runs
 added to its folder since, fails (docs/results/README.md)."""
 
+import json
 import pathlib
 import re
 import unittest
@@ -68,6 +69,22 @@ class TestKeptBatteries(unittest.TestCase):
                     continue
                 self.assertRegex(command, _ADAPTIVE_KEPT)
                 self.assertEqual(text.split("\n\nFigures (")[0].rstrip(), KeptReport(command, ROOT))
+
+    def test_the_one_blas_thread_runs_are_the_batterys_but_for_their_wall_time(self):
+        """docs/adaptive_space.md says the runs made with one BLAS thread a worker are the
+        exploration battery's runs of the same names, measure for measure, but for their wall
+        time."""
+        results = ROOT / "docs" / "results"
+        runs = sorted((results / "adaptive_space_one_blas_thread").glob("runs/*_seed*"))
+        self.assertEqual(len(runs), 16)
+        for run in runs:
+            with self.subTest(run=run.name):
+                one, battery = (
+                    json.loads((folder / run.name / "result.json").read_text())
+                    for folder in (run.parent, results / "adaptive_space" / "runs")
+                )
+                self.assertNotEqual(one.pop("wall_seconds"), battery.pop("wall_seconds"))
+                self.assertEqual(one, battery)
 
     def _CheckQuotedDifferences(self, prose: str, tables: str) -> None:
         for difference in _DIFFERENCE.findall(prose):

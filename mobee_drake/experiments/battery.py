@@ -35,24 +35,25 @@ parent keeps submitted):
 - :class:`LocalProcesses`, the default: a pool of ``workers`` spawned processes. Each worker asks
   Linux for SIGKILL when its parent dies (``prctl(PR_SET_PDEATHSIG)``; it checks right after that
   the parent is still the one that started it) and ignores SIGINT, so a Ctrl-C in a terminal reaches
-  only the parent. The workers are the battery's parallelism, so each gets one BLAS thread
-  (:data:`BLAS_THREADS`, unless the command's environment sets them): OpenBLAS threads a
-  product of a 1800-row matrix and up (a 256-state roadmap's model of 2028 state-actions), and
-  on cores the other workers keep busy its threads wait for one another, which made the curious
-  agent's value iteration on a roadmap 30 to 100 times slower on two cores. The parent then
-  stops the queue, asks the running jobs to stop (SIGUSR1:
+  only the parent. The parent then stops the queue, asks the running jobs to stop (SIGUSR1:
   :func:`StopRequested` turns True, and a job that checkpoints saves and stops at its next safe
   point), waits for them up to :data:`STOP_SECONDS`, kills the workers and re-raises. During a
   battery, SIGTERM raises :class:`KeyboardInterrupt` in the parent as SIGINT does, so the same
-  clean-up runs; after a SIGKILL of the parent the kernel
-  kills the workers (processes that a job starts itself are the job's to tie to its own life). A
-  worker that dies (say, at the hands of the OOM killer) breaks the pool: the battery stops with
-  :class:`BatteryError`, and running it again resumes.
+  clean-up runs; after a SIGKILL of the parent the kernel kills the workers (processes that a job
+  starts itself are the job's to tie to its own life). A worker that dies (say, at the hands of the
+  OOM killer) breaks the pool: the battery stops with :class:`BatteryError`, and running it again
+  resumes. The workers are the battery's parallelism, so each gets one BLAS thread
+  (:data:`BLAS_THREADS`, unless the command's environment sets them): OpenBLAS threads a product
+  above a size (a 256-state roadmap's model of 2028 state-actions is above it, the rank-4 lattice's
+  of 1536 below), and on cores the other workers keep busy its threads wait for one another (the
+  roadmap's runs of the curious agent took several times the lattice's wall time:
+  docs/adaptive_space.md).
 - :class:`Ray`: tasks on a Ray cluster (``ray.init(address)``; no address, a local instance, or
   the cluster ``RAY_ADDRESS`` names). When Ray is already initialised, the battery uses that
   connection (so a caller can pass ``runtime_env`` and other options to :func:`ray.init` itself)
   and leaves it open; otherwise it initialises Ray and shuts it down at the end. Ray retries a
-  task whose worker died (its ``max_retries``), and the job resumes from its checkpoint. On a
+  task whose worker died (its ``max_retries``), and the job resumes from its checkpoint. Ray
+  gives a task of one CPU ``OMP_NUM_THREADS=1``, which OpenBLAS reads too (Ray 2.60). On a
   cluster of several nodes, ``output`` must be on storage that every node sees at the same path
   (a shared file system), and the package must be installed on every node. On Ctrl-C or SIGTERM
   the tasks are cancelled (their workers killed) before Ray is shut down.
