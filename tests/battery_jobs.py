@@ -3,6 +3,7 @@ workers import them by name (with ``tests/`` on their PYTHONPATH); and the batte
 tests run in a process of their own (:func:`Main`, run as
 ``python -c "import battery_jobs; battery_jobs.Main(...)"`` so that its jobs are this module's)."""
 
+import ctypes
 import errno
 import json
 import os
@@ -46,8 +47,15 @@ def FullDisk(run, calls: str) -> dict:
 
 
 def BlasThreads(run) -> dict:
-    """The BLAS thread counts the worker's environment names."""
-    return {name: os.environ.get(name) for name in BLAS_THREADS}
+    """The BLAS thread counts the worker's environment names, and the threads numpy's OpenBLAS
+    uses (None if numpy was built with another BLAS)."""
+    names = {name: os.environ.get(name) for name in BLAS_THREADS}
+    libraries = [line.split()[-1] for line in open("/proc/self/maps") if "openblas" in line]
+    for symbol in ("scipy_openblas_get_num_threads64_", "openblas_get_num_threads"):
+        for library in libraries:
+            if hasattr(ctypes.CDLL(library), symbol):
+                return dict(names, openblas=getattr(ctypes.CDLL(library), symbol)())
+    return dict(names, openblas=None)
 
 
 def Nan(run) -> dict:

@@ -172,6 +172,16 @@ class TestSmokeBattery(FigureTest):
         self.assertIn("error: --rules develop: the exploration part's agent", stderr.getvalue())
         self.assertFalse(self.output.exists())
 
+    def test_a_doc_table_without_a_doc_is_refused(self):
+        stderr = io.StringIO()
+        with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit) as exit:
+            adaptive_space_command.main(
+                ["--doc-table", "other", "--report-only", "--output", str(self.output)]
+            )
+        self.assertEqual(exit.exception.code, 2)
+        self.assertIn("error: --doc-table: no --doc to write it in", stderr.getvalue())
+        self.assertFalse(self.output.exists())
+
     def test_the_smoke_battery(self):
         """2 seeds x 30 actions on the rank-4 lattice and on a roadmap of 12 states, on both
         arms, fixed and maintained every 5 actions (a state pruned after one try into it), no
@@ -256,17 +266,17 @@ class TestSmokeBattery(FigureTest):
         for name in ("adaptive_space.png", "adaptive_space_icub.html"):
             self.assertTrue((self.output / name).is_file(), name)
         self.assertIn("Figures (the first seed's maintained runs)", report)
-        # --doc-block: the report into another block of a doc, the part's own left alone.
+        # --doc-table: the report into another block of a doc, the part's own left alone.
         doc = self.output.parent / "doc.md"
         doc.write_text("".join(f"<!-- generated: {name}, by x -->\n<!-- end generated: {name} -->\n"
                                for name in ("adaptive-space", "other")))  # fmt: skip
         with contextlib.redirect_stdout(io.StringIO()):
             adaptive_space_command.main(
-                [*arguments, "--report-only", "--doc", str(doc), "--doc-block", "other"]
+                [*arguments, "--report-only", "--doc", str(doc), "--doc-table", "other"]
             )
         blocks = {name: text for name, _, text in GeneratedBlocks(doc)}
         self.assertEqual(blocks["adaptive-space"], "")
-        self.assertIn("--doc-block other`.", blocks["other"])
+        self.assertIn("--doc-table other`.", blocks["other"])
         self.assertEqual(blocks["other"], (self.output / "report.md").read_text())
 
 

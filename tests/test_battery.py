@@ -159,18 +159,21 @@ class LocalBatteryTest(TemporaryFolder):
             self.assertEqual(write.call_args.args[1], {"done": 1000})
 
     def test_local_workers_get_one_blas_thread_unless_the_environment_says(self):
+        """The OpenBLAS of numpy in a worker uses one thread, or the count the environment names in
+        any of the variables (here OMP_NUM_THREADS, which OpenBLAS falls back on); the parent's
+        environment is left as it was."""
         names = battery.BLAS_THREADS
         jobs = [Job("threads", BlasThreads, {})]
         with mock.patch.dict(os.environ):
             for name in names:
                 os.environ.pop(name, None)
-            ran = RunBattery(jobs, self.folder / "one", workers=1, progress=False)
-            self.assertEqual(ran["threads"], dict.fromkeys(names, "1"))
-            self.assertFalse(set(names) & set(os.environ))  # (the parent's as it was)
-            os.environ["OPENBLAS_NUM_THREADS"] = "2"
-            ran = RunBattery(jobs, self.folder / "two", workers=1, progress=False)
-            self.assertEqual(ran["threads"]["OPENBLAS_NUM_THREADS"], "2")
-            self.assertEqual(ran["threads"]["OMP_NUM_THREADS"], "1")
+            ran = RunBattery(jobs, self.folder / "one", workers=1, progress=False)["threads"]
+            self.assertEqual(ran, dict(dict.fromkeys(names, "1"), openblas=1))
+            self.assertFalse(set(names) & set(os.environ))
+            os.environ["OMP_NUM_THREADS"] = "2"
+            ran = RunBattery(jobs, self.folder / "two", workers=1, progress=False)["threads"]
+            self.assertEqual(ran, dict(dict.fromkeys(names), OMP_NUM_THREADS="2", openblas=2))
+            self.assertEqual(os.environ["OMP_NUM_THREADS"], "2")
 
     def test_bad_jobs_are_refused(self):
         with self.assertRaisesRegex(TypeError, "job 'local'"):

@@ -38,7 +38,7 @@ Per run, at the end:
 Maintained minus fixed on each space, and the roadmap, fixed and maintained, minus the fixed
 rank-4 lattice, are compared paired by seed in two families, each Holm-corrected over its
 comparisons: what was learned (coverage, dispersion, prediction error, state-actions tried; the
-shares' differences in percentage points, dispersion's in hundredths of range) and what it cost
+shares' differences in percentage points, dispersion's in thousandths of range) and what it cost
 (robot seconds per action, wall seconds per run). No round is made at the run's last action count
 (``MaintenanceConfig.until``): the measures see the space the agent explored in its last
 ``--every`` actions, not one just reshaped. The command, its figures and the battery's stages are
@@ -201,10 +201,10 @@ def AdaptiveSpaceJob(
 
 # What a run learned, and what it cost: each a family of comparisons of its own. The shares'
 # differences in percentage points; dispersion's (a distance in the joints' fractions of range,
-# the table's unit) in hundredths of it.
+# the table's unit) in thousandths of it (the maintained lattices' differ by a few).
 _MEASURES = {
     "coverage (percentage points)": lambda r: 100 * r.coverage,
-    "dispersion (hundredths of range)": lambda r: 100 * r.dispersion,
+    "dispersion (thousandths of range)": lambda r: 1000 * r.dispersion,
     "prediction error (percentage points)": lambda r: 100 * r.prediction_error,
     "state-actions tried (percentage points)": lambda r: 100 * r.tried_share,
 }

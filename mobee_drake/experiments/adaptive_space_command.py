@@ -146,13 +146,11 @@ def _Parser() -> CommandParser:
     parser.add_argument(
         "--output", help="the battery folder (results/adaptive_space[_reaching] by default)"
     )
+    parser.add_argument("--doc", help="a doc whose generated block (--doc-table) gets the report")
     parser.add_argument(
-        "--doc",
-        help="a doc whose generated block 'adaptive-space' ('adaptive-space-reaching') gets "
-        "the report",
-    )
-    parser.add_argument(
-        "--doc-block", help="the generated block of --doc that gets the report, if another"
+        "--doc-table",
+        help="the name of --doc's generated block (by default 'adaptive-space', with --part "
+        "reaching 'adaptive-space-reaching'; another for a side battery's report)",
     )
     parser.add_argument(
         "--report-only",
@@ -386,7 +384,9 @@ def KeptReport(command: str, root: pathlib.Path) -> str:
 def main(argv: list[str] | None = None) -> None:
     parser = _Parser()
     args = parser.parse_args(argv)
-    block = args.doc_block or _BLOCKS[args.part]
+    if args.doc_table and not args.doc:
+        parser.error("--doc-table: no --doc to write it in")
+    block = args.doc_table or _BLOCKS[args.part]
     CheckDocBlocks(parser, args.doc, block)
     maintenance = _Maintenance(parser, args)
     output = _Output(args)

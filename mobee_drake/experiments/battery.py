@@ -43,7 +43,7 @@ parent keeps submitted):
   starts itself are the job's to tie to its own life). A worker that dies (say, at the hands of the
   OOM killer) breaks the pool: the battery stops with :class:`BatteryError`, and running it again
   resumes. The workers are the battery's parallelism, so each gets one BLAS thread
-  (:data:`BLAS_THREADS`, unless the command's environment sets them): OpenBLAS threads a product
+  (:data:`BLAS_THREADS`, unless the command's environment names a count): OpenBLAS threads a product
   above a size (a 256-state roadmap's model of 2028 state-actions is above it, the rank-4 lattice's
   of 1536 below), and on cores the other workers keep busy its threads wait for one another (the
   roadmap's runs of the curious agent took several times the lattice's wall time:
@@ -270,22 +270,27 @@ def DieWithParent(parent: int) -> None:
             os._exit(1)
 
 
-# The thread counts of the BLAS libraries numpy and scipy may load, set to 1 in the local
-# workers' environment unless set already (a library reads its count when it loads).
+# The thread counts of the BLAS libraries numpy and scipy may load (a library reads its count
+# when it loads; OpenBLAS and MKL fall back on OMP_NUM_THREADS).
 BLAS_THREADS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 
 
 @contextlib.contextmanager
 def _OneBlasThread():
-    """Within it, the processes this one starts get one BLAS thread (:data:`BLAS_THREADS`)
-    unless its environment names their count; on leaving, the environment is as it was."""
-    unset = [name for name in BLAS_THREADS if name not in os.environ]
-    os.environ.update(dict.fromkeys(unset, "1"))
+    """Within it, the processes this one starts get one BLAS thread, unless its environment
+    names a count in any of :data:`BLAS_THREADS` (then all are left as they are); on leaving,
+    the environment is as it was."""
+    saved = {name: os.environ.get(name) for name in BLAS_THREADS}
+    if not any(saved.values()):
+        os.environ.update(dict.fromkeys(BLAS_THREADS, "1"))
     try:
         yield
     finally:
-        for name in unset:
-            os.environ.pop(name, None)
+        for name, value in saved.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
 
 
 def _DieWithParent(parent: int) -> None:
