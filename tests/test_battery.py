@@ -6,6 +6,7 @@ import argparse
 import contextlib
 import importlib.util
 import io
+import json
 import os
 import pathlib
 import re
@@ -23,6 +24,7 @@ import zipfile
 from battery_jobs import BlasThreads, Count, DefaultSigint, FullDisk, Nan, Walk
 import numpy as np
 
+from mobee_drake import __version__
 from mobee_drake.experiments import battery, saggriac
 from mobee_drake.experiments.battery import (
     RAY_MISSING,
@@ -84,6 +86,24 @@ class LocalBatteryTest(TemporaryFolder):
         self.assertEqual(len(Calls(calls)), 3)
         RunBattery(Counts(calls, 4), output, backend=InProcess(), progress=False)
         self.assertEqual(sorted(Calls(calls)), ["count0", "count1", "count2", "count3"])
+
+    def test_each_sitting_that_runs_jobs_records_its_code_and_backend(self):
+        output, calls = self.folder / "out", self.folder / "calls"
+        with mock.patch.dict(os.environ, OMP_NUM_THREADS="3"):
+            RunBattery(Counts(calls, 2), output, workers=2, progress=False)
+        RunBattery(Counts(calls, 2), output, progress=False)  # (nothing to run: no sitting)
+        RunBattery(Counts(calls, 3), output, backend=InProcess(), progress=False)
+        sittings = [json.loads(line) for line in (output / battery.SESSIONS).open()]
+        self.assertEqual(len(sittings), 2)
+        git = ["git", "-C", str(ROOT), "rev-parse", "HEAD"]
+        head = subprocess.run(git, capture_output=True, text=True, check=True).stdout.strip()
+        for sitting in sittings:
+            self.assertEqual((sitting["version"], sitting["commit"]), (__version__, head))
+            self.assertIsInstance(sitting["changed"], bool)
+            self.assertRegex(sitting["began"], r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ$")
+        self.assertEqual(sittings[0]["backend"], "LocalProcesses(workers=2)")
+        self.assertEqual(sittings[0]["blas_environment"]["OMP_NUM_THREADS"], "3")
+        self.assertEqual(sittings[1]["backend"], "InProcess()")
 
     def test_finished_results_run_nothing_and_refuse_other_arguments(self):
         output, calls = self.folder / "out", self.folder / "calls"

@@ -16,6 +16,10 @@ A battery is a list of jobs (:class:`Job`), each a module-level function called 
 - ``runs/<name>/progress.json``: the last count the job gave :meth:`RunFolder.Progress`, from
   which the parent draws the run's bar (a battery bar counts the runs, a bar per running job
   counts its units; the parent reads the records every :data:`POLL_SECONDS`).
+- ``sessions.jsonl`` (beside ``runs/``): a line per sitting that ran jobs (:data:`SESSIONS`):
+  when it began, the package's version, the git commit its files were imported from and whether
+  they differed from it, the backend and the BLAS variables, so that a kept battery says what
+  code made it.
 - anything else in ``runs/<name>/``: the job's own checkpoints. A job that saves its whole state
   there (atomically, see :mod:`mobee_drake.atomic_files`) and starts from it when it finds one
   resumes exactly after a kill, on either backend.
@@ -269,6 +273,9 @@ def DieWithParent(parent: int) -> None:
         if os.getppid() != parent:  # The parent died before the prctl.
             os._exit(1)
 
+
+# Each sitting of a battery (a call that runs jobs) as a line of JSON in its folder.
+SESSIONS = "sessions.jsonl"
 
 # The thread counts of the BLAS libraries numpy and scipy may load (a library reads its count
 # when it loads; OpenBLAS and MKL fall back on OMP_NUM_THREADS).
@@ -616,6 +623,43 @@ def _RefuseOtherArguments(jobs: list[Job], output: pathlib.Path) -> None:
         )
 
 
+def _SourceCommit() -> dict:
+    """The git commit this package's files were imported from (``commit``) and whether they
+    differ from it (``changed``); both None when they are not a git checkout's (an installed
+    wheel, say) or git cannot tell."""
+    package = pathlib.Path(__file__).resolve().parents[1]
+
+    def Git(*arguments: str) -> str | None:
+        try:
+            done = subprocess.run(["git", "-C", str(package), *arguments], capture_output=True,
+                                  text=True, timeout=30)  # fmt: skip
+        except (OSError, subprocess.TimeoutExpired):
+            return None
+        return done.stdout if done.returncode == 0 else None
+
+    if not Git("ls-files", "--", "__init__.py"):  # (not tracked: not a checkout's files)
+        return dict(commit=None, changed=None)
+    commit, status = Git("rev-parse", "HEAD"), Git("status", "--porcelain", "--", ".")
+    return dict(
+        commit=commit and commit.strip(), changed=None if status is None else bool(status.strip())
+    )
+
+
+def _RecordSession(output: pathlib.Path, backend: Backend) -> None:
+    """Appends to ``output``'s :data:`SESSIONS` a line on this sitting of the battery: when it
+    began, the package's version and source commit, the backend and the BLAS variables of the
+    environment (the workers' thread counts follow from them, see the module)."""
+    record = dict(
+        began=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+        version=__version__,
+        **_SourceCommit(),
+        backend=repr(backend),
+        blas_environment={name: os.environ.get(name) for name in BLAS_THREADS},
+    )
+    with open(output / SESSIONS, "a") as stream:
+        stream.write(StrictJson(record) + "\n")
+
+
 def _RunJobs(
     jobs: list[Job], output: pathlib.Path, backend: Backend, progress: bool, description: str
 ) -> dict[str, dict]:
@@ -627,6 +671,7 @@ def _RunJobs(
     # Records of an interrupted battery would show bars for jobs not yet started.
     for job in queue:
         (output / "runs" / job.name / PROGRESS).unlink(missing_ok=True)
+    _RecordSession(output, backend)
     errors = {}
     display = _Display(output, len(jobs), len(jobs) - len(queue), description, progress)
     try:
