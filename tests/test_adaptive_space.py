@@ -172,6 +172,15 @@ class TestSmokeBattery(FigureTest):
         self.assertIn("error: --rules develop: the exploration part's agent", stderr.getvalue())
         self.assertFalse(self.output.exists())
 
+    def test_a_join_within_below_the_actions_ends_is_refused(self):
+        stderr = io.StringIO()
+        with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit) as exit:
+            adaptive_space_command.main(
+                ["--join-within", "0.4", "--report-only", "--output", str(self.output)]
+            )
+        self.assertEqual(exit.exception.code, 2)
+        self.assertIn("error: maintenance: join_within must be >= 0.5", stderr.getvalue())
+
     def test_a_doc_table_without_a_doc_is_refused(self):
         stderr = io.StringIO()
         with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit) as exit:

@@ -195,6 +195,18 @@ class LocalBatteryTest(TemporaryFolder):
             self.assertEqual(ran, dict(dict.fromkeys(names), OMP_NUM_THREADS="2", openblas=2))
             self.assertEqual(os.environ["OMP_NUM_THREADS"], "2")
 
+    def test_a_later_field_at_its_value_is_not_recorded(self):
+        """A kept battery's recorded arguments still match after a field is added to a
+        settings dataclass, as long as it keeps the value the battery ran with."""
+        from mobee_drake.planning.space_maintenance import MaintenanceConfig
+
+        def Recorded(config):
+            return json.loads(battery._ArgumentsText(Job("j", Count, dict(m=config))))["m"]
+
+        self.assertNotIn("join_within", Recorded(MaintenanceConfig())["MaintenanceConfig"])
+        local = Recorded(MaintenanceConfig(join_within=0.5))["MaintenanceConfig"]
+        self.assertEqual(local["join_within"], 0.5)
+
     def test_bad_jobs_are_refused(self):
         with self.assertRaisesRegex(TypeError, "job 'local'"):
             Job("local", lambda run: {})

@@ -248,6 +248,11 @@ class TestTheRules(unittest.TestCase):
         self.assertIsNone(
             Maintenance(MaintenanceConfig(rules=["develop"]), 4).Plan(Explorer(SQUARE), 3, 10)
         )  # (nothing favoured, nothing developed)
+        # Joined within half a side (the action's ends): not to each other, 0.35 apart.
+        local = Maintenance(MaintenanceConfig(rules=["develop"], join_within=0.5), 4)
+        edit = local.Plan(Explorer(SQUARE), 3, 10, favoured=[0])
+        pairs = set(zip(edit.space.action_state.tolist(), edit.space.action_goal.tolist()))
+        self.assertEqual(pairs, old | new - {(4, 5), (5, 4)})
 
     def test_settings_are_checked(self):
         with self.assertRaisesRegex(ValueError, "unknown rule 'trim'"):
@@ -262,6 +267,8 @@ class TestTheRules(unittest.TestCase):
             Maintenance(MaintenanceConfig(until=-1), 4)
         with self.assertRaisesRegex(ValueError, "develop_min_targets must be >= 1"):
             Maintenance(MaintenanceConfig(develop_min_targets=0), 4)
+        with self.assertRaisesRegex(ValueError, r"join_within must be >= 0.5 .*got 0.4"):
+            Maintenance(MaintenanceConfig(join_within=0.4), 4)
 
     def test_a_dropped_transition_never_comes_back_as_a_shortcut(self):
         """On a line 0 - 1 - 2 with a direct 0 -> 2: 0 -> 2 missed 5 of 5 and is dropped; the

@@ -95,6 +95,13 @@ def _AddMaintenanceArguments(maintenance) -> None:
         default=None,
         help="the space grows while it has fewer states than this (default: no limit)",
     )
+    maintenance.add_argument(
+        "--join-within",
+        type=PositiveFloat,
+        default=MaintenanceConfig().join_within,
+        help="grow, develop: a new state is joined to every state within this share of the "
+        "length of the action it grew from (at least 0.5, the action's ends)",
+    )
 
 
 def _Parser() -> CommandParser:
@@ -356,13 +363,17 @@ def _Maintenance(parser, args) -> MaintenanceConfig:
             "--rules develop: the exploration part's agent favours no states "
             "(the rule is the reach learner's: --part reaching)"
         )
-    return MaintenanceConfig(
+    config = MaintenanceConfig(
         every=args.every,
         rules=list(rules),
         prune_after=args.prune_after,
         develop_min_targets=args.develop_min_targets,
         max_states=args.max_states or 0,
+        join_within=args.join_within,
     )
+    for error in config.Errors():
+        parser.error(f"maintenance: {error}")
+    return config
 
 
 def _Output(args) -> pathlib.Path:

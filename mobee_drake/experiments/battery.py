@@ -562,9 +562,15 @@ def RunBattery(
 
 
 def _Plain(value):
-    """JSON for what a job's arguments hold besides JSON's own types."""
+    """JSON for what a job's arguments hold besides JSON's own types. A dataclass's fields
+    named in its ``LATER_FIELDS`` (name: value) are left out at those values: fields added
+    after batteries were kept, whose recorded arguments must still match."""
     if dataclasses.is_dataclass(value):
-        return {type(value).__name__: dataclasses.asdict(value)}
+        fields = dataclasses.asdict(value)
+        for name, default in getattr(value, "LATER_FIELDS", {}).items():
+            if fields[name] == default:
+                del fields[name]
+        return {type(value).__name__: fields}
     if hasattr(value, "tolist"):
         return value.tolist()
     return str(value)

@@ -24,9 +24,13 @@ The rules (:class:`MaintenanceConfig` holds their parameters):
   from where the first did), an action from the first straight to the third is added, unless
   ``drop`` removed that transition before (no shortcut brings a dropped transition back).
 - ``grow``: halfway between a state pruned in this round and each state that had an action into
-  it, a new state, joined both ways to every state within that action's length of it: the
-  boundary of the reachable region is probed more finely, down to ``min_spacing``, never back
-  where a state was pruned, and while the space has fewer than ``max_states`` states.
+  it, a new state, joined both ways to every state within ``join_within`` times that action's
+  length of it: the boundary of the reachable region is probed more finely, down to
+  ``min_spacing``, never back where a state was pruned, and while the space has fewer than
+  ``max_states`` states. (The source does not say how a new state is linked. The default, 1,
+  joins it on a lattice to the action's two ends and the new states beside it, but on a roadmap
+  of long edges to every state as near as the edge is long, which can make the roadmap dense:
+  docs/adaptive_space.md. 0.5 joins it only to the states no farther than the action's ends.)
 - ``develop``: the same halfway between each state the learner favours (it names them, e.g. the
   reach learner's states whose reaches worked best for many targets, ch. 9.4.5) and each of its
   neighbours: the regions that matter get more states.
@@ -36,6 +40,7 @@ import collections
 from collections.abc import Iterable
 import copy
 import dataclasses as dc
+from typing import ClassVar
 
 import numpy as np
 
@@ -71,6 +76,13 @@ class MaintenanceConfig:
     min_spacing: float = 0.05
     # The space grows while it has fewer states than this (0: no limit).
     max_states: int = 0
+    # grow, develop: a new state is joined both ways to every state within this share of the
+    # length of the action it grew from (at least 0.5, the distance to that action's ends).
+    join_within: float = 1.0
+
+    # Fields added after batteries that record these settings were kept: left out of a job's
+    # recorded arguments at these values (experiments.battery).
+    LATER_FIELDS: ClassVar[dict] = {"join_within": 1.0}
     # No round at or after this many actions (0: no such limit): a run that ends there is
     # measured on the space it explored, not on one just reshaped.
     until: int = 0
@@ -98,6 +110,8 @@ class MaintenanceConfig:
             errors.append(f"drop_miss_share must be in (0, 1], got {self.drop_miss_share}")
         if not self.min_spacing > 0:
             errors.append(f"min_spacing must be > 0, got {self.min_spacing}")
+        if not self.join_within >= 0.5:
+            errors.append(f"join_within must be >= 0.5 (the action's ends), got {self.join_within}")
         return errors
 
 
@@ -247,7 +261,7 @@ class Maintenance:
                 drop_states=pruned,
                 drop_actions=[_ActionOf(space, *c.states) for c in changes if c.rule == "drop"],
                 new_centres=[c.centre for c in changes if c.rule in _NEW_STATES],
-                new_actions=_NewActions(space, changes),
+                new_actions=_NewActions(space, changes, self.config.join_within),
             )
             kept = np.flatnonzero(edit.state_index >= 0)
             actions_out = np.bincount(edit.space.action_state, minlength=edit.space.num_states)
@@ -466,16 +480,18 @@ def _Halfway(
     return made
 
 
-def _NewActions(space: StateActionSpace, changes: list[SpaceChange]) -> list[tuple[int, int]]:
+def _NewActions(
+    space: StateActionSpace, changes: list[SpaceChange], join_within: float
+) -> list[tuple[int, int]]:
     """The shortcuts, and each new state joined both ways to every state (old or new) within
-    the length of the action it grew from."""
+    ``join_within`` times the length of the action it grew from."""
     pairs = [c.states for c in changes if c.rule == "shortcut"]
     grown = [c for c in changes if c.rule in _NEW_STATES]
     centres = np.vstack([space.centres] + [[c.centre] for c in grown])
     for i, change in enumerate(grown):
         new = space.num_states + i
         u, r = change.states
-        reach = np.linalg.norm(space.centres[u] - space.centres[r]) + 1e-9
+        reach = join_within * np.linalg.norm(space.centres[u] - space.centres[r]) + 1e-9
         near = np.flatnonzero(np.linalg.norm(centres - centres[new], axis=1) <= reach)
         pairs += [(new, int(o)) for o in near if o != new] + [(int(o), new) for o in near]
     return pairs
