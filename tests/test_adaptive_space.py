@@ -161,35 +161,27 @@ class TestSmokeBattery(FigureTest):
         self.output = pathlib.Path(tempfile.mkdtemp()) / "adaptive"
         self.addCleanup(shutil.rmtree, self.output.parent)
 
-    def test_the_exploration_part_refuses_develop(self):
-        """Its agent favours no states: ``develop`` would do nothing (exit code 2, one line)."""
+    def _AssertRefused(self, arguments: list[str], message: str) -> None:
+        """The command refuses ``arguments`` in one line with exit code 2, before it makes its
+        folder."""
         stderr = io.StringIO()
         with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit) as exit:
-            adaptive_space_command.main(
-                ["--rules", "prune", "develop", "--report-only", "--output", str(self.output)]
-            )
+            adaptive_space_command.main([*arguments, "--report-only", "--output", str(self.output)])
         self.assertEqual(exit.exception.code, 2)
-        self.assertIn("error: --rules develop: the exploration part's agent", stderr.getvalue())
+        self.assertIn(f"error: {message}", stderr.getvalue())
         self.assertFalse(self.output.exists())
+
+    def test_the_exploration_part_refuses_develop(self):
+        """Its agent favours no states: ``develop`` would do nothing."""
+        self._AssertRefused(
+            ["--rules", "prune", "develop"], "--rules develop: the exploration part's agent"
+        )
 
     def test_a_join_within_below_the_actions_ends_is_refused(self):
-        stderr = io.StringIO()
-        with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit) as exit:
-            adaptive_space_command.main(
-                ["--join-within", "0.4", "--report-only", "--output", str(self.output)]
-            )
-        self.assertEqual(exit.exception.code, 2)
-        self.assertIn("error: maintenance: join_within must be >= 0.5", stderr.getvalue())
+        self._AssertRefused(["--join-within", "0.4"], "maintenance: join_within must be >= 0.5")
 
     def test_a_doc_table_without_a_doc_is_refused(self):
-        stderr = io.StringIO()
-        with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit) as exit:
-            adaptive_space_command.main(
-                ["--doc-table", "other", "--report-only", "--output", str(self.output)]
-            )
-        self.assertEqual(exit.exception.code, 2)
-        self.assertIn("error: --doc-table: no --doc to write it in", stderr.getvalue())
-        self.assertFalse(self.output.exists())
+        self._AssertRefused(["--doc-table", "other"], "--doc-table: no --doc to write it in")
 
     def test_the_smoke_battery(self):
         """2 seeds x 30 actions on the rank-4 lattice and on a roadmap of 12 states, on both
