@@ -79,13 +79,13 @@ class MaintenanceConfig:
     # grow, develop: a new state is joined both ways to every state within this share of the
     # length of the action it grew from (at least 0.5, the distance to that action's ends).
     join_within: float = 1.0
+    # No round at or after this many actions (0: no such limit): a run that ends there is
+    # measured on the space it explored, not on one just reshaped.
+    until: int = 0
 
     # Fields added after batteries that record these settings were kept: left out of a job's
     # recorded arguments at these values (experiments.battery).
     LATER_FIELDS: ClassVar[dict] = {"join_within": 1.0}
-    # No round at or after this many actions (0: no such limit): a run that ends there is
-    # measured on the space it explored, not on one just reshaped.
-    until: int = 0
 
     def Errors(self) -> list[str]:
         """What is wrong with the settings that their types cannot say (empty: nothing)."""
