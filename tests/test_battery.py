@@ -104,6 +104,17 @@ class LocalBatteryTest(TemporaryFolder):
         self.assertEqual(sittings[0]["backend"], "LocalProcesses(workers=2)")
         self.assertEqual(sittings[0]["blas_environment"]["OMP_NUM_THREADS"], "3")
         self.assertEqual(sittings[1]["backend"], "InProcess()")
+        # Files that are not a checkout's (an installed copy, even inside a repository, as a
+        # venv's may be): no commit claimed.
+        repository = self.folder / "repository"
+        copy = repository / "venv" / "mobee_drake" / "experiments"
+        copy.mkdir(parents=True)
+        (repository / "README").write_text("a repository of other files\n")
+        for command in (["init", "-q"], ["add", "README"], ["commit", "-q", "-m", "other"]):
+            subprocess.run(["git", "-C", str(repository), "-c", "user.name=t", "-c",
+                            "user.email=t@t", *command], check=True)  # fmt: skip
+        with mock.patch.object(battery, "__file__", str(copy / "battery.py")):
+            self.assertEqual(battery._SourceCommit(), dict(commit=None, changed=None))
 
     def test_finished_results_run_nothing_and_refuse_other_arguments(self):
         output, calls = self.folder / "out", self.folder / "calls"

@@ -564,7 +564,8 @@ def RunBattery(
 def _Plain(value):
     """JSON for what a job's arguments hold besides JSON's own types. A dataclass's fields
     named in its ``LATER_FIELDS`` (name: value) are left out at those values: fields added
-    after batteries were kept, whose recorded arguments must still match."""
+    after batteries were kept, whose recorded arguments must still match (of a dataclass that
+    is itself an argument: ``asdict`` writes those nested in it whole)."""
     if dataclasses.is_dataclass(value):
         fields = dataclasses.asdict(value)
         for name, default in getattr(value, "LATER_FIELDS", {}).items():
@@ -630,22 +631,26 @@ def _RefuseOtherArguments(jobs: list[Job], output: pathlib.Path) -> None:
 
 
 def _SourceCommit() -> dict:
-    """The git commit this package's files were imported from (``commit``) and whether they
-    differ from it (``changed``); both None when they are not a git checkout's (an installed
-    wheel, say) or git cannot tell."""
+    """The git commit this package's files were imported from (``commit``) and whether they,
+    or the models and diagrams the package ships from beside it, differ from it (``changed``);
+    both None when they are not a git checkout's (an installed wheel, say) or git cannot
+    tell."""
     package = pathlib.Path(__file__).resolve().parents[1]
 
     def Git(*arguments: str) -> str | None:
         try:
-            done = subprocess.run(["git", "-C", str(package), *arguments], capture_output=True,
-                                  text=True, timeout=30)  # fmt: skip
+            done = subprocess.run(
+                ["git", "--no-optional-locks", "-C", str(package), *arguments],
+                capture_output=True, text=True, timeout=30,
+            )  # fmt: skip
         except (OSError, subprocess.TimeoutExpired):
             return None
         return done.stdout if done.returncode == 0 else None
 
     if not Git("ls-files", "--", "__init__.py"):  # (not tracked: not a checkout's files)
         return dict(commit=None, changed=None)
-    commit, status = Git("rev-parse", "HEAD"), Git("status", "--porcelain", "--", ".")
+    shipped = (".", "../models", "../diagrams")  # (pyproject.toml's package data)
+    commit, status = Git("rev-parse", "HEAD"), Git("status", "--porcelain", "--", *shipped)
     return dict(
         commit=commit and commit.strip(), changed=None if status is None else bool(status.strip())
     )
@@ -662,8 +667,11 @@ def _RecordSession(output: pathlib.Path, backend: Backend) -> None:
         backend=repr(backend),
         blas_environment={name: os.environ.get(name) for name in BLAS_THREADS},
     )
-    with open(output / SESSIONS, "a") as stream:
-        stream.write(StrictJson(record) + "\n")
+    try:
+        with open(output / SESSIONS, "a") as stream:
+            stream.write(StrictJson(record) + "\n")
+    except OSError as error:  # (a full disk's error names no file)
+        raise OSError(error.errno, error.strerror, str(output / SESSIONS)) from None
 
 
 def _RunJobs(
@@ -677,11 +685,11 @@ def _RunJobs(
     # Records of an interrupted battery would show bars for jobs not yet started.
     for job in queue:
         (output / "runs" / job.name / PROGRESS).unlink(missing_ok=True)
-    _RecordSession(output, backend)
     errors = {}
     display = _Display(output, len(jobs), len(jobs) - len(queue), description, progress)
     try:
         with TerminationInterrupts(), backend.Session() as submit:
+            _RecordSession(output, backend)
             running = {}
             while queue or running:
                 while queue and len(running) < backend.capacity:

@@ -28,9 +28,11 @@ The rules (:class:`MaintenanceConfig` holds their parameters):
   length of it: the boundary of the reachable region is probed more finely, down to
   ``min_spacing``, never back where a state was pruned, and while the space has fewer than
   ``max_states`` states. (The source does not say how a new state is linked. The default, 1,
-  joins it on a lattice to the action's two ends and the new states beside it, but on a roadmap
-  of long edges to every state as near as the edge is long, which can make the roadmap dense:
-  docs/adaptive_space.md. 0.5 joins it only to the states no farther than the action's ends.)
+  joins it on a lattice to the action's two ends and to the round's other new states within
+  that length, the one across the favoured or pruned state included; on a roadmap of long
+  edges to every state as near as the edge is long, which can make the roadmap dense:
+  docs/adaptive_space.md. 0.5 joins it only to the states no farther than the action's ends: a
+  state grown toward a pruned one, to the end that stays.)
 - ``develop``: the same halfway between each state the learner favours (it names them, e.g. the
   reach learner's states whose reaches worked best for many targets, ch. 9.4.5) and each of its
   neighbours: the regions that matter get more states.
@@ -40,6 +42,7 @@ import collections
 from collections.abc import Iterable
 import copy
 import dataclasses as dc
+import math
 from typing import ClassVar
 
 import numpy as np
@@ -110,8 +113,10 @@ class MaintenanceConfig:
             errors.append(f"drop_miss_share must be in (0, 1], got {self.drop_miss_share}")
         if not self.min_spacing > 0:
             errors.append(f"min_spacing must be > 0, got {self.min_spacing}")
-        if not self.join_within >= 0.5:
-            errors.append(f"join_within must be >= 0.5 (the action's ends), got {self.join_within}")
+        if not 0.5 <= self.join_within < math.inf:
+            errors.append(
+                f"join_within must be >= 0.5 (the action's ends) and finite, got {self.join_within}"
+            )
         return errors
 
 
