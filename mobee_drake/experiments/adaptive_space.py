@@ -81,7 +81,6 @@ from mobee_drake.planning.supervisor import ExploringAgent, SavedMaintenance, Sa
 # battery.
 LATTICES = {"rank4": [0.125, 0.375, 0.625, 0.875], "rank3": [0.25, 0.5, 0.75]}
 SPACES = (*LATTICES, "trm")
-CONDITIONS = ("fixed", "maintained")
 AGENT = "right_arm"
 
 

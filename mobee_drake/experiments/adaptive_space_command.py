@@ -25,7 +25,6 @@ from mobee_drake.atomic_files import CurrentGeneration
 from mobee_drake.experiments import adaptive_space_reaching as reaching_part
 from mobee_drake.experiments.adaptive_space import (
     AGENT,
-    CONDITIONS,
     LATTICES,
     SETTING,
     SPACES,
@@ -35,7 +34,7 @@ from mobee_drake.experiments.adaptive_space import (
     Report,
 )
 from mobee_drake.experiments.adaptive_space_figures import History, WriteSpaceFigures
-from mobee_drake.experiments.adaptive_space_report import BySetting
+from mobee_drake.experiments.adaptive_space_report import CONDITIONS, BySetting
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat, PositiveInt
 from mobee_drake.experiments.arms import (
     Arm,

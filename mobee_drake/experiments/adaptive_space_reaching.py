@@ -30,6 +30,7 @@ import dataclasses as dc
 import numpy as np
 
 from mobee_drake.experiments.adaptive_space_report import (
+    CONDITIONS,
     BySetting,
     ChangesCell,
     NearnessLines,
@@ -53,7 +54,6 @@ from mobee_drake.planning.space_maintenance import RULES, MaintenanceConfig
 from mobee_drake.planning.state_space import Lattice
 
 STRATEGIES = ("greedy", "intrinsic", "random")
-CONDITIONS = ("fixed", "maintained")
 MDP_TRIES = 5
 # The spaces a run starts on: ch. 8's rank-3 lattice, and "trm", a roadmap over the arm's valid
 # configurations with at most the lattice's number of states (built by the battery's job

@@ -10,6 +10,9 @@ import numpy as np
 from mobee_drake.experiments.statistics import PairedBySeed
 from mobee_drake.planning.space_maintenance import RULES
 
+# Each space as it began, and the same maintained by the rules (both parts' runs).
+CONDITIONS = ("fixed", "maintained")
+
 
 def BySetting(runs: Iterable, fields: tuple[str, ...]) -> dict[tuple, list]:
     """The runs by their values of ``fields`` (the last the condition), sorted; each group in
