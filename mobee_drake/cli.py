@@ -275,6 +275,7 @@ _BENCHMARKS = {
     "reactive": ("bench_reactive", "MoBeE 2.0 against Drake's differential IK as reactive control"),
     "safety": ("bench_safety", "whether a client can push the robot through an obstacle"),
     "simulation": ("bench_simulation", "real-time factor and safety, kinematic and dynamic robot"),
+    "values": ("bench_values", "the reach learner's value iteration, T sparse against dense"),
     "viewer": ("bench_viewer", "Meshcat in a real browser: sizes, stream, slider latency"),
 }
 _EXPERIMENTS = {

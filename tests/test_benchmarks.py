@@ -5,7 +5,7 @@ import unittest
 
 import numpy as np
 
-from mobee_drake.experiments import bench_objects
+from mobee_drake.experiments import bench_objects, bench_values
 from mobee_drake.experiments.bench_forces import STAGES, MeasureForceEvaluations, MeasureStages
 from mobee_drake.experiments.bench_simulation import ControlPeriodAndFloor
 from mobee_drake.scenario import LoadScenario
@@ -64,6 +64,28 @@ class TestObjectCount(unittest.TestCase):
         self.assertTrue(np.isnan(peak) or peak > 0)
         seconds, peak, error = bench_objects.Measure("floor", 100, 8 * 2**30, timeout=0.01)
         self.assertEqual(error, "timed out")
+
+
+class TestValueIteration(unittest.TestCase):
+    def test_sparse_and_dense(self):
+        T, rewards, action_state = bench_values.LearnerModel(6, 40, outcomes=2)
+        # Each transition's row is a distribution over its own state, its goal and what it
+        # observed (at least two states); each state's reach has an empty row.
+        sums = T.sum(axis=1)
+        np.testing.assert_allclose(np.sort(sums), [0.0] * 6 + [1.0] * 40, atol=1e-12)
+        stored = np.diff(T.indptr)
+        self.assertTrue(np.all((stored >= 2) == (sums > 0)))
+        self.assertTrue(np.all(np.diff(action_state) >= 0))  # (value iteration's order)
+        self.assertEqual(len(rewards), 46)
+        row = bench_values.Row(6, 40, outcomes=2, repeats=2).strip("|").split("|")
+        states, transitions, entries, mib, dense, fast, ratio, difference = row
+        self.assertEqual((int(states), int(transitions), int(entries)), (6, 40, T.nnz))
+        self.assertEqual(float(mib), round(46 * 6 * 8 / 2**20, 1))
+        self.assertLess(float(difference), 1e-12)  # (the same values, summed in another order)
+        rounding = 0.005 / float(dense) + 0.005 / float(fast)  # (ms shown to 0.01)
+        self.assertAlmostEqual(
+            float(ratio), float(dense) / float(fast), delta=0.05 + float(ratio) * rounding
+        )
 
 
 if __name__ == "__main__":

@@ -34,6 +34,7 @@ COMMANDS = [
     ["bench", "babbling"],
     ["bench", "safety"],
     ["bench", "objects"],
+    ["bench", "values"],
     ["bench", "viewer"],
 ]
 

@@ -4,8 +4,9 @@ import json
 import unittest
 
 import numpy as np
+from scipy import sparse
 
-from mobee_drake.planning.curiosity import KlDivergence, TransitionCounts
+from mobee_drake.planning.curiosity import KlDivergence, SetProbabilityRow, TransitionCounts
 from mobee_drake.planning.explorers import Explorer, ExplorerConfig
 from mobee_drake.planning.state_space import FromSamples, Lattice
 from mobee_drake.planning.strategies import STRATEGIES, RegisterStrategy
@@ -66,6 +67,21 @@ class TestObserve(unittest.TestCase):
             self.assertEqual(ours, round(KlDivergence(p, t), 4))
 
 
+class TestSparseProbabilities(unittest.TestCase):
+    def test_a_row_set_after_each_observation_is_the_dense_t(self):
+        # Observations that add bins (the row's stored entries grow) and that do not.
+        rng = np.random.default_rng(0)
+        counts = TransitionCounts(30, 12)
+        counts.counts[np.arange(30), rng.integers(12, size=30)] = 2.0
+        T = sparse.csr_array(counts.Probabilities())
+        for _ in range(400):
+            sa = int(rng.integers(30))
+            counts.Observe(sa, int(rng.integers(12)))
+            SetProbabilityRow(T, sa, counts.counts[sa])
+            np.testing.assert_array_equal(T.toarray(), counts.Probabilities())
+        self.assertEqual(T.nnz, np.count_nonzero(counts.counts))
+
+
 class TestStateActionSpaces(unittest.TestCase):
     def test_sizes_of_the_dissertation_spaces(self):
         cases = [
@@ -119,10 +135,11 @@ class TestValueIteration(unittest.TestCase):
         gamma = 0.5
         T = np.array([[1.0, 0.0], [0.5, 0.5], [0.0, 1.0]])
         R = np.array([1.0, 0.0, 2.0])
-        q, v = ValueIteration(T, R, np.array([0, 0, 1]), 2, gamma, delta=1e-12)
         v1 = 2 / (1 - gamma)
         v0 = max(1 / (1 - gamma), 0.5 * gamma * v1 / (1 - 0.5 * gamma))
-        np.testing.assert_allclose(v, [v0, v1], rtol=1e-9)
+        for given in (T, sparse.csr_array(T)):  # (the reach learner's T is sparse)
+            q, v = ValueIteration(given, R, np.array([0, 0, 1]), 2, gamma, delta=1e-12)
+            np.testing.assert_allclose(v, [v0, v1], rtol=1e-9)
 
     def test_stops_at_delta(self):
         T = np.array([[1.0]])

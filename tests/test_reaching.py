@@ -14,6 +14,7 @@ import numpy as np
 
 from mobee_drake.reaching.predictors import (
     FAILED_TRANSITION_REWARD,
+    PREDICTORS,
     ReachReward,
     RewardHistories,
     TransitionReward,
@@ -54,6 +55,19 @@ class TestPredictors(unittest.TestCase):
         targets, estimates, rewards = h.History(0)
         np.testing.assert_array_equal(rewards, [0.0, -10.0])
         self.assertEqual(targets.shape, (2, 3))
+
+    def test_predictions_of_many_are_each_ones(self):
+        from mobee_drake.reaching.predictors import PredictorConfig
+
+        # Empty and recorded histories of transitions and reaches, both predictors.
+        for kind in PREDICTORS:
+            h = RewardHistories([False, True, False, True], PredictorConfig(kind))
+            h.Record(2, [1, 0, 0], 0.0, FAILED_TRANSITION_REWARD)
+            h.Record(3, [0, 1, 0], 0.9, 0.5)
+            target = [0.5, 0.5, 0]
+            each = [h.Predict(sa, target) for sa in range(4)]
+            self.assertEqual(h.PredictEach(range(4), target).tolist(), each)
+            self.assertEqual(each[:2], [0.0, 1.0])
 
     def test_rewards(self):
         self.assertEqual(ReachReward([0, 0, 0], [0, 0, 0]), 1.0)  # eq. 8.4

@@ -11,6 +11,7 @@ yet created: one row changes per observation, and value iteration reads the whol
 """
 
 import numpy as np
+from scipy import sparse
 
 
 def KlDivergence(p_counts, t_counts) -> float:
@@ -41,3 +42,18 @@ class TransitionCounts:
         """T(s, a, s') for every state-action (rows of zeros for state-actions never observed)."""
         totals = self.counts.sum(axis=1, keepdims=True)
         return np.divide(self.counts, totals, out=np.zeros_like(self.counts), where=totals > 0)
+
+
+def SetProbabilityRow(probabilities: sparse.csr_array, row: int, counts: np.ndarray) -> None:
+    """Sets ``row`` of a sparse T to ``counts`` normalised, in place: the entries it stores become
+    the bins of ``counts``, their values those of :meth:`TransitionCounts.Probabilities` (the
+    counts are whole numbers, so their sum does not depend on the order of summation)."""
+    bins = np.flatnonzero(counts)
+    T, start, end = probabilities, probabilities.indptr[row], probabilities.indptr[row + 1]
+    if not np.array_equal(T.indices[start:end], bins):
+        T.indices = np.concatenate([T.indices[:start], bins, T.indices[end:]]).astype(
+            T.indices.dtype
+        )
+        T.data = np.concatenate([T.data[:start], np.zeros(len(bins)), T.data[end:]])
+        T.indptr[row + 1 :] += len(bins) - (end - start)
+    T.data[start : start + len(bins)] = counts[bins] / counts.sum()

@@ -23,7 +23,8 @@ def ValueIteration(
     """Returns ``(V(s, a), V(s))``.
 
     Args:
-        transitions: (n_sa, m) T(s, a, s'), rows summing to 1 (or 0 for untried rows).
+        transitions: (n_sa, m) T(s, a, s'), rows summing to 1 (or 0 for untried rows); an
+            array, or a scipy sparse array where most outcomes were never observed.
         rewards: (n_sa,) R(s, a).
         action_state: (n_sa,) the state of each state-action, sorted.
         num_states: m.

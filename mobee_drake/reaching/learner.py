@@ -63,8 +63,9 @@ import json
 from typing import Protocol
 
 import numpy as np
+from scipy import sparse
 
-from mobee_drake.planning.curiosity import TransitionCounts
+from mobee_drake.planning.curiosity import SetProbabilityRow, TransitionCounts
 from mobee_drake.planning.space_maintenance import SpaceEdit
 from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.planning.value_iteration import ValueIteration
@@ -258,7 +259,6 @@ class ReachLearner:
         # each state-action went.
         self._order = np.argsort(self.action_state, kind="stable")
         self._rank = np.argsort(self._order)
-        self._T_sorted = np.zeros((k + m, m))
         self._RefreshT()
 
     def Reshape(self, edit: SpaceEdit, transition_counts: np.ndarray) -> None:
@@ -314,7 +314,7 @@ class ReachLearner:
         reaches = np.arange(self.num_transitions, self.num_state_actions)
         return np.concatenate(
             [
-                [histories.Predict(sa, target) for sa in range(self.num_transitions)],
+                histories.PredictEach(range(self.num_transitions), target),
                 REACH_STRATEGIES[strategy].ReachRewards(histories, target, reaches, drawn),
             ]
         )
@@ -344,9 +344,20 @@ class ReachLearner:
     # ------------------------------------------------------------------------------------------
     # Acting.
 
-    def _RefreshT(self) -> None:
-        """T of the transitions from the model's counts, in value iteration's order."""
-        self._T_sorted[self._rank[: self.num_transitions]] = self.model.Probabilities()
+    def _RefreshT(self, state_action: int | None = None) -> None:
+        """T from the model's counts in value iteration's order, sparse (a row holds the
+        outcomes its transition observed; a reach's row is empty): every row, or after an
+        observation of ``state_action`` its row alone."""
+        if state_action is not None:
+            SetProbabilityRow(
+                self._T_sorted, self._rank[state_action], self.model.counts[state_action]
+            )
+            return
+        m = self.space.num_states
+        rows = sparse.vstack(
+            [sparse.csr_array(self.model.Probabilities()), sparse.csr_array((m, m))]
+        )
+        self._T_sorted = sparse.csr_array(rows[self._order])
 
     def _Try(
         self,
@@ -384,7 +395,7 @@ class ReachLearner:
                     reward = 0.0
                     if learn:
                         self.model.Observe(sa, outcome)
-                        self._RefreshT()
+                        self._RefreshT(sa)
                 failed += reward < 0
             histories.Record(sa, seen, estimate, reward)
             if failures is not None and not self.reaching[sa] and reward < 0:

@@ -214,8 +214,18 @@ class RewardHistories:
 
     def Predict(self, state_action: int, target) -> float:
         """The expected reward (eq. 8.1 for transitions, 8.5 for reaches)."""
-        prior = 1.0 if self.reaching[state_action] else 0.0
+        prior = float(self.reaching[state_action])  # (eq. 8.5's 1, eq. 8.1's 0)
         return self._Estimate(state_action, target, self._rewards[state_action], prior, False)
+
+    def PredictEach(self, state_actions, target) -> np.ndarray:
+        """:meth:`Predict` of each of ``state_actions``; an empty history predicts its prior
+        without a fit (eq. 8.3: most transitions of a grown space have none)."""
+        return np.array(
+            [
+                self.Predict(sa, target) if len(self._rewards[sa]) else float(self.reaching[sa])
+                for sa in state_actions
+            ]
+        )
 
     def PredictIntrinsic(self, state_action: int, target) -> float:
         """The expected prediction error of a reach (eq. 8.7 over eq. 8.6)."""

@@ -36,7 +36,7 @@ class Greedy:
         return -1
 
     def ReachRewards(self, histories, target, reaches, drawn) -> np.ndarray:
-        return np.array([histories.Predict(sa, target) for sa in reaches])  # eq. 8.5
+        return histories.PredictEach(reaches, target)  # eq. 8.5
 
 
 class Intrinsic(Greedy):
