@@ -7,7 +7,9 @@ divergence D(P || T) of the normalised counts, and keeps P as the new T. Because
 take part, the divergence is always defined ("Kail" divergence, ch. 6.4.3).
 
 The counts live in one dense (state-actions x states) array whose zero entries are the bins not
-yet created: one row changes per observation, and value iteration reads the whole array as T.
+yet created: one row changes per observation, and the curious agent's value iteration reads the
+whole array as T. A learner whose space can grow large (the reach learner's) keeps T sparse and
+sets the changed row with :func:`SetProbabilityRow`.
 """
 
 import numpy as np
