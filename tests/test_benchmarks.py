@@ -77,10 +77,14 @@ class TestValueIteration(unittest.TestCase):
         self.assertTrue(np.all((stored >= 2) == (sums > 0)))
         self.assertTrue(np.all(np.diff(action_state) >= 0))  # (value iteration's order)
         self.assertEqual(len(rewards), 46)
-        row = bench_values.Row(6, 40, outcomes=2, repeats=2).strip("|").split("|")
-        states, transitions, entries, mib, dense, fast, ratio, difference = row
-        self.assertEqual((int(states), int(transitions), int(entries)), (6, 40, T.nnz))
-        self.assertEqual(float(mib), round(46 * 6 * 8 / 2**20, 1))
+        self.assertEqual(T.nnz, np.count_nonzero(T.toarray()))
+        # A model whose dense T is about 1.6 MiB (2100 state-actions x 100 states x 8 bytes).
+        row = bench_values.Row(100, 2000, outcomes=1, repeats=2).strip("|").split("|")
+        cells = [cell.replace(",", "") for cell in row]  # (thousands separated)
+        states, transitions, entries, mib, dense, fast, ratio, difference = cells
+        big, _, _ = bench_values.LearnerModel(100, 2000, outcomes=1)
+        self.assertEqual((int(states), int(transitions), int(entries)), (100, 2000, big.nnz))
+        self.assertEqual(float(mib), round(2100 * 100 * 8 / 2**20, 1))
         self.assertLess(float(difference), 1e-12)  # (the same values, summed in another order)
         rounding = 0.005 / float(dense) + 0.005 / float(fast)  # (ms shown to 0.01)
         self.assertAlmostEqual(

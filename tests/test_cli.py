@@ -132,6 +132,8 @@ class TestMistakes(unittest.TestCase):
             (["run", "reach_around_ball", "--record", ""], "--record: must be a non-empty path"),
             (["run", "reach_around_ball", "--checkpoint", ""], "--checkpoint: must be a non-empty"),
             (["bench", "forces", "--amplitude", "5"], "--amplitude: must be a number in (0, 1]"),
+            (["bench", "values", "--sizes", "81x0"], "'81x0' is not STATESxTRANSITIONS"),
+            (["bench", "values", "--sizes", "81"], "'81' is not STATESxTRANSITIONS"),
             (["experiment", "ch8", "--stages", "2", "2"], "--stages must differ from each other"),
             # Issue 31, item 8: bench simulation's values ended in tracebacks.
             (["bench", "simulation", "--seconds", "0.5"], "--seconds: the timing leaves out"),
@@ -220,6 +222,7 @@ class TestMistakes(unittest.TestCase):
             (["bench", "objects"], "object count"),
             (["bench", "reactive"], "reactive"),
             (["bench", "safety"], "safety scenes"),
+            (["bench", "values"], "value iteration"),
             (["bench", "viewer"], "viewer"),
         ):
             with self.subTest(command):

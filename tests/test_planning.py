@@ -81,6 +81,20 @@ class TestSparseProbabilities(unittest.TestCase):
             np.testing.assert_array_equal(T.toarray(), counts.Probabilities())
         self.assertEqual(T.nnz, np.count_nonzero(counts.counts))
 
+    def test_any_row_set_to_any_counts(self):
+        # Rows that grow, shrink, empty and fill again, the first and the last among them.
+        rng = np.random.default_rng(1)
+        counts = rng.integers(0, 3, size=(8, 6)).astype(float)
+        T = sparse.csr_array(counts / np.maximum(counts.sum(axis=1, keepdims=True), 1))
+        for row in [0, 7, 3, 0, 7] + list(rng.integers(8, size=200)):
+            counts[row] = rng.integers(0, 3, size=6) * (rng.random() > 0.2)
+            SetProbabilityRow(T, row, counts[row])
+            T.check_format(full_check=True)
+            totals = counts.sum(axis=1, keepdims=True)
+            dense = np.divide(counts, totals, out=np.zeros_like(counts), where=totals > 0)
+            np.testing.assert_array_equal(T.toarray(), dense)
+            self.assertEqual(T.nnz, np.count_nonzero(counts))
+
 
 class TestStateActionSpaces(unittest.TestCase):
     def test_sizes_of_the_dissertation_spaces(self):

@@ -13,22 +13,24 @@ in [-10, 1] (eq. 8.1's penalty to eq. 8.4's best). Value iteration runs with the
 gamma and delta on the same T sparse and dense, best of ``--repeats``; the table gives both
 times, their ratio and the largest difference of the values (summation order).
 
-Run: ``mobee-drake bench values [--sizes 81x432 80x620 432x55054] [--doc docs/benchmarks.md]``.
+Run: ``mobee-drake bench values [--sizes 81x432 80x620 432x55054] [--doc docs/benchmarks.md]``;
+the generated table's command names the BLAS thread counts its environment set.
 The default sizes are the rank-3 lattice, the roadmap of 80 states and the roadmap that the
 reaching battery's first developed run (iCub, greedy, seed 0) ended with.
 """
 
 import argparse
+import os
 import time
 
 import numpy as np
-from scipy import sparse
 
 from mobee_drake.experiments.arguments import CommandParser, PositiveInt
+from mobee_drake.experiments.battery import BLAS_THREADS
 from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
 from mobee_drake.planning.curiosity import TransitionCounts
 from mobee_drake.planning.value_iteration import ValueIteration
-from mobee_drake.reaching.learner import ReachLearningConfig
+from mobee_drake.reaching.learner import ReachLearningConfig, SortedTransitions
 
 DOC_TABLE = "value iteration"
 DEFAULT_SIZES = ("81x432", "80x620", "432x55054")
@@ -61,8 +63,7 @@ def LearnerModel(states: int, transitions: int, outcomes: int, seed: int = 0):
             counts.Observe(sa, outcome)
     action_state = np.concatenate([start, np.arange(states)])  # (then one reach per state)
     order = np.argsort(action_state, kind="stable")
-    empty = sparse.csr_array((states, states))
-    T = sparse.csr_array(sparse.vstack([sparse.csr_array(counts.Probabilities()), empty])[order])
+    T = SortedTransitions(counts.Probabilities(), order)
     rewards = rng.uniform(-10.0, 1.0, size=transitions + states)[order]
     return T, rewards, action_state[order]
 
@@ -124,8 +125,9 @@ def main(argv=None) -> None:
         print(lines[-1], flush=True)
     if args.doc:
         named = " ".join(f"{s}x{t}" for s, t in sizes)
+        threads = "".join(f"{n}={os.environ[n]} " for n in BLAS_THREADS if n in os.environ)
         command = (
-            f"mobee-drake bench values --sizes {named} --outcomes {args.outcomes} "
+            f"{threads}mobee-drake bench values --sizes {named} --outcomes {args.outcomes} "
             f"--repeats {args.repeats}"
         )
         WriteGeneratedTable(args.doc, DOC_TABLE, f"{command} --doc {args.doc}", "\n".join(lines))

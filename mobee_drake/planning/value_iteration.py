@@ -9,10 +9,11 @@ state without actions has value 0.
 """
 
 import numpy as np
+from scipy import sparse
 
 
 def ValueIteration(
-    transitions: np.ndarray,
+    transitions: np.ndarray | sparse.sparray,
     rewards: np.ndarray,
     action_state: np.ndarray,
     num_states: int,

@@ -204,6 +204,15 @@ LOG_COLUMNS = (
 )
 
 
+def SortedTransitions(probabilities: np.ndarray, order: np.ndarray) -> sparse.csr_array:
+    """T as the reach learner's value iteration reads it, sparse: the transitions' rows
+    ``probabilities`` (k, m), then one empty row per state (a reach ends the policy), in
+    ``order`` (its state-actions sorted by state)."""
+    m = probabilities.shape[1]
+    rows = sparse.vstack([sparse.csr_array(probabilities), sparse.csr_array((m, m))])
+    return sparse.csr_array(rows[order])
+
+
 def _WithDefaults(saved: dict, defaults: dict) -> dict:
     """``saved`` (a configuration as JSON data) with every key it lacks taken from
     ``defaults`` (the same configuration's defaults), nested mappings included."""
@@ -353,11 +362,7 @@ class ReachLearner:
                 self._T_sorted, self._rank[state_action], self.model.counts[state_action]
             )
             return
-        m = self.space.num_states
-        rows = sparse.vstack(
-            [sparse.csr_array(self.model.Probabilities()), sparse.csr_array((m, m))]
-        )
-        self._T_sorted = sparse.csr_array(rows[self._order])
+        self._T_sorted = SortedTransitions(self.model.Probabilities(), self._order)
 
     def _Try(
         self,

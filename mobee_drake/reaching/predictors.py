@@ -214,15 +214,19 @@ class RewardHistories:
 
     def Predict(self, state_action: int, target) -> float:
         """The expected reward (eq. 8.1 for transitions, 8.5 for reaches)."""
-        prior = float(self.reaching[state_action])  # (eq. 8.5's 1, eq. 8.1's 0)
+        prior = self._Prior(state_action)
         return self._Estimate(state_action, target, self._rewards[state_action], prior, False)
 
+    def _Prior(self, state_action: int) -> float:
+        """A prediction's prior: eq. 8.5's 1 for a reach, eq. 8.1's 0 for a transition."""
+        return float(self.reaching[state_action])
+
     def PredictEach(self, state_actions, target) -> np.ndarray:
-        """:meth:`Predict` of each of ``state_actions``; an empty history predicts its prior
-        without a fit (eq. 8.3: most transitions of a grown space have none)."""
+        """:meth:`Predict` of each of ``state_actions``, an empty history's prior read without
+        the call (eq. 8.3; most transitions of a grown space have none)."""
         return np.array(
             [
-                self.Predict(sa, target) if len(self._rewards[sa]) else float(self.reaching[sa])
+                self.Predict(sa, target) if len(self._rewards[sa]) else self._Prior(sa)
                 for sa in state_actions
             ]
         )
