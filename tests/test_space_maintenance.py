@@ -7,7 +7,13 @@ import unittest
 
 import numpy as np
 
-from mobee_drake.planning.explorers import Explorer, MissShares, ObservedOutcomes
+from mobee_drake.planning.explorers import (
+    INITIALIZATIONS,
+    Explorer,
+    ExplorerConfig,
+    MissShares,
+    ObservedOutcomes,
+)
 from mobee_drake.planning.space_maintenance import (
     CarryExplorer,
     EditSpace,
@@ -38,15 +44,31 @@ class TestTheModelsStatistics(unittest.TestCase):
         """A fresh model has observed nothing; then exactly what was observed, a first outcome
         in a new bin counted once (its bin's own 1 is not an observation)."""
         explorer = Explorer(SQUARE)
-        self.assertFalse(ObservedOutcomes(explorer).any())
+        self.assertFalse(ObservedOutcomes(explorer).toarray().any())
         _Tried(explorer, 0, 1, 2)  # arrived twice
         _Tried(explorer, 0, 0, 1)  # stayed once
         _Tried(explorer, 0, 3, 1)  # a new outcome
-        observed = ObservedOutcomes(explorer)
+        observed = ObservedOutcomes(explorer).toarray()
         np.testing.assert_array_equal(observed[0], [1, 2, 0, 1])
         self.assertFalse(observed[1:].any())
         self.assertAlmostEqual(MissShares(explorer)[0], 0.5)
         self.assertEqual(MissShares(explorer)[1], 0.0)  # (untried)
+
+    def test_observed_outcomes_are_the_formula_on_every_count(self):
+        """Sparse, they are what the formula gives on the whole array, for any counts (even
+        below the initialisation's) and either initialisation."""
+        space, rng = Lattice([0.1, 0.5, 0.9], 2), np.random.default_rng(2)
+        every = np.arange(space.num_state_actions)
+        for initialization in INITIALIZATIONS:
+            explorer = Explorer(space, ExplorerConfig(initialization=initialization))
+            counts = explorer.transitions.counts
+            counts[...] = rng.integers(0, 4, size=counts.shape) * (rng.random(counts.shape) < 0.3)
+            initial = np.zeros_like(counts)
+            initial[every, space.action_state] = 2.0
+            initial[every, space.action_goal] = 1.0 + INITIALIZATIONS[initialization]
+            formula = np.rint(counts - initial - ((counts > 0) & (initial == 0))).astype(int)
+            self.assertTrue((formula < 0).any())  # (counts below the initialisation's)
+            np.testing.assert_array_equal(ObservedOutcomes(explorer).toarray(), formula)
 
 
 class TestEditSpace(unittest.TestCase):
@@ -95,7 +117,9 @@ class TestEditSpace(unittest.TestCase):
             carried.transitions.counts[added], fresh.transitions.counts[added]
         )
         np.testing.assert_array_equal(carried.rewards[added], fresh.rewards[added])
-        np.testing.assert_array_equal(ObservedOutcomes(carried)[action_index[0]], [0, 3, 0, 0])
+        np.testing.assert_array_equal(
+            ObservedOutcomes(carried).toarray()[action_index[0]], [0, 3, 0, 0]
+        )
         self.assertEqual(carried.rng.random(), _Generator(3, skip=1).random())
 
 

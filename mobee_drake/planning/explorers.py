@@ -18,6 +18,7 @@ import math
 import pathlib
 
 import numpy as np
+from scipy import sparse
 
 from mobee_drake.atomic_files import CurrentGeneration
 from mobee_drake.planning.curiosity import TransitionCounts
@@ -119,22 +120,31 @@ class Explorer:
         return self.rewards[state_action]
 
 
-def _InitialCounts(explorer: Explorer) -> np.ndarray:
-    """The counts of Alg. 6's initialisation: each state-action once in its own state, then
-    in its goal (each first observation of an outcome counts 2: the new bin's 1 and itself)."""
+def _InitialCounts(explorer: Explorer, rows: np.ndarray, columns: np.ndarray) -> np.ndarray:
+    """The counts of Alg. 6's initialisation at (``rows``, ``columns``): each state-action
+    once in its own state, then in its goal (each first observation of an outcome counts 2:
+    the new bin's 1 and itself)."""
     space = explorer.space
-    rows = np.arange(space.num_state_actions)
-    initial = np.zeros_like(explorer.transitions.counts)
-    initial[rows, space.action_state] = 2.0
-    initial[rows, space.action_goal] = 1.0 + INITIALIZATIONS[explorer.config.initialization]
-    return initial
+    goal = 1.0 + INITIALIZATIONS[explorer.config.initialization]
+    own = np.where(columns == space.action_state[rows], 2.0, 0.0)
+    return np.where(columns == space.action_goal[rows], goal, own)
 
 
-def ObservedOutcomes(explorer: Explorer) -> np.ndarray:
-    """(state-actions, states): the outcomes observed since the initialisation."""
-    counts, initial = explorer.transitions.counts, _InitialCounts(explorer)
-    new_bins = (counts > 0) & (initial == 0)  # (each began with a 1 of its own)
-    return np.rint(counts - initial - new_bins).astype(int)
+def ObservedOutcomes(explorer: Explorer) -> sparse.csr_array:
+    """(state-actions, states), sparse: the outcomes observed since the initialisation, stored
+    where a count or the initialisation is not zero (none elsewhere)."""
+    counts, space = explorer.transitions.counts, explorer.space
+    every = np.arange(space.num_state_actions)
+    rows, columns = np.nonzero(counts)
+    cells = np.unique(
+        np.concatenate([rows, every, every]) * counts.shape[1]
+        + np.concatenate([columns, space.action_state, space.action_goal])
+    )
+    rows, columns = np.divmod(cells, counts.shape[1])
+    bins, initial = counts[rows, columns], _InitialCounts(explorer, rows, columns)
+    new_bins = (bins > 0) & (initial == 0)  # (each began with a 1 of its own)
+    observed = np.rint(bins - initial - new_bins).astype(int)
+    return sparse.csr_array((observed, (rows, columns)), shape=counts.shape)
 
 
 def MissShares(explorer: Explorer) -> np.ndarray:
