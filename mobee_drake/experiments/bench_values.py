@@ -78,6 +78,7 @@ def _Best(repeats: int, solve) -> tuple[float, tuple]:
 
 
 def Row(states: int, transitions: int, outcomes: int, repeats: int) -> str:
+    """The table's row of a model of ``states`` and ``transitions`` (see the module)."""
     config = ReachLearningConfig()
     T, rewards, action_state = LearnerModel(states, transitions, outcomes)
     dense = T.toarray()
