@@ -15,6 +15,7 @@ import numpy as np
 from mobee_drake.reaching.predictors import (
     FAILED_TRANSITION_REWARD,
     PREDICTORS,
+    PredictorConfig,
     ReachReward,
     RewardHistories,
     TransitionReward,
@@ -57,8 +58,6 @@ class TestPredictors(unittest.TestCase):
         self.assertEqual(targets.shape, (2, 3))
 
     def test_predictions_of_many_are_each_ones(self):
-        from mobee_drake.reaching.predictors import PredictorConfig
-
         # Empty and recorded histories of transitions and reaches, both predictors.
         for kind in PREDICTORS:
             h = RewardHistories([False, True, False, True], PredictorConfig(kind))
