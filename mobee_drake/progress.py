@@ -40,3 +40,8 @@ def ProgressBar(**options):
     if options.get("disable") or sys.stderr.isatty():
         return tqdm(**options)
     return _PlainLines(**options)
+
+
+def Say(line: str) -> None:
+    """``line`` on standard error, beside any bars (tqdm moves them out of its way)."""
+    tqdm.write(line, file=sys.stderr)

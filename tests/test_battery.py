@@ -164,6 +164,19 @@ class LocalBatteryTest(TemporaryFolder):
                                       r"result.json'")  # fmt: skip
             self.assertEqual(message.count("NotStarted: not started: [Errno 28]"), 6 - len(started))
 
+    def test_a_failed_job_is_said_when_it_fails(self):
+        """A battery of hours names a failed job at once, not only when it ends."""
+        printed, output = io.StringIO(), self.folder / "out"
+        jobs = [Job("bad", Nan), Job("fine", Walk, dict(steps=8, seed=9, pause=0.3))]
+        with contextlib.redirect_stderr(printed), self.assertRaises(BatteryError):
+            RunBattery(jobs, output, workers=2, progress=True)
+        lines = printed.getvalue().splitlines()
+        said = [i for i, line in enumerate(lines) if line.startswith("bad failed: ValueError")]
+        self.assertEqual(len(said), 1, printed.getvalue())
+        # (before the battery's own last line, which it writes when its runs have ended)
+        self.assertTrue(lines[-1].startswith("battery: 2/2 run"), printed.getvalue())
+        self.assertLess(said[0], len(lines) - 1)
+
     def test_plain_progress_lines_end_at_each_runs_count(self):
         """In a log (not a terminal), a run's last line gives its final count, not the count
         last seen while it ran (issue 36: '0/600 it')."""

@@ -105,7 +105,7 @@ from mobee_drake import __version__
 from mobee_drake.atomic_files import StrictJson, WriteJsonAtomically, WriteTextAtomically
 from mobee_drake.experiments.arguments import PositiveInt
 from mobee_drake.owned_folders import OwnedFolder
-from mobee_drake.progress import ProgressBar
+from mobee_drake.progress import ProgressBar, Say
 from mobee_drake.yaml_io import YamlDifferences
 
 RESULT = "result.json"
@@ -512,6 +512,12 @@ class _Display:
         except (OSError, ValueError):
             return None
 
+    def Failed(self, name: str, error: Exception) -> None:
+        """Says at once that job ``name`` failed (the battery names every failed job again
+        when it ends)."""
+        if self.enabled:
+            Say(f"{name} failed: {type(error).__name__}: {error}")
+
     def Close(self) -> None:
         for bar in self.runs.values():
             bar.close()
@@ -707,6 +713,7 @@ def _RunJobs(
                         results[job.name] = json.loads(future.result())
                     except Exception as error:
                         errors[job.name] = error
+                        display.Failed(job.name, error)
                         if _DiskRefuses(error):  # Every later job's writes would fail too.
                             for waiting in queue:
                                 errors[waiting.name] = NotStarted(f"not started: {error}")
