@@ -7,11 +7,11 @@ value iteration read every state of every state-action; on a roadmap that ``deve
 with before every action.
 
 For each size (states, transitions) a model like a learner's is drawn: each transition from a
-random state to another, its counts Alg. 6's initialisation (2 in its own state, 2 in its goal)
-and ``--outcomes`` more outcomes observed in random states; one reach per state; rewards drawn
-in [-10, 1] (eq. 8.1's penalty to eq. 8.4's best). Value iteration runs with the learner's
-gamma and delta on the same T sparse and dense, best of ``--repeats``; the table gives both
-times, their ratio and the largest difference of the values (summation order).
+random state to another, its counts Alg. 6's initialisation (the curious agent's, as the MDP a
+learner starts from) and ``--outcomes`` more outcomes observed in random states; one reach per
+state; rewards drawn in [-10, 1] (eq. 8.1's penalty to eq. 8.4's best). Value iteration runs
+with the learner's gamma and delta on the same T sparse and dense, best of ``--repeats``; the
+table gives both times, their ratio and the largest difference of the values (summation order).
 
 Run: ``mobee-drake bench values [--sizes 81x432 80x620 432x55054] [--doc docs/benchmarks.md]``;
 the generated table's command names the BLAS thread counts its environment set.
@@ -28,7 +28,8 @@ import numpy as np
 from mobee_drake.experiments.arguments import CommandParser, PositiveInt
 from mobee_drake.experiments.battery import BLAS_THREADS
 from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
-from mobee_drake.planning.curiosity import TransitionCounts
+from mobee_drake.planning.explorers import Explorer, ExplorerConfig
+from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.planning.value_iteration import ValueIteration
 from mobee_drake.reaching.learner import ReachLearningConfig, SortedTransitions
 
@@ -52,14 +53,12 @@ def LearnerModel(states: int, transitions: int, outcomes: int, seed: int = 0):
     """(T sparse, rewards, each state-action's state), in value iteration's order, of a
     model like a reach learner's (see the module)."""
     rng = np.random.default_rng(seed)
-    start = rng.integers(states, size=transitions)
+    start = np.sort(rng.integers(states, size=transitions))
     goal = (start + rng.integers(1, states, size=transitions)) % states
-    counts = TransitionCounts(transitions, states)
-    rows = np.arange(transitions)
-    counts.counts[rows, start] = 2.0
-    counts.counts[rows, goal] = 2.0
+    space = StateActionSpace(rng.random((states, 2)), start, goal)
+    counts = Explorer(space, ExplorerConfig()).transitions  # (Alg. 6's initialisation)
     for _ in range(outcomes):
-        for sa, outcome in zip(rows, rng.integers(states, size=transitions)):
+        for sa, outcome in enumerate(rng.integers(states, size=transitions)):
             counts.Observe(sa, outcome)
     action_state = np.concatenate([start, np.arange(states)])  # (then one reach per state)
     order = np.argsort(action_state, kind="stable")
