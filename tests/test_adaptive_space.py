@@ -65,6 +65,39 @@ class TestTheBatterysOrder(unittest.TestCase):
         settings = 2 * 2 * 3 * 2  # robots x spaces x strategies x conditions
         self.assertEqual(seeds, [0] * settings + [1] * settings)
 
+    def test_the_report_names_the_runs_without_a_result(self):
+        """Of a two-seed battery on both robots, the results of all but the Katana's roadmap
+        run with intrinsic, maintained, seed 1 and the iCub's lattice random fixed seeds 0 and
+        1: the report names those three runs by setting, and no other."""
+        from mobee_drake.experiments.adaptive_space_reaching import MissingRuns, Report, Stages
+        from mobee_drake.planning.space_maintenance import MaintenanceConfig
+
+        args = adaptive_space_command._Parser().parse_args(
+            ["--part", "reaching", "--robots", "icub", "katana", "--seeds", "2"]
+        )
+        jobs = Stages(args, MaintenanceConfig())[-1][1]
+        left_out = {
+            "reach_katana_trm_intrinsic_maintained_seed1",
+            "reach_random_fixed_seed0",
+            "reach_random_fixed_seed1",
+        }
+        results = {job.name: {} for job in jobs if job.name not in left_out}
+        missing = MissingRuns(jobs, results)
+        self.assertEqual(
+            missing,
+            {
+                ("katana", "trm", "intrinsic", "maintained"): [1],
+                ("icub", "rank3", "random", "fixed"): [0, 1],
+            },
+        )
+        self.assertIn(
+            "Runs without a result (3: failed, or not yet run; their seeds are left out of "
+            "their settings' pairs): icub rank3 random fixed seeds 0, 1; katana trm intrinsic "
+            "maintained seed 1.",
+            Report([], "test", missing=missing),
+        )
+        self.assertNotIn("Runs without a result", Report([], "test", missing={}))
+
 
 class TestReachTargets(unittest.TestCase):
     def test_the_icub_has_the_sources_grid_and_the_katana_one_in_front_of_it(self):
@@ -355,11 +388,53 @@ class TestTheReachLearnersSpace(unittest.TestCase):
             self.assertTrue((output / f"adaptive_space_reaching_{robot}.html").is_file())
         self.assertIn("adaptive_space_reaching.png", report)
         self.assertEqual(_KeptReport(report), report.split("\n\nFigures (")[0])
-        # The report of the finished runs alone, a third seed's runs not started.
+        # The report of the finished runs alone, a third seed's runs not started (and named).
         self._Reaching(output, 3, 8, *arms, "--report-only")
         self.assertFalse(list(output.glob("runs/*seed2")))
         table = (output / "report.md").read_text()
-        self.assertEqual(table.split("Command:")[0], report.split("Command:")[0])
+        missing = (
+            "\n\nRuns without a result (4: failed, or not yet run; their seeds are left out of "
+            "their settings' pairs): icub rank3 greedy fixed seed 2; icub rank3 greedy "
+            "maintained seed 2; katana rank3 greedy fixed seed 2; katana rank3 greedy "
+            "maintained seed 2."
+        )
+        self.assertIn(missing, table)
+        self.assertEqual(
+            table.replace(missing, "").split("Command:")[0], report.split("Command:")[0]
+        )
+        self._AssertFixedRunsShared(output, report)
+
+    def _AssertFixedRunsShared(self, first: pathlib.Path, report: str) -> None:
+        """A battery of another ``join_within`` reads its fixed runs from ``first`` (a smoke
+        battery's folder, its ``report``) and makes only its maintained runs; a battery of
+        other arguments than the maintenance's is refused before anything runs."""
+        from mobee_drake.experiments.battery import BatteryRefused
+
+        output, icub = self.output / "join_half", ["--robots", "icub", "--reach-spaces", "rank3"]
+        self._Reaching(output, 2, 8, *icub, "--join-within", "0.5", "--fixed-from", str(first))
+        self.assertEqual(
+            sorted(p.name for p in output.glob("runs/reach_*")),
+            ["reach_greedy_maintained_seed0", "reach_greedy_maintained_seed1"],
+        )
+        job = json.loads((output / "runs/reach_greedy_maintained_seed0/job.json").read_text())
+        self.assertEqual(job["maintenance"]["MaintenanceConfig"]["join_within"], 0.5)
+        shared = (output / "report.md").read_text()
+        (fixed,) = [
+            line for line in report.splitlines() if "| icub | rank3 | greedy | fixed |" in line
+        ]
+        self.assertIn(fixed, shared)
+        self.assertIn("icub rank3 greedy, maintained minus fixed, summed reward:", shared)
+        other = self.output / "other"
+        with self.assertRaisesRegex(BatteryRefused, r"reach_greedy_fixed_seed0: evaluations"):
+            self._Reaching(other, 2, 8, *icub, "--evaluations", "2", "--fixed-from", str(first))
+        self.assertFalse(other.exists())
+        stderr = io.StringIO()
+        with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit) as exit:
+            adaptive_space_command.main(["--part", "reaching", "--fixed-from", str(other)])
+        self.assertEqual(exit.exception.code, 2)
+        self.assertIn(
+            f"error: --fixed-from: no reaching battery's runs in {other}", stderr.getvalue()
+        )
 
     def test_the_reach_learner_on_a_roadmap(self):
         """The reaching part on the iCub's roadmap space (spacing 1.0: a few states), greedy, one

@@ -53,6 +53,7 @@ from mobee_drake.experiments.battery import (
     FinishedResults,
     Job,
     RunBattery,
+    SharedResults,
 )
 from mobee_drake.experiments.ch8_reaching import MdpName
 from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
@@ -252,10 +253,13 @@ def _ExplorationReport(
 def _ReachingReport(
     args, maintenance: MaintenanceConfig, output: pathlib.Path, command: str, kept: bool = False
 ):
-    """Runs the reaching part's battery, stage by stage; its report (``kept``:
-    :func:`KeptReport`'s)."""
-    results = {}
-    for description, jobs in reaching_part.Stages(args, maintenance):
+    """Runs the reaching part's battery, stage by stage (with ``--fixed-from``, the fixed runs
+    read from that battery's folder); its report (``kept``: :func:`KeptReport`'s)."""
+    stages = reaching_part.Stages(args, maintenance)
+    fixed = reaching_part.FixedRuns(args, maintenance) if args.fixed_from else []
+    # (read first: a folder of runs of other arguments is refused before anything runs)
+    results = SharedResults(fixed, args.fixed_from, "maintenance") if fixed else {}
+    for description, jobs in stages:
         results.update(_Results(args, jobs, output, description, kept))
     runs = [
         reaching_part.AdaptiveReachRun(**r) for n, r in results.items() if n.startswith("reach_")
@@ -278,7 +282,10 @@ def _ReachingReport(
                 TargetGaps(arms[robot], ended) for ended in EndedSpaces(runs, output, robot, space)
             ]
     nearness = _Nearness(args.robots, args.reach_spaces, output)
-    report = reaching_part.Report(runs, command, targets, roadmaps, mdps, nearness)
+    run_jobs = [job for _, jobs in stages for job in jobs if job.name.startswith("reach_")]
+    run_jobs += fixed
+    missing = reaching_part.MissingRuns(run_jobs, results)
+    report = reaching_part.Report(runs, command, targets, roadmaps, mdps, nearness, missing)
     if kept:
         return report
     with OwnedFolder(output, "battery"):
@@ -388,6 +395,8 @@ def KeptReport(command: str, root: pathlib.Path) -> str:
     parser = _Parser()
     args = parser.parse_args(shlex.split(command)[3:])  # (after "mobee-drake experiment ...")
     output = root / _Output(args)
+    if args.fixed_from:
+        args.fixed_from = root / args.fixed_from
     return _REPORTS[args.part](args, _Maintenance(parser, args), output, command, kept=True)
 
 
@@ -400,6 +409,8 @@ def main(argv: list[str] | None = None) -> None:
     CheckDocBlocks(parser, args.doc, block)
     maintenance = _Maintenance(parser, args)
     output = _Output(args)
+    if args.fixed_from and not (args.part == "reaching" and (args.fixed_from / "runs").is_dir()):
+        parser.error(f"--fixed-from: no reaching battery's runs in {args.fixed_from}")
     if args.report_only and not any(output.glob("runs/*/result.json")):
         parser.error(f"--report-only: no finished runs in {output / 'runs'}")
     command = ("mobee-drake experiment adaptive-space " + shlex.join(argv or [])).strip()

@@ -25,7 +25,9 @@ lattice, are compared paired by seed in two families, each Holm-corrected over i
 (the robots, spaces and strategies): what was learned (the summed reward with penalties) and
 what it cost (the robot hours of the exploration, the wall seconds)."""
 
+import collections
 import dataclasses as dc
+import pathlib
 
 import numpy as np
 
@@ -179,13 +181,21 @@ def AddArguments(reaching) -> None:
         default="continued",
         help="the MDP learned first and further with the reaches, or only with them",
     )
+    reaching.add_argument(
+        "--fixed-from",
+        metavar="FOLDER",
+        type=pathlib.Path,
+        help="read the fixed runs from this battery's folder (their jobs the same but for the "
+        "maintenance settings, which a fixed run does not use) rather than make them again",
+    )
 
 
 def Stages(args, maintenance: MaintenanceConfig) -> list[tuple[str, list[Job]]]:
     """The battery's jobs in the order they must finish, each stage (its description, its
     jobs) before the next begins: the "trm" spaces' roadmaps, the MDPs learned first on each
-    space (unless ``--mdp simultaneous``), then the runs, seed by seed. The iCub's lattice
-    jobs keep the names and arguments they had before there was a choice of robot or space."""
+    space (unless ``--mdp simultaneous``), then the runs, seed by seed (with ``--fixed-from``
+    the maintained ones alone: :func:`FixedRuns`). The iCub's lattice jobs keep the names and
+    arguments they had before there was a choice of robot or space."""
     roadmaps, mdps, runs = [], [], []
     for robot in args.robots:
         if "trm" in args.reach_spaces:
@@ -197,11 +207,22 @@ def Stages(args, maintenance: MaintenanceConfig) -> list[tuple[str, list[Job]]]:
                     mdp["space"] = space
                 name = MdpName(MDP_TRIES, robot=robot, space=space)
                 mdps.append(Job(name, MdpJob, mdp))
-            runs += _RunJobs(args, maintenance, robot, space)
+            conditions = ("maintained",) if args.fixed_from else CONDITIONS
+            runs += _RunJobs(args, maintenance, robot, space, conditions)
     # Seed-major: a battery stopped early has about as many seeds of every setting.
     runs.sort(key=lambda job: job.kwargs["seed"])
     stages = [("trm spaces", roadmaps), ("the MDPs (actions)", mdps), ("adaptive reaching", runs)]
     return [(description, jobs) for description, jobs in stages if jobs]
+
+
+def FixedRuns(args, maintenance: MaintenanceConfig) -> list[Job]:
+    """The fixed runs that ``--fixed-from`` reads from another battery's folder."""
+    return [
+        job
+        for robot in args.robots
+        for space in args.reach_spaces
+        for job in _RunJobs(args, maintenance, robot, space, ("fixed",))
+    ]
 
 
 def RunName(robot: str, space: str, strategy: str, condition: str, seed: int) -> str:
@@ -211,7 +232,9 @@ def RunName(robot: str, space: str, strategy: str, condition: str, seed: int) ->
     return "_".join([*parts, strategy, condition, f"seed{seed}"])
 
 
-def _RunJobs(args, maintenance: MaintenanceConfig, robot: str, space: str) -> list[Job]:
+def _RunJobs(
+    args, maintenance: MaintenanceConfig, robot: str, space: str, conditions: tuple[str, ...]
+) -> list[Job]:
     stages = sorted({*args.stages, args.problem_tries})
     named = {} if robot == "icub" else dict(robot=robot)
     if space != "rank3":
@@ -235,7 +258,34 @@ def _RunJobs(args, maintenance: MaintenanceConfig, robot: str, space: str) -> li
         )
         for seed in range(args.seeds)
         for strategy in args.strategies
-        for condition in CONDITIONS
+        for condition in conditions
+    ]
+
+
+def MissingRuns(jobs: list[Job], results: dict) -> dict[tuple, list[int]]:
+    """Per setting (robot, space, strategy, condition), the seeds of ``jobs`` without a
+    result in ``results`` (failed, or not yet run)."""
+    missing = collections.defaultdict(list)
+    for job in jobs:
+        if job.name not in results:
+            kwargs = job.kwargs
+            setting = (kwargs.get("robot", "icub"), kwargs.get("space", "rank3"))
+            missing[(*setting, kwargs["strategy"], kwargs["condition"])].append(kwargs["seed"])
+    return dict(missing)
+
+
+def _MissingLines(missing: dict[tuple, list[int]]) -> list[str]:
+    """Report lines naming the runs without a result, by setting (:func:`MissingRuns`)."""
+    if not missing:
+        return []
+    named = "; ".join(
+        f"{' '.join(setting)} seed{'s' * (len(seeds) > 1)} {', '.join(map(str, seeds))}"
+        for setting, seeds in sorted(missing.items())
+    )
+    return [
+        "",
+        f"Runs without a result ({sum(map(len, missing.values()))}: failed, or not yet run; "
+        f"their seeds are left out of their settings' pairs): {named}.",
     ]
 
 
@@ -266,6 +316,7 @@ def Report(
     roadmaps: dict | None = None,
     mdps: dict | None = None,
     nearness: dict | None = None,
+    missing: dict | None = None,
 ) -> str:
     """The report's table, the "trm" spaces' roadmaps (``roadmaps``: per robot, its roadmap
     job's result), how near each space's states lie to the valid configurations
@@ -275,7 +326,7 @@ def Report(
     :class:`~mobee_drake.reaching.targets.TargetGrid`; per space, each target's distance to the
     nearest state's marker, :func:`~mobee_drake.experiments.arms.TargetGaps`; and per space,
     the same on the space each maintained run ended with), the targets and how near each space
-    comes to them (markdown)."""
+    comes to them, and the runs without a result (``missing``, :func:`MissingRuns`'s; markdown)."""
     group = BySetting(runs, ("robot", "space", "strategy", "condition"))
     lines = [
         "| robot | space | strategy | condition | runs | problem-tries | summed reward | without "
@@ -301,6 +352,7 @@ def Report(
         ),
         "wall s per run": lambda r: r.wall_seconds,
     }
+    lines += _MissingLines(missing or {})
     lines += RoadmapLines(roadmaps or {}) + NearnessLines(nearness or {})
     if mdps:
         actions = "; ".join(f"{setting}, {r['actions']} actions" for setting, r in mdps.items())

@@ -606,6 +606,33 @@ def FinishedResults(jobs: Iterable[Job], output: str | pathlib.Path) -> dict[str
     return {name: result for name, result in results.items() if result is not None}
 
 
+def SharedResults(jobs: Iterable[Job], output: str | pathlib.Path, unused: str) -> dict[str, dict]:
+    """The stored results of those of ``jobs`` that have finished in another battery's
+    ``output``, whose recorded arguments may differ from theirs in the argument ``unused``
+    alone: one their function does not use for these jobs (a battery that reads the runs it
+    shares with another rather than make them again). Runs and writes nothing.
+
+    Raises:
+        BatteryRefused: When a finished job's recorded arguments differ in another one.
+    """
+    output, results, mismatches = pathlib.Path(output).absolute(), {}, []
+    for job in jobs:
+        result = _StoredResult(output, job.name)
+        if result is None:
+            continue
+        recorded = json.loads((output / "runs" / job.name / ARGUMENTS).read_text())
+        own = json.loads(_ArgumentsText(job))
+        for arguments in (recorded, own):
+            arguments.pop(unused, None)
+        if recorded != own:
+            differences = YamlDifferences(json.dumps(recorded), json.dumps(own))
+            mismatches.append(f"{job.name}: {'; '.join(differences[:3])}")
+        results[job.name] = result
+    if mismatches:
+        raise _Refusal(output, f"its runs were made with other arguments than {unused}", mismatches)
+    return results
+
+
 def _CheckArguments(jobs: list[Job], output: pathlib.Path) -> None:
     """Records each job's arguments in its folder (``job.json``), or, when the folder holds
     a run of other arguments, refuses the battery naming what differs."""
@@ -629,11 +656,19 @@ def _RefuseOtherArguments(jobs: list[Job], output: pathlib.Path) -> None:
             differences = YamlDifferences(path.read_text(), text)
             mismatches.append(f"{job.name}: {'; '.join(differences[:3])}")
     if mismatches:
-        raise BatteryRefused(
-            f"{output}: holds runs of other arguments ({' | '.join(mismatches[:3])}"
-            + (f" | and {len(mismatches) - 3} more" if len(mismatches) > 3 else "")
-            + "); use another output folder for these settings"
+        raise _Refusal(
+            output,
+            "holds runs of other arguments",
+            mismatches,
+            "; use another output folder for these settings",
         )
+
+
+def _Refusal(output: pathlib.Path, what: str, mismatches: list[str], advice: str = ""):
+    """The refusal of a battery whose ``output`` holds runs of other arguments than its jobs'
+    (``what``), naming the first three ``mismatches``."""
+    more = f" | and {len(mismatches) - 3} more" if len(mismatches) > 3 else ""
+    return BatteryRefused(f"{output}: {what} ({' | '.join(mismatches[:3])}{more}){advice}")
 
 
 def _SourceCommit() -> dict:
