@@ -376,6 +376,7 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         histories = adaptive_space_command.ReachSpaceHistories(runs, output)
         for robot in ("icub", "katana"):
             (history,) = histories[robot]
+            self.assertEqual(history.title, f"{robot}, rank3, greedy, seed0")
             (first,) = [
                 r for r in runs if (r.robot, r.condition, r.seed) == (robot, "maintained", 0)
             ]

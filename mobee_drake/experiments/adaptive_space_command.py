@@ -293,8 +293,8 @@ def _ReachingReport(
         figures = WriteSpaceFigures(histories, output, "adaptive_space_reaching")
     if figures:
         report += (
-            "\n\nFigures (each space's first seed's maintained run, of the intrinsic strategy "
-            f"where it ran): {', '.join(figures)}."
+            "\n\nFigures (each space's first finished seed's maintained run, of the intrinsic "
+            f"strategy where it ran): {', '.join(figures)}."
         )
     return report
 
@@ -313,8 +313,8 @@ def EndedSpaces(runs: list, output: pathlib.Path, robot: str, space: str) -> lis
 
 
 def ReachSpaceHistories(runs: list, output: pathlib.Path) -> dict[str, list]:
-    """Per robot, the history of each space's first seed's maintained run of the intrinsic
-    strategy (where it ran; of the first strategy else), with the arm's targets."""
+    """Per robot, the history of each space's first finished seed's maintained run of the
+    intrinsic strategy (where it ran; of the first strategy else), with the arm's targets."""
     arms, histories = Arms(), collections.defaultdict(list)
     maintained = collections.defaultdict(list)
     for r in runs:
@@ -329,7 +329,7 @@ def ReachSpaceHistories(runs: list, output: pathlib.Path) -> dict[str, list]:
         if initial is None:  # (its roadmap is not there: nothing to draw it from)
             continue
         changes = SpaceChanges(output / "runs" / name / "checkpoint", "learner")
-        title = f"{robot}, {space}, {strategy}"
+        title = f"{robot}, {space}, {strategy}, seed{seed}"
         histories[robot].append(
             History(title, arms[robot], initial, changes, ReachTargets(arms[robot]))
         )

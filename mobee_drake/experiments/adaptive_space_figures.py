@@ -198,7 +198,7 @@ def WriteSpaceFigures(
     """``<stem>.png`` and, per robot, ``<stem>_<robot>.html`` (Meshcat, with the robot at home,
     its world's objects and the reach targets: a recording of its spaces as they changed) in
     ``output``, of ``histories`` (per robot, its spaces' histories, titled "<robot>, <space>" or
-    "<robot>, <space>, <strategy>"); their names."""
+    "<robot>, <space>, <strategy>, seed<n>"); their names."""
     if not histories:
         return []
     written = [f"{stem}.png"]
