@@ -4,9 +4,11 @@ against closed forms on small spaces."""
 import json
 import pathlib
 import unittest
+from unittest import mock
 
 import numpy as np
 
+from mobee_drake.planning import space_maintenance
 from mobee_drake.planning.explorers import (
     INITIALIZATIONS,
     Explorer,
@@ -19,6 +21,7 @@ from mobee_drake.planning.space_maintenance import (
     EditSpace,
     Maintenance,
     MaintenanceConfig,
+    SpaceTooLarge,
     VisitedStates,
 )
 from mobee_drake.planning.state_space import FromGraph, Lattice
@@ -277,6 +280,26 @@ class TestTheRules(unittest.TestCase):
         edit = local.Plan(Explorer(SQUARE), 3, 10, favoured=[0])
         pairs = set(zip(edit.space.action_state.tolist(), edit.space.action_goal.tolist()))
         self.assertEqual(pairs, old | new - {(4, 5), (5, 4)})
+
+    def test_a_space_too_large_for_the_memory_is_refused_by_name(self):
+        """With less memory available than the developed space's counts need (6 states by 18
+        state-actions, 864 bytes), the round is refused naming its step, the sizes and the
+        bounds, and the maintenance is left as it was; with enough, it is made."""
+        maintenance = Maintenance(MaintenanceConfig(rules=["develop"]), 4)
+        with mock.patch.object(space_maintenance, "AvailableMemory", return_value=863):
+            with self.assertRaisesRegex(
+                SpaceTooLarge,
+                r"^space maintenance at step 10: the round planned 6 states and 18 "
+                r"state-actions, whose outcome counts need 0\.0 GiB, more than the 0\.0 GiB "
+                r"available; bound the space \(max_states, or a smaller join_within\)$",
+            ):
+                maintenance.Plan(Explorer(SQUARE), 3, 10, favoured=[0])
+        self.assertEqual(maintenance.changes, [])
+        with mock.patch.object(space_maintenance, "AvailableMemory", return_value=864):
+            self.assertEqual(
+                maintenance.Plan(Explorer(SQUARE), 3, 10, favoured=[0]).space.num_states, 6
+            )
+        self.assertGreater(space_maintenance.AvailableMemory(), 2**20)  # (this machine says)
 
     def test_settings_are_checked(self):
         with self.assertRaisesRegex(ValueError, "unknown rule 'trim'"):

@@ -205,6 +205,38 @@ def CarryExplorer(explorer: Explorer, edit: SpaceEdit) -> Explorer:
     return carried
 
 
+class SpaceTooLarge(MemoryError):
+    """A round planned a space whose learned model would not fit in the memory available."""
+
+
+def AvailableMemory() -> int | None:
+    """The bytes the system says it can give without swapping (Linux's ``MemAvailable``);
+    None where it does not say."""
+    try:
+        with open("/proc/meminfo") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return None
+
+
+def _CheckModelFits(space: StateActionSpace, step: int) -> None:
+    """Refuses a planned ``space`` whose outcome counts (dense: state-actions by states, as
+    :class:`~mobee_drake.planning.curiosity.TransitionCounts` holds them) would need more
+    memory than is available, naming the round and what would bound it, rather than fail deep
+    in the carry with numpy's bare MemoryError."""
+    needed, available = 8 * space.num_state_actions * space.num_states, AvailableMemory()
+    if available is not None and needed > available:
+        raise SpaceTooLarge(
+            f"space maintenance at step {step}: the round planned {space.num_states} states and "
+            f"{space.num_state_actions:,} state-actions, whose outcome counts need "
+            f"{needed / 2**30:.1f} GiB, more than the {available / 2**30:.1f} GiB available; "
+            "bound the space (max_states, or a smaller join_within)"
+        )
+
+
 class Maintenance:
     """One agent's space maintenance: its settings, what it has seen of the agent's chains of
     actions (for ``shortcut``), and every change made so far."""
@@ -278,6 +310,7 @@ class Maintenance:
             if len(kept_pruned) == len(pruned):
                 break  # (no pruning strands them: nothing more to keep)
             pruned = kept_pruned
+        _CheckModelFits(edit.space, actions_done)
         for change in changes:
             if change.rule == "shortcut":  # (an action now: no chain to count)
                 self.chains[change.states] = 0
