@@ -116,6 +116,14 @@ class TestKeptBatteries(unittest.TestCase):
             "adaptive_space_reaching_dense_t", "adaptive_space_reaching", 32, parted
         )
 
+    def test_the_side_batterys_code_makes_the_batterys_runs(self):
+        """docs/adaptive_space.md says a maintained roadmap run of the reaching battery, made
+        again with the code the side battery runs (its sparse ``ObservedOutcomes``), is the
+        battery's run, measure for measure, but for its wall time."""
+        self._AssertTheBatterysRunsButForWallTime(
+            "adaptive_space_reaching_again", "adaptive_space_reaching", 1
+        )
+
     def _CheckQuotedDifferences(self, prose: str, tables: str) -> None:
         for difference in _DIFFERENCE.findall(prose):
             with self.subTest(difference=difference):
