@@ -91,8 +91,8 @@ class TestTheBatterysOrder(unittest.TestCase):
             },
         )
         self.assertIn(
-            "Runs without a result (3: failed, or not yet run; their seeds are left out of "
-            "their settings' pairs): icub rank3 random fixed seeds 0, 1; katana trm intrinsic "
+            "Runs without a result (3: failed, or not finished; the comparisons leave out the "
+            "pairs they belong to): icub rank3 random fixed seeds 0, 1; katana trm intrinsic "
             "maintained seed 1.",
             Report([], "test", missing=missing),
         )
@@ -376,7 +376,7 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         histories = adaptive_space_command.ReachSpaceHistories(runs, output)
         for robot in ("icub", "katana"):
             (history,) = histories[robot]
-            self.assertEqual(history.title, f"{robot}, rank3, greedy, seed0")
+            self.assertEqual(history.title, f"{robot}, rank3, greedy, seed 0")
             (first,) = [
                 r for r in runs if (r.robot, r.condition, r.seed) == (robot, "maintained", 0)
             ]
@@ -387,6 +387,10 @@ class TestTheReachLearnersSpace(unittest.TestCase):
             self.assertEqual(len(history.removed), first.changes["prune"])
             self.assertEqual(len(history.targets), 27)
             self.assertTrue((output / f"adaptive_space_reaching_{robot}.html").is_file())
+        # (a seed 0 without a result: the first finished seed is drawn, and named)
+        later = [r for r in runs if (r.robot, r.condition, r.seed) != ("icub", "maintained", 0)]
+        (history,) = adaptive_space_command.ReachSpaceHistories(later, output)["icub"]
+        self.assertEqual(history.title, "icub, rank3, greedy, seed 1")
         self.assertIn("adaptive_space_reaching.png", report)
         self.assertEqual(_KeptReport(report), report.split("\n\nFigures (")[0])
         # The report of the finished runs alone, a third seed's runs not started (and named).
@@ -394,8 +398,8 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         self.assertFalse(list(output.glob("runs/*seed2")))
         table = (output / "report.md").read_text()
         missing = (
-            "\n\nRuns without a result (4: failed, or not yet run; their seeds are left out of "
-            "their settings' pairs): icub rank3 greedy fixed seed 2; icub rank3 greedy "
+            "\n\nRuns without a result (4: failed, or not finished; the comparisons leave out the "
+            "pairs they belong to): icub rank3 greedy fixed seed 2; icub rank3 greedy "
             "maintained seed 2; katana rank3 greedy fixed seed 2; katana rank3 greedy "
             "maintained seed 2."
         )
@@ -407,8 +411,11 @@ class TestTheReachLearnersSpace(unittest.TestCase):
 
     def _AssertFixedRunsShared(self, first: pathlib.Path, report: str) -> None:
         """A battery of another ``join_within`` reads its fixed runs from ``first`` (a smoke
-        battery's folder, its ``report``) and makes only its maintained runs; a battery of
-        other arguments than the maintenance's is refused before anything runs."""
+        battery's folder, its ``report``) and makes only its maintained runs; its report says
+        where the fixed runs came from and does not compare wall time, and the kept report
+        reads the folder under its root. A folder of runs of other arguments, of none of the
+        fixed runs, or this battery's own, and the exploration part, are refused before
+        anything runs."""
         from mobee_drake.experiments.battery import BatteryRefused
 
         output, icub = self.output / "join_half", ["--robots", "icub", "--reach-spaces", "rank3"]
@@ -425,17 +432,34 @@ class TestTheReachLearnersSpace(unittest.TestCase):
         ]
         self.assertIn(fixed, shared)
         self.assertIn("icub rank3 greedy, maintained minus fixed, summed reward:", shared)
+        self.assertIn(f"The fixed runs are read from {first}, not made again", shared)
+        self.assertIn("wall s per run", report.split("paired by seed")[-1])
+        self.assertNotIn("wall s per run", shared.split("paired by seed")[-1])
+        # (the kept report: the paths under its root)
+        command = shared.split("Command: `")[1].split("`")[0].replace(f"{self.output}/", "")
+        kept = adaptive_space_command.KeptReport(command, self.output)
+        relative = shared.split("\n\nFigures (")[0].replace(f"{self.output}/", "")
+        self.assertEqual(kept, relative)
         other = self.output / "other"
         with self.assertRaisesRegex(BatteryRefused, r"reach_greedy_fixed_seed0: evaluations"):
             self._Reaching(other, 2, 8, *icub, "--evaluations", "2", "--fixed-from", str(first))
+        with self.assertRaisesRegex(BatteryRefused, "none of the 2 fixed runs is finished there"):
+            self._Reaching(other, 2, 8, *icub, "--fixed-from", str(output))
         self.assertFalse(other.exists())
-        stderr = io.StringIO()
-        with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit) as exit:
-            adaptive_space_command.main(["--part", "reaching", "--fixed-from", str(other)])
-        self.assertEqual(exit.exception.code, 2)
-        self.assertIn(
-            f"error: --fixed-from: no reaching battery's runs in {other}", stderr.getvalue()
-        )
+        for arguments, message in (
+            (["--part", "reaching", "--fixed-from", str(other)], "no battery's runs in"),
+            (["--fixed-from", str(first)], "only with --part reaching"),
+            (
+                ["--part", "reaching", "--fixed-from", str(first), "--output", str(first)],
+                "is this battery's own folder",
+            ),
+        ):
+            stderr = io.StringIO()
+            with contextlib.redirect_stderr(stderr), self.assertRaises(SystemExit) as exit:
+                adaptive_space_command.main(arguments)
+            self.assertEqual(exit.exception.code, 2)
+            self.assertIn("error: --fixed-from: ", stderr.getvalue())
+            self.assertIn(message, stderr.getvalue())
 
     def test_the_reach_learner_on_a_roadmap(self):
         """The reaching part on the iCub's roadmap space (spacing 1.0: a few states), greedy, one

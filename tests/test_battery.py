@@ -127,6 +127,28 @@ class LocalBatteryTest(TemporaryFolder):
         with self.assertRaisesRegex(BatteryRefused, "count1: .*x"):
             FinishedResults(other, output)
 
+    def test_shared_results_may_differ_in_an_unused_argument_alone(self):
+        """Another battery reads the finished runs it shares (their recorded arguments theirs
+        but for the one named unused), runs nothing there, and is refused by name where they
+        differ in another; copied, the runs are read where they were copied, not run again,
+        and a run of the battery's own is not overwritten."""
+        source, output, calls = self.folder / "source", self.folder / "out", self.folder / "calls"
+        RunBattery(Counts(calls, 2), source, backend=InProcess(), progress=False)
+        tagged = [Job(j.name, Count, dict(j.kwargs, tag="other")) for j in Counts(calls, 3)]
+        self.assertEqual(
+            battery.SharedResults(tagged, source, "tag"), FinishedResults(Counts(calls), source)
+        )
+        with self.assertRaisesRegex(BatteryRefused, r"count0: tag: - -> other"):
+            battery.SharedResults(tagged, source)
+        mine = [Job("count1", Count, dict(x=7, calls=str(calls)))]
+        RunBattery(mine, output, backend=InProcess(), progress=False)
+        self.assertEqual(battery.CopySharedRuns(Counts(calls, 3), source, output), ["count0"])
+        self.assertEqual(len(Calls(calls)), 3)
+        RunBattery(Counts(calls, 1), output, backend=InProcess(), progress=False)
+        self.assertEqual(len(Calls(calls)), 3)  # (count0 read where it was copied)
+        with self.assertRaisesRegex(BatteryRefused, "count1: x: 7 -> 1"):
+            RunBattery(Counts(calls, 2), output, backend=InProcess(), progress=False)
+
     def test_killed_job_resumes_exactly(self):
         reference = RunBattery(Walks(), self.folder / "ref", backend=InProcess(), progress=False)
         output = self.folder / "out"

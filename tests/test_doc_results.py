@@ -118,11 +118,26 @@ class TestKeptBatteries(unittest.TestCase):
 
     def test_the_side_batterys_code_makes_the_batterys_runs(self):
         """docs/adaptive_space.md says a maintained roadmap run of the reaching battery, made
-        again with the code the side battery runs (its sparse ``ObservedOutcomes``), is the
-        battery's run, measure for measure, but for its wall time."""
+        again with 30c7f3e's code (its sparse ``ObservedOutcomes``), is the battery's run, of
+        the same arguments, measure for measure, but for its wall time."""
+        results = ROOT / "docs" / "results"
         self._AssertTheBatterysRunsButForWallTime(
             "adaptive_space_reaching_again", "adaptive_space_reaching", 1
         )
+        (run,) = (results / "adaptive_space_reaching_again").glob("runs/*")
+        made = results / "adaptive_space_reaching" / "runs" / run.name
+        self.assertEqual((run / "job.json").read_text(), (made / "job.json").read_text())
+        sittings = (results / "adaptive_space_reaching_again" / "sessions.jsonl").read_text()
+        self.assertEqual(
+            {(s["commit"][:7], s["changed"]) for s in map(json.loads, sittings.splitlines())},
+            {("30c7f3e", False)},
+        )
+        # (made beside other work: more than twice the battery's wall time, as the doc says)
+        again, battery = (
+            json.loads((folder / "result.json").read_text())["wall_seconds"]
+            for folder in (run, made)
+        )
+        self.assertGreater(again, 2 * battery)
 
     def _CheckQuotedDifferences(self, prose: str, tables: str) -> None:
         for difference in _DIFFERENCE.findall(prose):

@@ -5,6 +5,8 @@ import base64
 import math
 import pathlib
 import re
+import subprocess
+import sys
 import tempfile
 import unittest
 
@@ -339,6 +341,44 @@ class TestCameraAndScene(unittest.TestCase):
         for body in ("chest", "l_forearm", "head", "root_link"):
             self.assertFalse(meshcat.HasPath(f"{ghost}/{body}"), body)
             self.assertTrue(meshcat.HasPath(f"/drake/illustration/icub_iCubGazeboV2_5/iCub/{body}"))
+
+
+# A process that records a run in a Meshcat of its own (nothing holds it after) and writes a
+# space's figures (a model built with a Meshcat holds it in a cycle), then sets the cycle
+# collector off on another thread, as a battery's worker pool may: Drake ends a process whose
+# Meshcat is destroyed on another thread than its own.
+_MESHCAT_THREADS = """
+import gc, pathlib, sys, threading
+import numpy as np
+from mobee_drake.experiments.adaptive_space_figures import History, WriteSpaceFigures
+from mobee_drake.experiments.arms import Arms
+from mobee_drake.scenario import LoadScenario, RunScenario
+folder = pathlib.Path(sys.argv[1])
+RunScenario(LoadScenario(sys.argv[2], "{duration: 0.1}"), record=str(folder / "run.html"))
+history = History("icub, rank3", Arms()["icub"], np.full((2, 4), 0.5) + [[0], [0.1]], [])
+WriteSpaceFigures({"icub": [history]}, folder, "space")
+collector = threading.Thread(target=gc.collect)
+collector.start()
+collector.join()
+print("survived")
+"""
+
+
+class TestMeshcatThreads(unittest.TestCase):
+    def test_a_meshcat_made_for_a_while_is_gone_before_another_thread_collects(self):
+        """RunScenario's own recording Meshcat and the figures' scenes are destroyed on the
+        thread that made them, before their functions return (the figures' by
+        ``ReleaseMeshcats``)."""
+        with tempfile.TemporaryDirectory() as folder:
+            done = subprocess.run(
+                [sys.executable, "-c", _MESHCAT_THREADS, folder, str(REACH)],
+                capture_output=True,
+                text=True,
+                timeout=300,
+            )
+            self.assertEqual(done.returncode, 0, done.stderr[-600:])
+            self.assertEqual(done.stdout.split()[-1], "survived")
+            self.assertTrue((pathlib.Path(folder) / "space_icub.html").is_file())
 
 
 class TestLightMeshes(unittest.TestCase):

@@ -6,7 +6,8 @@ reaching part's (``--part reaching``) :mod:`mobee_drake.experiments.adaptive_spa
 this module builds their jobs, runs them in order (the roadmaps first, then for the reach
 learner the MDPs, then the runs), writes the report (``report.md`` in ``--output``, and the
 generated block of ``--doc``) and names a PNG and, per arm, a Meshcat scene of the first
-seed's maintained runs (:mod:`mobee_drake.experiments.adaptive_space_figures`).
+finished seed's maintained runs (:mod:`mobee_drake.experiments.adaptive_space_figures`). With
+``--fixed-from``, a reaching battery reads its fixed runs from another's folder.
 :func:`KeptReport` gives what a kept battery's ``--report-only`` reports now, for the tests
 that hold the docs to it.
 
@@ -50,6 +51,8 @@ from mobee_drake.experiments.arms import (
 from mobee_drake.experiments.battery import (
     AddBackendArguments,
     BackendOf,
+    BatteryRefused,
+    CopySharedRuns,
     FinishedResults,
     Job,
     RunBattery,
@@ -254,11 +257,11 @@ def _ReachingReport(
     args, maintenance: MaintenanceConfig, output: pathlib.Path, command: str, kept: bool = False
 ):
     """Runs the reaching part's battery, stage by stage (with ``--fixed-from``, the fixed runs
-    read from that battery's folder); its report (``kept``: :func:`KeptReport`'s)."""
+    read from that battery's folder: :func:`_SharedRuns`); its report (``kept``:
+    :func:`KeptReport`'s)."""
     stages = reaching_part.Stages(args, maintenance)
     fixed = reaching_part.FixedRuns(args, maintenance) if args.fixed_from else []
-    # (read first: a folder of runs of other arguments is refused before anything runs)
-    results = SharedResults(fixed, args.fixed_from, "maintenance") if fixed else {}
+    results = _SharedRuns(args, stages, fixed, output, kept) if fixed else {}
     for description, jobs in stages:
         results.update(_Results(args, jobs, output, description, kept))
     runs = [
@@ -285,7 +288,9 @@ def _ReachingReport(
     run_jobs = [job for _, jobs in stages for job in jobs if job.name.startswith("reach_")]
     run_jobs += fixed
     missing = reaching_part.MissingRuns(run_jobs, results)
-    report = reaching_part.Report(runs, command, targets, roadmaps, mdps, nearness, missing)
+    report = reaching_part.Report(
+        runs, command, targets, roadmaps, mdps, nearness, missing, args.fixed_from
+    )
     if kept:
         return report
     with OwnedFolder(output, "battery"):
@@ -297,6 +302,24 @@ def _ReachingReport(
             f"strategy where it ran): {', '.join(figures)}."
         )
     return report
+
+
+def _SharedRuns(args, stages: list, fixed: list[Job], output: pathlib.Path, kept: bool) -> dict:
+    """The results of the ``fixed`` runs finished in ``--fixed-from``'s folder, read before
+    anything runs (a folder of other arguments, or of none of them, is refused); unless only
+    reporting, the roadmaps and MDPs made there are copied here first (where this battery has
+    none of its own), so that its maintained runs read the very files the fixed ones did."""
+    source = args.fixed_from_folder
+    shared = SharedResults(fixed, source, "maintenance")
+    if not shared:
+        raise BatteryRefused(
+            f"{source}: none of the {len(fixed)} fixed runs is finished there (--fixed-from)"
+        )
+    if not (kept or args.report_only):
+        support = [job for _, jobs in stages for job in jobs if not job.name.startswith("reach_")]
+        with OwnedFolder(output, "battery"):
+            CopySharedRuns(support, source, output)
+    return shared
 
 
 def EndedSpaces(runs: list, output: pathlib.Path, robot: str, space: str) -> list[np.ndarray]:
@@ -329,7 +352,7 @@ def ReachSpaceHistories(runs: list, output: pathlib.Path) -> dict[str, list]:
         if initial is None:  # (its roadmap is not there: nothing to draw it from)
             continue
         changes = SpaceChanges(output / "runs" / name / "checkpoint", "learner")
-        title = f"{robot}, {space}, {strategy}, seed{seed}"
+        title = f"{robot}, {space}, {strategy}, seed {seed}"
         histories[robot].append(
             History(title, arms[robot], initial, changes, ReachTargets(arms[robot]))
         )
@@ -387,6 +410,16 @@ def _Output(args) -> pathlib.Path:
     return pathlib.Path(args.output or default)
 
 
+def _CheckFixedFrom(parser, args, output: pathlib.Path) -> None:
+    """Refuses a ``--fixed-from`` that cannot give this battery its fixed runs."""
+    if args.part != "reaching":
+        parser.error("--fixed-from: only with --part reaching")
+    if not (args.fixed_from / "runs").is_dir():
+        parser.error(f"--fixed-from: no battery's runs in {args.fixed_from}")
+    if args.fixed_from.resolve() == output.resolve():
+        parser.error(f"--fixed-from: {args.fixed_from} is this battery's own folder (--output)")
+
+
 def KeptReport(command: str, root: pathlib.Path) -> str:
     """The report that ``command`` (a ``--report-only`` command as a doc's generated block
     names it, its paths relative to ``root``) gives from the runs finished in its folder now,
@@ -395,8 +428,7 @@ def KeptReport(command: str, root: pathlib.Path) -> str:
     parser = _Parser()
     args = parser.parse_args(shlex.split(command)[3:])  # (after "mobee-drake experiment ...")
     output = root / _Output(args)
-    if args.fixed_from:
-        args.fixed_from = root / args.fixed_from
+    args.fixed_from_folder = args.fixed_from and root / args.fixed_from
     return _REPORTS[args.part](args, _Maintenance(parser, args), output, command, kept=True)
 
 
@@ -409,8 +441,9 @@ def main(argv: list[str] | None = None) -> None:
     CheckDocBlocks(parser, args.doc, block)
     maintenance = _Maintenance(parser, args)
     output = _Output(args)
-    if args.fixed_from and not (args.part == "reaching" and (args.fixed_from / "runs").is_dir()):
-        parser.error(f"--fixed-from: no reaching battery's runs in {args.fixed_from}")
+    args.fixed_from_folder = args.fixed_from  # (KeptReport's is under its root)
+    if args.fixed_from:
+        _CheckFixedFrom(parser, args, output)
     if args.report_only and not any(output.glob("runs/*/result.json")):
         parser.error(f"--report-only: no finished runs in {output / 'runs'}")
     command = ("mobee-drake experiment adaptive-space " + shlex.join(argv or [])).strip()

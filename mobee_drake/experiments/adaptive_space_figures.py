@@ -18,6 +18,7 @@ from mobee_drake.atomic_files import WriteTextAtomically
 from mobee_drake.experiments.arms import Arms
 from mobee_drake.experiments.plots import Legend, SaveFigure
 from mobee_drake.ngik.kinematic_model import KinematicModel
+from mobee_drake.station.viewer import ReleaseMeshcats
 from mobee_drake.world.live_world import ROLE_COLORS, MakeShape, ObjectPose
 
 # The colours of the kept, removed and added states.
@@ -198,33 +199,38 @@ def WriteSpaceFigures(
     """``<stem>.png`` and, per robot, ``<stem>_<robot>.html`` (Meshcat, with the robot at home,
     its world's objects and the reach targets: a recording of its spaces as they changed) in
     ``output``, of ``histories`` (per robot, its spaces' histories, titled "<robot>, <space>" or
-    "<robot>, <space>, <strategy>, seed<n>"); their names."""
+    "<robot>, <space>, <strategy>, seed <n>"); their names."""
     if not histories:
         return []
     written = [f"{stem}.png"]
     SaveFigure(Figure([h for hs in histories.values() for h in hs]), output / written[0])
-    arms = Arms()
     for robot, robot_histories in histories.items():
-        meshcat = Meshcat()
-        model = KinematicModel(arms[robot].robot, list(arms[robot].objects), meshcat=meshcat)
-        model.Publish(model.home)
-        ShowObjects(meshcat, arms[robot].objects)
-        meshcat.StartRecording(frames_per_second=10, set_visualizations_while_recording=False)
-        # (the space that changed most is shown; the rest are in the tree)
-        shown = max(robot_histories, key=lambda h: len(h.removed) + len(h.added))
-        for history in robot_histories:
-            path = "spaces/" + "/".join(history.title.split(", ")[1:])
-            ShowSpace(meshcat, history, path)
-            meshcat.SetProperty(path, "visible", history is shown)
-        meshcat.PublishRecording()
-        for k, centre in enumerate(shown.targets):
-            meshcat.SetObject(f"targets/{k}", Sphere(shown.target_radius), _RGBA["target"])
-            meshcat.SetTransform(f"targets/{k}", RigidTransform(centre))
-        points = np.vstack([h.points for h in robot_histories])
-        centre = points.mean(axis=0)
-        spread = np.linalg.norm(points - centre, axis=1).max()  # (all in view: 1.5 times it)
-        direction = np.array([-0.9, 0.5, 0.45]) / np.linalg.norm([-0.9, 0.5, 0.45])
-        meshcat.SetCameraPose(centre + max(1.5 * spread, 0.3) * direction, centre)
         written.append(f"{stem}_{robot}.html")
-        WriteTextAtomically(output / written[-1], meshcat.StaticHtml())
+        _WriteScene(robot, robot_histories, output / written[-1])
+        ReleaseMeshcats()  # (its Meshcat, on this thread)
     return written
+
+
+def _WriteScene(robot: str, histories: list[SpaceHistory], path: pathlib.Path) -> None:
+    """The Meshcat scene of ``robot``'s ``histories`` (:func:`WriteSpaceFigures`) at ``path``."""
+    meshcat, arm = Meshcat(), Arms()[robot]
+    model = KinematicModel(arm.robot, list(arm.objects), meshcat=meshcat)
+    model.Publish(model.home)
+    ShowObjects(meshcat, arm.objects)
+    meshcat.StartRecording(frames_per_second=10, set_visualizations_while_recording=False)
+    # (the space that changed most is shown; the rest are in the tree)
+    shown = max(histories, key=lambda h: len(h.removed) + len(h.added))
+    for history in histories:
+        node = "spaces/" + "/".join(history.title.split(", ")[1:3])  # (space, strategy)
+        ShowSpace(meshcat, history, node)
+        meshcat.SetProperty(node, "visible", history is shown)
+    meshcat.PublishRecording()
+    for k, centre in enumerate(shown.targets):
+        meshcat.SetObject(f"targets/{k}", Sphere(shown.target_radius), _RGBA["target"])
+        meshcat.SetTransform(f"targets/{k}", RigidTransform(centre))
+    points = np.vstack([h.points for h in histories])
+    centre = points.mean(axis=0)
+    spread = np.linalg.norm(points - centre, axis=1).max()  # (all in view: 1.5 times it)
+    direction = np.array([-0.9, 0.5, 0.45]) / np.linalg.norm([-0.9, 0.5, 0.45])
+    meshcat.SetCameraPose(centre + max(1.5 * spread, 0.3) * direction, centre)
+    WriteTextAtomically(path, meshcat.StaticHtml())

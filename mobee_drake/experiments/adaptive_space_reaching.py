@@ -264,7 +264,7 @@ def _RunJobs(
 
 def MissingRuns(jobs: list[Job], results: dict) -> dict[tuple, list[int]]:
     """Per setting (robot, space, strategy, condition), the seeds of ``jobs`` without a
-    result in ``results`` (failed, or not yet run)."""
+    result in ``results`` (failed, or not finished)."""
     missing = collections.defaultdict(list)
     for job in jobs:
         if job.name not in results:
@@ -284,8 +284,8 @@ def _MissingLines(missing: dict[tuple, list[int]]) -> list[str]:
     )
     return [
         "",
-        f"Runs without a result ({sum(map(len, missing.values()))}: failed, or not yet run; "
-        f"their seeds are left out of their settings' pairs): {named}.",
+        f"Runs without a result ({sum(map(len, missing.values()))}: failed, or not finished; "
+        f"the comparisons leave out the pairs they belong to): {named}.",
     ]
 
 
@@ -317,6 +317,7 @@ def Report(
     mdps: dict | None = None,
     nearness: dict | None = None,
     missing: dict | None = None,
+    fixed_from: pathlib.Path | None = None,
 ) -> str:
     """The report's table, the "trm" spaces' roadmaps (``roadmaps``: per robot, its roadmap
     job's result), how near each space's states lie to the valid configurations
@@ -326,7 +327,9 @@ def Report(
     :class:`~mobee_drake.reaching.targets.TargetGrid`; per space, each target's distance to the
     nearest state's marker, :func:`~mobee_drake.experiments.arms.TargetGaps`; and per space,
     the same on the space each maintained run ended with), the targets and how near each space
-    comes to them, and the runs without a result (``missing``, :func:`MissingRuns`'s; markdown)."""
+    comes to them, and the runs without a result (``missing``, :func:`MissingRuns`'s); with
+    ``fixed_from``, the fixed runs were read from that battery's folder, made in its sittings,
+    so their wall time is not compared (markdown)."""
     group = BySetting(runs, ("robot", "space", "strategy", "condition"))
     lines = [
         "| robot | space | strategy | condition | runs | problem-tries | summed reward | without "
@@ -352,6 +355,13 @@ def Report(
         ),
         "wall s per run": lambda r: r.wall_seconds,
     }
+    if fixed_from:
+        del costs["wall s per run"]
+        lines += [
+            "",
+            f"The fixed runs are read from {fixed_from}, not made again: made in that battery's "
+            "sittings, with its code, so their wall time is not compared with this battery's.",
+        ]
     lines += _MissingLines(missing or {})
     lines += RoadmapLines(roadmaps or {}) + NearnessLines(nearness or {})
     if mdps:

@@ -93,6 +93,7 @@ import pathlib
 import pickle
 import re
 import select
+import shutil
 import signal
 import socket
 import subprocess
@@ -606,11 +607,13 @@ def FinishedResults(jobs: Iterable[Job], output: str | pathlib.Path) -> dict[str
     return {name: result for name, result in results.items() if result is not None}
 
 
-def SharedResults(jobs: Iterable[Job], output: str | pathlib.Path, unused: str) -> dict[str, dict]:
+def SharedResults(
+    jobs: Iterable[Job], output: str | pathlib.Path, unused: str | None = None
+) -> dict[str, dict]:
     """The stored results of those of ``jobs`` that have finished in another battery's
-    ``output``, whose recorded arguments may differ from theirs in the argument ``unused``
-    alone: one their function does not use for these jobs (a battery that reads the runs it
-    shares with another rather than make them again). Runs and writes nothing.
+    ``output``, whose recorded arguments are theirs, but maybe for the argument ``unused``: one
+    their function does not use for these jobs (a battery that reads the runs it shares with
+    another rather than make them again). Runs and writes nothing.
 
     Raises:
         BatteryRefused: When a finished job's recorded arguments differ in another one.
@@ -618,19 +621,44 @@ def SharedResults(jobs: Iterable[Job], output: str | pathlib.Path, unused: str) 
     output, results, mismatches = pathlib.Path(output).absolute(), {}, []
     for job in jobs:
         result = _StoredResult(output, job.name)
-        if result is None:
-            continue
-        recorded = json.loads((output / "runs" / job.name / ARGUMENTS).read_text())
-        own = json.loads(_ArgumentsText(job))
-        for arguments in (recorded, own):
-            arguments.pop(unused, None)
-        if recorded != own:
-            differences = YamlDifferences(json.dumps(recorded), json.dumps(own))
-            mismatches.append(f"{job.name}: {'; '.join(differences[:3])}")
-        results[job.name] = result
-    if mismatches:
-        raise _Refusal(output, f"its runs were made with other arguments than {unused}", mismatches)
+        if result is not None:
+            mismatches.append(_Mismatch(job, output, unused))
+            results[job.name] = result
+    if any(mismatches):
+        but = f" but for {unused}" if unused else ""
+        raise _Refusal(output, f"holds runs of other arguments than ours{but}", mismatches)
     return results
+
+
+def CopySharedRuns(jobs: Iterable[Job], source: str | pathlib.Path, output: pathlib.Path) -> list:
+    """Copies into ``output`` (a battery's folder, owned) the runs of ``jobs`` finished in
+    another battery's ``source`` with the same arguments, where ``output`` has none of its own:
+    the battery then reads the very files the other one made. The names copied.
+
+    Raises:
+        BatteryRefused: As :func:`SharedResults`.
+    """
+    copied = []
+    for name in SharedResults(jobs, source):
+        if not (output / "runs" / name).exists():
+            shutil.copytree(pathlib.Path(source) / "runs" / name, output / "runs" / name)
+            copied.append(name)
+    return copied
+
+
+def _Mismatch(job: Job, output: pathlib.Path, unused: str | None = None) -> str | None:
+    """What the arguments recorded in ``job``'s folder in ``output`` differ in from its own
+    (but for ``unused``), named; None when they are the same."""
+    path = output / "runs" / job.name / ARGUMENTS
+    if not path.is_file():
+        return f"{job.name}: its folder holds a run without recorded arguments"
+    recorded, own = json.loads(path.read_text()), json.loads(_ArgumentsText(job))
+    for arguments in (recorded, own):
+        arguments.pop(unused, None)
+    recorded, own = (json.dumps(a, sort_keys=True) for a in (recorded, own))
+    if recorded == own:
+        return None
+    return f"{job.name}: {'; '.join(YamlDifferences(recorded, own)[:3])}"
 
 
 def _CheckArguments(jobs: list[Job], output: pathlib.Path) -> None:
@@ -645,17 +673,10 @@ def _CheckArguments(jobs: list[Job], output: pathlib.Path) -> None:
 def _RefuseOtherArguments(jobs: list[Job], output: pathlib.Path) -> None:
     mismatches = []
     for job in jobs:
-        path, text = output / "runs" / job.name / ARGUMENTS, _ArgumentsText(job)
-        if not path.is_file():
-            if (output / "runs" / job.name).is_dir() and any(
-                (output / "runs" / job.name).iterdir()
-            ):
-                mismatches.append(f"{job.name}: its folder holds a run without recorded arguments")
-            continue
-        if path.read_text() != text:
-            differences = YamlDifferences(path.read_text(), text)
-            mismatches.append(f"{job.name}: {'; '.join(differences[:3])}")
-    if mismatches:
+        folder = output / "runs" / job.name
+        if (folder / ARGUMENTS).is_file() or (folder.is_dir() and any(folder.iterdir())):
+            mismatches.append(_Mismatch(job, output))
+    if any(mismatches):
         raise _Refusal(
             output,
             "holds runs of other arguments",
@@ -667,6 +688,7 @@ def _RefuseOtherArguments(jobs: list[Job], output: pathlib.Path) -> None:
 def _Refusal(output: pathlib.Path, what: str, mismatches: list[str], advice: str = ""):
     """The refusal of a battery whose ``output`` holds runs of other arguments than its jobs'
     (``what``), naming the first three ``mismatches``."""
+    mismatches = [m for m in mismatches if m]
     more = f" | and {len(mismatches) - 3} more" if len(mismatches) > 3 else ""
     return BatteryRefused(f"{output}: {what} ({' | '.join(mismatches[:3])}{more}){advice}")
 

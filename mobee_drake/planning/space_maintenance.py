@@ -43,6 +43,7 @@ from collections.abc import Iterable
 import copy
 import dataclasses as dc
 import math
+import pathlib
 from typing import ClassVar
 
 import numpy as np
@@ -209,31 +210,45 @@ class SpaceTooLarge(MemoryError):
     """A round planned a space whose learned model would not fit in the memory available."""
 
 
-def AvailableMemory() -> int | None:
-    """The bytes the system says it can give without swapping (Linux's ``MemAvailable``);
-    None where it does not say."""
+# A round holds about this many copies of the outcome counts at once (the model's, the
+# carried one and the rows moved into it; a reach learner's then its own and its T).
+COUNTS_COPIES = 3
+
+
+def AvailableMemory(meminfo: str = "/proc/meminfo", cgroup: str = "/sys/fs/cgroup") -> int | None:
+    """The bytes this process could still take: Linux's ``MemAvailable`` and free swap, or the
+    room left under its cgroup's limit if that is less; None where the system does not say."""
     try:
-        with open("/proc/meminfo") as meminfo:
-            for line in meminfo:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
+        lines = pathlib.Path(meminfo).read_text().splitlines()
+        info = dict(line.split(":", 1) for line in lines)
+        available = 1024 * sum(int(info[key].split()[0]) for key in ("MemAvailable", "SwapFree"))
+    except (OSError, KeyError, ValueError):
+        return None
+    cgroup = pathlib.Path(cgroup)
+    try:
+        limit = (cgroup / "memory.max").read_text().strip()
+        if limit != "max":
+            used = int((cgroup / "memory.current").read_text())
+            available = min(available, int(limit) - used)
+    except (OSError, ValueError):
         pass
-    return None
+    return available
 
 
-def _CheckModelFits(space: StateActionSpace, step: int) -> None:
+def _CheckModelFits(space: StateActionSpace, done: int) -> None:
     """Refuses a planned ``space`` whose outcome counts (dense: state-actions by states, as
-    :class:`~mobee_drake.planning.curiosity.TransitionCounts` holds them) would need more
-    memory than is available, naming the round and what would bound it, rather than fail deep
-    in the carry with numpy's bare MemoryError."""
-    needed, available = 8 * space.num_state_actions * space.num_states, AvailableMemory()
-    if available is not None and needed > available:
+    :class:`~mobee_drake.planning.curiosity.TransitionCounts` holds them), at
+    :data:`COUNTS_COPIES` copies, would need more memory than is available, naming the round
+    and what would bound it, rather than fail deep in the carry with numpy's bare MemoryError
+    (or the machine's OOM killer)."""
+    copy, available = 8 * space.num_state_actions * space.num_states, AvailableMemory()
+    if available is not None and COUNTS_COPIES * copy > available:
         raise SpaceTooLarge(
-            f"space maintenance at step {step}: the round planned {space.num_states} states and "
-            f"{space.num_state_actions:,} state-actions, whose outcome counts need "
-            f"{needed / 2**30:.1f} GiB, more than the {available / 2**30:.1f} GiB available; "
-            "bound the space (max_states, or a smaller join_within)"
+            f"space maintenance after {done} actions (or problem-tries): the round planned "
+            f"{space.num_states} states and {space.num_state_actions:,} state-actions, whose "
+            f"outcome counts need {copy / 2**30:.1f} GiB a copy, and a round holds about "
+            f"{COUNTS_COPIES}: more than the {available / 2**30:.1f} GiB available; bound the "
+            "space (max_states, or a smaller join_within)"
         )
 
 

@@ -1,6 +1,7 @@
 """Meshcat: the robot and its world, the attractor as a translucent robot, the trail of a marker,
 and MoBeE's workspace forces: field forces at witness points, client forces at markers."""
 
+import gc
 import logging
 import math
 
@@ -52,6 +53,15 @@ COLLISION_LAYER_FRAMES = 4
 # The smallest motion of a body the viewer sends (m, or in its rotation matrix's entries, about
 # 0.006 degrees): far below a pixel (see PoseStreamer).
 POSE_TOLERANCE = 1e-4
+
+
+def ReleaseMeshcats() -> None:
+    """Destroys now, on this thread, the Meshcats that only reference cycles still hold (a
+    model built with one holds it so). Drake ends the process when a Meshcat is destroyed on
+    another thread than the one that made it, as Python's cycle collector would do from
+    whichever thread next sets it off (a battery's worker pool, say): call this on the
+    Meshcat's thread once a function's Meshcat and what was built with it are dropped."""
+    gc.collect()
 
 
 def RecordingMeshcat() -> Meshcat:
