@@ -73,6 +73,10 @@ class TestPredictors(unittest.TestCase):
         self.assertAlmostEqual(ReachReward([0.3, 0, 0.4], [0, 0, 0]), 1 / 1.5)
         self.assertEqual(TransitionReward(0.2, 0.3), 0.0)
         self.assertEqual(TransitionReward(0.3, 0.3), FAILED_TRANSITION_REWARD)
+        # Equal but for the rounding of a sum taken in another order: no climb.
+        self.assertEqual(TransitionReward(0.3, 0.1 + 0.2), FAILED_TRANSITION_REWARD)
+        self.assertGreater(0.1 + 0.2, 0.3)
+        self.assertEqual(TransitionReward(0.3, 0.3 + 1e-9), 0.0)
 
     def test_distance_unit(self):
         from mobee_drake.reaching.predictors import PredictorConfig

@@ -24,7 +24,7 @@ from mobee_drake.atomic_files import CurrentGeneration
 from mobee_drake.planning.curiosity import TransitionCounts
 from mobee_drake.planning.state_space import StateActionSpace
 from mobee_drake.planning.strategies import STRATEGIES
-from mobee_drake.planning.value_iteration import ValueIteration
+from mobee_drake.planning.value_iteration import VALUE_TIE, ValueIteration
 
 INITIALIZATIONS = {"50-50": 1, "60-40": 2}  # successes observed after the one failure
 
@@ -110,7 +110,7 @@ class Explorer:
         if len(actions) == 0:
             raise ValueError(f"state {state} has no actions")
         scores = STRATEGIES[self.config.strategy].Scores(self, actions)
-        best = actions[np.flatnonzero(scores >= scores.max() - 1e-12)]
+        best = actions[np.flatnonzero(scores >= scores.max() - VALUE_TIE)]
         return int(self.rng.choice(best))
 
     def Observe(self, state_action: int, outcome: int) -> float:

@@ -11,6 +11,10 @@ state without actions has value 0.
 import numpy as np
 from scipy import sparse
 
+# Values (and the scores made of them) within this of each other are equal: what parts them is
+# the rounding of sums taken in another order (a sparse T's, a dense T's).
+VALUE_TIE = 1e-12
+
 
 def ValueIteration(
     transitions: np.ndarray | sparse.sparray,

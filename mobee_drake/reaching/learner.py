@@ -68,7 +68,7 @@ from scipy import sparse
 from mobee_drake.planning.curiosity import SetProbabilityRow, TransitionCounts
 from mobee_drake.planning.space_maintenance import SpaceEdit
 from mobee_drake.planning.state_space import StateActionSpace
-from mobee_drake.planning.value_iteration import ValueIteration
+from mobee_drake.planning.value_iteration import VALUE_TIE, ValueIteration
 from mobee_drake.reaching.goals import GoalBabbler, ReachGoalsConfig
 from mobee_drake.reaching.predictors import (
     PredictorConfig,
@@ -343,11 +343,11 @@ class ReachLearner:
         return q, v
 
     def _Greedy(self, q: np.ndarray, state: int, rng) -> int:
-        """The greedy state-action of ``state``; among equal values (within 1e-12) the first
+        """The greedy state-action of ``state``; among equal values (``VALUE_TIE``) the first
         (``tie_break`` "first", no draw from ``rng``) or a random one."""
         actions = self.Actions(state)
         scores = q[actions]
-        best = actions[scores >= scores.max() - 1e-12]
+        best = actions[scores >= scores.max() - VALUE_TIE]
         return int(best[0] if self.config.EffectiveTieBreak() == "first" else rng.choice(best))
 
     # ------------------------------------------------------------------------------------------

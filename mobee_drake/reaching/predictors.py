@@ -39,6 +39,8 @@ import dataclasses as dc
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
+from mobee_drake.planning.value_iteration import VALUE_TIE
+
 PREDICTORS = ("weighted", "gaussian_process")
 # The readings of eq. 8.1 (see the module's docstring).
 EQ81_READINGS = ("printed", "prose")
@@ -92,8 +94,9 @@ def ReachReward(x: np.ndarray, target: np.ndarray, unit: float = 1.0) -> float:
 
 
 def TransitionReward(value_before: float, value_after: float) -> float:
-    """Ch. 8.1: 0 when the transition climbed the value function, else the failure penalty."""
-    return 0.0 if value_after > value_before else FAILED_TRANSITION_REWARD
+    """Ch. 8.1: 0 when the transition climbed the value function, else the failure penalty;
+    values equal but for rounding (``VALUE_TIE``) did not climb."""
+    return 0.0 if value_after > value_before + VALUE_TIE else FAILED_TRANSITION_REWARD
 
 
 def WeightedEstimate(
