@@ -9,13 +9,15 @@ from unittest import mock
 
 from mobee_drake.reaching import appearance
 from mobee_drake.reaching.appearance import AppearanceCounts, AppearanceWatch
+from mobee_drake.reaching.targets import TARGET_NAME
 
 
 class _Robot:
-    """Counts penetrating periods as the test says; a target is inside iff it is "inside"."""
+    """Counts penetrating periods as the test says; a target is inside iff it is "inside", and
+    the arm is inside itself while ``wedged``."""
 
     def __init__(self):
-        self.penetrating, self.target = 0, None
+        self.penetrating, self.target, self.wedged = 0, None, False
         self.station, self.context = types.SimpleNamespace(diagram=None), None
 
     def Safety(self):
@@ -28,16 +30,17 @@ class _Robot:
         return 7
 
 
-def _Penetrations(robot: _Robot):
+def _Pairs(robot: _Robot):
     return lambda diagram, context: (
-        ["the robot: 'r_hand' inside 'target'"] * (robot.target == "inside")
+        [(-0.01, "the robot", "r_hand", TARGET_NAME)] * (robot.target == "inside")
+        + [(-0.04, "the robot", "r_forearm", "r_upper_arm")] * robot.wedged
     )
 
 
 class AppearanceWatchTest(unittest.TestCase):
     def test_penetrations_split_by_where_the_target_appeared(self):
         robot = _Robot()
-        with mock.patch.object(appearance, "Penetrations", _Penetrations(robot)):
+        with mock.patch.object(appearance, "PenetratingPairs", _Pairs(robot)):
             watched = AppearanceWatch(robot)
             watched.SetProblem("inside")
             robot.penetrating += 3  # (the arm pushed out of the target: the draw's)
@@ -59,6 +62,25 @@ class AppearanceWatchTest(unittest.TestCase):
         watched.space = "reshaped"  # (a space keeper sets the robot's space through the watch)
         self.assertEqual(robot.space, "reshaped")
         self.assertNotIn("space", vars(watched))
+
+    def test_a_robot_inside_itself_is_not_set_aside_as_the_draws(self):
+        """A target that appears while the arm is wedged inside itself is not counted as one
+        that appeared inside; one that appeared inside, alone, but whose problem ends with the
+        arm inside itself (the push out drove it there) has its periods counted among the
+        others; a target alone inside at both ends is the draw's."""
+        robot = _Robot()
+        with mock.patch.object(appearance, "PenetratingPairs", _Pairs(robot)):
+            watched = AppearanceWatch(robot)
+            watched.SetProblem("inside")
+            robot.penetrating += 3  # (pushed out, cleanly: the draw's)
+            robot.target = "gone"
+            watched.SetProblem("inside")
+            robot.penetrating, robot.wedged = robot.penetrating + 20, True  # (into itself)
+            watched.SetProblem("inside")  # (appears while the arm is inside itself)
+            robot.penetrating += 40
+            watched.Close()
+        self.assertEqual(watched.counts.appeared_inside, 2)
+        self.assertEqual(watched.counts.other_penetrating_steps, 20 + 40)
 
     def test_a_reports_cell_sums_the_split_or_says_it_is_unknown(self):
         """Two runs' periods summed: all / the other problems' (problems whose target appeared

@@ -5,22 +5,31 @@ appear inside the hand or the forearm; MoBeE then pushes the arm out of it, and 
 safety monitor counts the periods the two solids overlap as penetrating. Those periods are the
 draw's, not a failure of MoBeE's safety: a run's penetrating periods are only a safety measure
 once they are split into the problems whose target appeared inside the robot and the rest.
+
+A problem's periods are set aside as the draw's only when its target's pairs alone penetrate
+when it appears, and none but its target's when it ends: a robot already inside itself or an
+object when a target appears, or left so at the problem's end (a push out of a target that
+drove the arm into itself), counts among the rest. (Before, any penetration at the target's
+appearance set the whole problem aside: a Katana wedged inside itself for most of a run counted
+as targets appearing inside it, docs/adaptive_space.md.)
 """
 
 import dataclasses as dc
 
 import numpy as np
 
-from mobee_drake.station.safety import Penetrations
+from mobee_drake.reaching.targets import TARGET_NAME
+from mobee_drake.station.safety import PenetratingPairs
 
 
 @dc.dataclass
 class AppearanceCounts:
     """What an :class:`AppearanceWatch` has seen so far (and where its current problem began)."""
 
-    # Problems whose target appeared inside the robot.
+    # Problems whose target appeared inside the robot, nothing else penetrating.
     appeared_inside: int = 0
-    # Penetrating control periods of the other problems.
+    # Penetrating control periods of the other problems (and of those that ended with something
+    # but their target penetrating).
     other_penetrating_steps: int = 0
     # The open problem: whether its target appeared inside (None: none is open), and the
     # robot's penetrating periods when it appeared (its own are the difference at its end).
@@ -50,10 +59,16 @@ class AppearanceWatch:
     def _Penetrating(self) -> int:
         return self.robot.Safety().penetrating_steps
 
+    def _Pairs(self) -> tuple[bool, bool]:
+        """Whether a pair with the target penetrates, and whether a pair without it does."""
+        pairs = PenetratingPairs(self.robot.station.diagram, self.robot.context)
+        targets = [TARGET_NAME in (a, b) for _, _, a, b in pairs]
+        return any(targets), not all(targets)
+
     def Close(self) -> None:
         """Ends the current problem's count (call once after the last problem)."""
         c = self.counts
-        if c.current_inside is False:
+        if c.current_inside is False or (c.current_inside and self._Pairs()[1]):
             c.other_penetrating_steps += self._Penetrating() - c.current_start
         c.current_inside = None
 
@@ -61,6 +76,7 @@ class AppearanceWatch:
         self.Close()
         self.robot.SetProblem(target)
         c = self.counts
-        c.current_inside = bool(Penetrations(self.robot.station.diagram, self.robot.context))
+        target, others = self._Pairs()
+        c.current_inside = target and not others
         c.current_start = self._Penetrating()
         c.appeared_inside += c.current_inside

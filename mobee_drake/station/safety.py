@@ -111,9 +111,9 @@ class StartsInPenetrationError(ValueError):
     """A run whose robot starts inside an object or itself (the message names the pairs)."""
 
 
-def Penetrations(diagram, root_context) -> list[str]:
+def PenetratingPairs(diagram, root_context) -> list[tuple[float, str, str, str]]:
     """Each pair of solids that penetrates at ``root_context``, for every MoBeE in ``diagram``:
-    ``the robot: 'r_hand' 12.3 mm inside 'table'``, deepest first."""
+    (signed distance (m, < 0), the robot, solid A, solid B), deepest first."""
     found = []
     for system in diagram.GetSystems():
         if isinstance(system, Mobee):
@@ -123,7 +123,15 @@ def Penetrations(diagram, root_context) -> list[str]:
             for contact in system.GetOutputPort("field_contacts").Eval(context):
                 if contact.distance < 0:
                     found.append((contact.distance, robot, contact.name_A, contact.name_B))
-    return [f"{r}: '{a}' {-1000 * d:.1f} mm inside '{b}'" for d, r, a, b in sorted(found)]
+    return sorted(found)
+
+
+def Penetrations(diagram, root_context) -> list[str]:
+    """:func:`PenetratingPairs` in words: ``the robot: 'r_hand' 12.3 mm inside 'table'``."""
+    return [
+        f"{r}: '{a}' {-1000 * d:.1f} mm inside '{b}'"
+        for d, r, a, b in PenetratingPairs(diagram, root_context)
+    ]
 
 
 def CheckStart(diagram, root_context) -> None:
