@@ -139,6 +139,51 @@ class TestKeptBatteries(unittest.TestCase):
         )
         self.assertGreater(again, 2 * battery)
 
+    def test_the_wedged_katanas_probe_is_the_batterys_run_and_the_docs_figures(self):
+        """docs/adaptive_space.md's account of the Katana's run wedged inside itself is its
+        probe's (scripts/probe_penetrations.py): the battery's run but for its wall time; the
+        problems that ended with the arm inside itself, from the first on every one, their
+        periods, the first's start and the later problems' lengths."""
+        results = ROOT / "docs" / "results"
+        name = "reach_katana_random_maintained_seed1"
+        probe = json.loads((results / "adaptive_space_reaching_probe" / f"{name}.json").read_text())
+        made = json.loads(
+            (results / "adaptive_space_reaching/runs" / name / "result.json").read_text()
+        )
+        kept = probe["result"]
+        self.assertEqual({k for k in kept | made if kept.get(k) != made.get(k)}, {"wall_seconds"})
+        problems = probe["problems"]
+        self.assertEqual(len(problems), made["appeared_inside"])
+        wedged = [
+            i
+            for i, p in enumerate(problems)
+            if any("'reach_target'" not in pair for pair in p["at_end"])
+        ]
+        self.assertEqual(wedged, list(range(wedged[0], len(problems))))
+        periods = sum(problems[i]["periods"] for i in wedged)
+        first = problems[wedged[0]]
+        self.assertTrue(all("'reach_target'" in pair for pair in first["at_start"]))
+        later = problems[wedged[0] + 1 :]
+        self.assertTrue(
+            all(p["at_start"] and "'reach_target'" not in p["at_start"][0] for p in later)
+        )
+        lengths = " or ".join(str(n) for n in sorted({p["periods"] for p in later}))
+        doc = _Folded((ROOT / "docs" / "adaptive_space.md").read_text())
+        for text in (
+            f"counts {made['penetrating_steps']:,} penetrating periods, all among the "
+            f"{len(problems)} problems",
+            f"{len(wedged)} of its {len(problems)} problems ended with the arm's own solids",
+            f"({first['at_end'][0].removeprefix('the robot: ')},",
+            f"those hold {periods:,} of its {made['penetrating_steps']:,} penetrating periods",
+            f"the {wedged[0] + 1}th such problem",
+            f"({first['at_start'][0].removeprefix('the robot: ')})",
+            f"lasted {lengths} control periods",
+            f"with {probe['commit'][:7]}'s code",
+        ):
+            with self.subTest(text=text):
+                self.assertIn(text, doc)
+        self.assertEqual(made["other_penetrating_steps"], 0)
+
     def _CheckQuotedDifferences(self, prose: str, tables: str) -> None:
         for difference in _DIFFERENCE.findall(prose):
             with self.subTest(difference=difference):

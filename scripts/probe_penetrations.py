@@ -1,0 +1,90 @@
+"""Makes one run of the adaptive-space reaching battery again, in this process, and records for
+every problem whose target appeared inside the robot (as the run's ``AppearanceWatch`` counts
+them) its target, its penetrating control periods, and the pairs of solids penetrating when the
+target appeared and when the problem ended (``safety.Penetrations``).
+
+The battery's report splits the penetrating periods by whether a problem's target appeared
+inside the robot; this shows what the periods it sets aside were.
+
+Run from the project's root: ``python scripts/probe_penetrations.py
+reach_katana_random_maintained_seed1 --battery docs/results/adaptive_space_reaching --output
+probe.json`` (its roadmaps and MDPs are copied from the battery's folder into a scratch one; the
+run is made with the code this imports, and its result is written beside the records, to be
+compared with the battery's).
+"""
+
+import argparse
+import json
+import pathlib
+import shutil
+import subprocess
+import tempfile
+
+from mobee_drake.experiments import adaptive_space_command as command
+from mobee_drake.experiments import adaptive_space_reaching as reaching
+from mobee_drake.experiments import ch8_reaching
+from mobee_drake.experiments.battery import RunFolder
+from mobee_drake.reaching import appearance
+from mobee_drake.station.safety import Penetrations
+
+
+class _Probe(appearance.AppearanceWatch):
+    """An appearance watch that keeps a record of each problem whose target appeared inside."""
+
+    records: list = []
+
+    def SetProblem(self, target) -> None:
+        super().SetProblem(target)
+        object.__setattr__(self, "_target", [float(v) for v in target])
+        object.__setattr__(self, "_at_start", self._Pairs())
+
+    def Close(self) -> None:
+        counts = self.counts
+        if counts.current_inside is True:
+            _Probe.records.append(
+                dict(
+                    target=self._target,
+                    periods=self._Penetrating() - counts.current_start,
+                    at_start=self._at_start,
+                    at_end=self._Pairs(),
+                )
+            )
+        super().Close()
+
+    def _Pairs(self) -> list[str]:
+        return Penetrations(self.robot.station.diagram, self.robot.context)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("run", help="the run's name in the battery, e.g. reach_katana_..._seed1")
+    parser.add_argument("--battery", type=pathlib.Path, required=True, help="its folder")
+    parser.add_argument("--output", type=pathlib.Path, required=True, help="a JSON file")
+    args = parser.parse_args()
+    runs = [job for job in _Jobs() if job.name == args.run]
+    if not runs:
+        parser.error(f"{args.run}: not a run of the reaching battery")
+    (run,) = runs
+    ch8_reaching.AppearanceWatch = _Probe  # (the run's robot is watched by the probe)
+    with tempfile.TemporaryDirectory() as scratch:
+        folder = pathlib.Path(scratch) / "runs"
+        for support in (args.battery / "runs").iterdir():
+            if not support.name.startswith("reach_"):
+                shutil.copytree(support, folder / support.name)
+        (folder / run.name).mkdir()
+        result = run.function(RunFolder(folder / run.name), **run.kwargs)
+    commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True)
+    probe = dict(run=run.name, commit=commit.stdout.strip(), result=result)
+    probe["problems"] = _Probe.records
+    args.output.write_text(json.dumps(probe, indent=1) + "\n")
+
+
+def _Jobs():
+    parser = command._Parser()
+    args = parser.parse_args("--part reaching --robots icub katana --seeds 10".split())
+    maintenance = command._Maintenance(parser, args)
+    return [job for _, jobs in reaching.Stages(args, maintenance) for job in jobs]
+
+
+if __name__ == "__main__":
+    main()
