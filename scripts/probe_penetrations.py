@@ -1,7 +1,10 @@
 """Makes one run of the adaptive-space reaching battery again, in this process, and records for
-every problem whose target appeared inside the robot (as the run's ``AppearanceWatch`` counts
-them) its target, its penetrating control periods, and the pairs of solids penetrating when the
-target appeared and when the problem ended (``safety.Penetrations``).
+every problem that began with solids penetrating (which the battery's watch, before adf6900,
+counted as one whose target appeared inside the robot) its target, its penetrating control
+periods, and, when the target appeared and when the problem ended, the pairs of solids
+penetrating
+(``safety.Penetrations``), MoBeE's joints and its joint-limit and barrier forces (the run's
+joint limits with them).
 
 The battery's report splits the penetrating periods by whether a problem's target appeared
 inside the robot; this shows what the periods it sets aside were.
@@ -29,30 +32,47 @@ from mobee_drake.station.safety import Penetrations
 
 
 class _Probe(appearance.AppearanceWatch):
-    """An appearance watch that keeps a record of each problem whose target appeared inside."""
+    """An appearance watch (counting as the code it runs with does) that keeps a record of each
+    problem that began with solids penetrating."""
 
     records: list = []
+    limits: tuple = ()
 
     def SetProblem(self, target) -> None:
         super().SetProblem(target)
+        _Probe.limits = self.robot.station.mobee.position_limits
         object.__setattr__(self, "_target", [float(v) for v in target])
-        object.__setattr__(self, "_at_start", self._Pairs())
+        object.__setattr__(self, "_at_start", self._Moment())
+        object.__setattr__(self, "_start", self._Penetrating())
+        object.__setattr__(self, "_recording", bool(self._at_start["pairs"]))
 
     def Close(self) -> None:
-        counts = self.counts
-        if counts.current_inside is True:
+        if getattr(self, "_recording", False):
+            object.__setattr__(self, "_recording", False)
             _Probe.records.append(
                 dict(
                     target=self._target,
-                    periods=self._Penetrating() - counts.current_start,
+                    periods=self._Penetrating() - self._start,
                     at_start=self._at_start,
-                    at_end=self._Pairs(),
+                    at_end=self._Moment(),
                 )
             )
         super().Close()
 
-    def _Pairs(self) -> list[str]:
-        return Penetrations(self.robot.station.diagram, self.robot.context)
+    def _Moment(self) -> dict:
+        """The penetrating pairs, MoBeE's joints (rad) and its f_lim and f_barrier now."""
+        station, context = self.robot.station, self.robot.context
+        mobee = station.mobee
+        mobee_context = mobee.GetMyContextFromRoot(context)
+        n = len(mobee.position_limits[0])
+        return dict(
+            pairs=Penetrations(station.diagram, context),
+            q=station.robot_state.Eval(context)[:n].tolist(),
+            **{
+                term: mobee.GetOutputPort(term).Eval(mobee_context).tolist()
+                for term in ("f_lim", "f_barrier")
+            },
+        )
 
 
 def main() -> None:
@@ -74,7 +94,9 @@ def main() -> None:
         (folder / run.name).mkdir()
         result = run.function(RunFolder(folder / run.name), **run.kwargs)
     commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True)
+    lower, upper = _Probe.limits
     probe = dict(run=run.name, commit=commit.stdout.strip(), result=result)
+    probe["limits"] = dict(lower=lower.tolist(), upper=upper.tolist())
     probe["problems"] = _Probe.records
     args.output.write_text(json.dumps(probe, indent=1) + "\n")
 

@@ -7,6 +7,8 @@ import pathlib
 import re
 import unittest
 
+import numpy as np
+
 from mobee_drake.experiments.adaptive_space_command import KeptReport
 from mobee_drake.experiments.ch8_claims import ClaimsTables
 from mobee_drake.experiments.ch8_reaching import StoredResults
@@ -141,48 +143,63 @@ class TestKeptBatteries(unittest.TestCase):
 
     def test_the_wedged_katanas_probe_is_the_batterys_run_and_the_docs_figures(self):
         """docs/adaptive_space.md's account of the Katana's run wedged inside itself is its
-        probe's (scripts/probe_penetrations.py): the battery's run but for its wall time; the
-        problems that ended with the arm inside itself, from the first on every one, their
-        periods, the first's start and the later problems' lengths."""
+        probe's (scripts/probe_penetrations.py): the battery's run but for its wall time and
+        the split (the probe's watch is adf6900's); the problems that ended with the arm inside
+        itself, from the first on every one, their periods, the first's start, the joint
+        farthest beyond its limits at its end and the forces there, the later problems'
+        lengths."""
         results = ROOT / "docs" / "results"
         name = "reach_katana_random_maintained_seed1"
         probe = json.loads((results / "adaptive_space_reaching_probe" / f"{name}.json").read_text())
         made = json.loads(
             (results / "adaptive_space_reaching/runs" / name / "result.json").read_text()
         )
-        kept = probe["result"]
-        self.assertEqual({k for k in kept | made if kept.get(k) != made.get(k)}, {"wall_seconds"})
+        kept, split = probe["result"], {"appeared_inside", "other_penetrating_steps"}
+        differ = {k for k in kept | made if kept.get(k) != made.get(k)}
+        self.assertEqual(differ, {"wall_seconds", *split})
         problems = probe["problems"]
-        self.assertEqual(len(problems), made["appeared_inside"])
-        wedged = [
-            i
-            for i, p in enumerate(problems)
-            if any("'reach_target'" not in pair for pair in p["at_end"])
-        ]
+        self.assertEqual(len(problems), made["appeared_inside"])  # (the old watch's count)
+
+        def Wedged(moment: dict) -> bool:
+            return any("'reach_target'" not in pair for pair in moment["pairs"])
+
+        wedged = [i for i, p in enumerate(problems) if Wedged(p["at_end"])]
         self.assertEqual(wedged, list(range(wedged[0], len(problems))))
         periods = sum(problems[i]["periods"] for i in wedged)
-        first = problems[wedged[0]]
-        self.assertTrue(all("'reach_target'" in pair for pair in first["at_start"]))
-        later = problems[wedged[0] + 1 :]
-        self.assertTrue(
-            all(p["at_start"] and "'reach_target'" not in p["at_start"][0] for p in later)
-        )
+        self.assertEqual(kept["other_penetrating_steps"], periods)  # (the new watch's split)
+        first, later = problems[wedged[0]], problems[wedged[0] + 1 :]
+        self.assertFalse(Wedged(first["at_start"]))
+        self.assertTrue(all(Wedged(p["at_start"]) for p in later))
         lengths = " or ".join(str(n) for n in sorted({p["periods"] for p in later}))
+        lower, upper = (np.array(probe["limits"][side]) for side in ("lower", "upper"))
+        q = np.array(first["at_end"]["q"])
+        joint = int(np.argmax(np.maximum(lower - q, q - upper)))
         doc = _Folded((ROOT / "docs" / "adaptive_space.md").read_text())
         for text in (
             f"counts {made['penetrating_steps']:,} penetrating periods, all among the "
             f"{len(problems)} problems",
             f"{len(wedged)} of its {len(problems)} problems ended with the arm's own solids",
-            f"({first['at_end'][0].removeprefix('the robot: ')},",
+            f"({first['at_end']['pairs'][0].removeprefix('the robot: ')},",
             f"those hold {periods:,} of its {made['penetrating_steps']:,} penetrating periods",
             f"the {wedged[0] + 1}th such problem",
-            f"({first['at_start'][0].removeprefix('the robot: ')})",
+            f"({first['at_start']['pairs'][0].removeprefix('the robot: ')})",
+            f"the {('first', 'second', 'third', 'fourth', 'fifth', 'sixth')[joint]} of MoBeE's "
+            f"joints stood at {q[joint]:.2f} rad, its limits [{lower[joint]:.2f}, "
+            f"{upper[joint]:.2f}]",
+            f"force ({first['at_end']['f_lim'][joint]:.0f}) and the barrier's "
+            f"({first['at_end']['f_barrier'][joint]:.0f})",
             f"lasted {lengths} control periods",
             f"with {probe['commit'][:7]}'s code",
+            f"the same run counts {kept['appeared_inside']} problems whose target appeared "
+            f"inside and {periods:,} periods among the others",
         ):
             with self.subTest(text=text):
                 self.assertIn(text, doc)
         self.assertEqual(made["other_penetrating_steps"], 0)
+        depth = first["at_start"]["pairs"][0].split("' ")[1].split(" mm")[0]
+        mobee = _Folded((ROOT / "docs" / "mobee.md").read_text())
+        self.assertIn(f"appeared {depth} mm inside the Katana's forearm", mobee)
+        self.assertIn(f"by turning a joint {q[joint]:.2f} rad", mobee)
 
     def _CheckQuotedDifferences(self, prose: str, tables: str) -> None:
         for difference in _DIFFERENCE.findall(prose):
