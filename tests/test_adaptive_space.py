@@ -7,6 +7,7 @@ import json
 import pathlib
 import shutil
 import tempfile
+import types
 import unittest
 
 import numpy as np
@@ -64,6 +65,20 @@ class TestTheBatterysOrder(unittest.TestCase):
         seeds = [job.kwargs["seed"] for job in stages[-1][1]]
         settings = 2 * 2 * 3 * 2  # robots x spaces x strategies x conditions
         self.assertEqual(seeds, [0] * settings + [1] * settings)
+
+    def test_the_closest_cell_gives_the_worst_of_the_runs(self):
+        """The closest the robot came to itself over the runs (those whose own pairs came within
+        a field) and the deepest penetration, in mm; "far" if none came near; "-" with a run
+        from before they were kept."""
+        from mobee_drake.experiments.adaptive_space_reaching import _ClosestCell
+
+        def Run(closest, deepest):
+            return types.SimpleNamespace(closest_to_itself=closest, deepest_penetration=deepest)
+
+        self.assertEqual(_ClosestCell([Run(-0.04, 0.0633), Run(None, 0.01)]), "-40.0 / 63.3")
+        self.assertEqual(_ClosestCell([Run(0.012, 0.0), Run(0.02, 0.005)]), "+12.0 / 5.0")
+        self.assertEqual(_ClosestCell([Run(None, 0.0)]), "far / 0.0")
+        self.assertEqual(_ClosestCell([Run(-0.04, 0.0633), Run(None, None)]), "-")
 
     def test_the_report_names_the_runs_without_a_result(self):
         """Of a two-seed battery on both robots, the results of all but the Katana's roadmap
@@ -351,9 +366,19 @@ class TestTheReachLearnersSpace(unittest.TestCase):
                 self.assertTrue(0 < run.exploring_hours < run.robot_hours)
                 self.assertEqual(run.states > 81, run.condition == "maintained")
                 self.assertEqual(sum(run.changes.values()) > 0, run.condition == "maintained")
+                self.assertGreaterEqual(run.deepest_penetration, 0.0)  # (the safety monitor's)
+        # (some arm's own solids came within their fields: the closest approach was kept)
+        self.assertTrue(any(r.closest_to_itself is not None for r in runs))
         report = (output / "report.md").read_text()
+        from mobee_drake.experiments.adaptive_space_reaching import _ClosestCell as ClosestCell
+
         for robot in ("icub", "katana"):
             self.assertIn(f"| {robot} | rank3 | greedy | maintained | 2 | 8 |", report)
+            for condition in ("fixed", "maintained"):
+                rs = [r for r in runs if (r.robot, r.condition) == (robot, condition)]
+                start = f"| {robot} | rank3 | greedy | {condition} |"
+                (row,) = [line for line in report.splitlines() if line.startswith(start)]
+                self.assertIn(f"| {ClosestCell(rs)} |", row)
             self.assertIn(f"{robot} rank3 greedy, maintained minus fixed, summed reward:", report)
             self.assertRegex(
                 report,

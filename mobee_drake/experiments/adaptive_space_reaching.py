@@ -89,6 +89,10 @@ class AdaptiveReachRun:
     # The robot hours of the exploration alone, without the evaluations' (None: a run from
     # before they were timed).
     exploring_hours: float | None = None
+    # The closest the robot's solids came to each other and the deepest penetration of any
+    # pair (m; see ReachRun; None: a run from before they were kept).
+    closest_to_itself: float | None = None
+    deepest_penetration: float | None = None
 
 
 def AdaptiveReachJob(
@@ -147,6 +151,8 @@ def AdaptiveReachJob(
             penetrating_steps=result.penetrating_steps,
             appeared_inside=result.appeared_inside,
             other_penetrating_steps=result.other_penetrating_steps,
+            closest_to_itself=result.closest_to_itself,
+            deepest_penetration=result.deepest_penetration,
             wall_seconds=result.wall_seconds,
         )
     )
@@ -296,6 +302,17 @@ def _Mean(values) -> str:
     return "-" if any(v is None for v in values) else f"{np.mean(values):.2f}"
 
 
+def _ClosestCell(runs) -> str:
+    """A cell: the closest the robot came to itself over the runs ("far" if its own pairs never
+    came within their fields) and the deepest penetration of any pair (mm); ``-`` where a run
+    is from before they were kept."""
+    if any(r.deepest_penetration is None for r in runs):
+        return "-"
+    closest = [r.closest_to_itself for r in runs if r.closest_to_itself is not None]
+    near = f"{1000 * min(closest):+.1f}" if closest else "far"
+    return f"{near} / {1000 * max(r.deepest_penetration for r in runs):.1f}"
+
+
 def _GapsText(space: str, gaps: np.ndarray, ended: list[np.ndarray]) -> str:
     """How near a space's valid states put the marker to the targets (``gaps``, m, per target)
     and, if any ran, how near the maintained runs' spaces did at their end (``ended``, per run)."""
@@ -334,8 +351,9 @@ def Report(
     lines = [
         "| robot | space | strategy | condition | runs | problem-tries | summed reward | without "
         f"the -10s | robot hours (exploring) | states | transitions | changes ({'/'.join(RULES)}) "
-        f"| {PENETRATION_HEADER} | wall s per run |",
-        "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|",
+        f"| {PENETRATION_HEADER} | closest to itself / deepest penetration (mm) | wall s per "
+        "run |",
+        "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|",
     ]
     for (robot, space, strategy, condition), rs in group.items():
         lines.append(
@@ -346,7 +364,7 @@ def Report(
             f"({_Mean(r.exploring_hours for r in rs)}) | "
             f"{np.mean([r.states for r in rs]):.0f} | "
             f"{np.mean([r.transitions for r in rs]):.0f} | {ChangesCell(rs)} | "
-            f"{PenetrationCell(rs)} | "
+            f"{PenetrationCell(rs)} | {_ClosestCell(rs)} | "
             f"{np.mean([r.wall_seconds for r in rs]):.0f} |"
         )
     costs = {

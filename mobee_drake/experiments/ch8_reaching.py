@@ -90,6 +90,7 @@ from mobee_drake.reaching.targets import TargetGrid
 from mobee_drake.robots.icub import RIGHT_SHOULDER_ELBOW_JOINTS
 from mobee_drake.scenario import BuildScenario, Scenario
 from mobee_drake.station.executor import ReachForcing, StateActionAttractor
+from mobee_drake.station.safety import SELF
 
 RIGHT_ARM = list(RIGHT_SHOULDER_ELBOW_JOINTS)
 SOURCE_STAGES = (100, 200, 400, 800, 1600, 3200, 6400)
@@ -286,6 +287,11 @@ class ReachRun:
         num_states: The MDP's states.
         barrier_periods: Periods the safety barrier acted (None: a run from before it was
             counted).
+        closest_to_itself: The closest the robot's solids came to each other (m; negative:
+            inside each other), over the whole run (None: a run from before it was kept, or
+            one whose own pairs never came within their fields).
+        deepest_penetration: The deepest penetration of any pair (m; None: as
+            ``closest_to_itself``).
         mdp: ``--mdp simultaneous``: the MDP learned with the reaches (see ``_LearnedMdp``).
         space: A space that reshaped itself: its size at the end and its changes by rule
             (:meth:`~mobee_drake.reaching.reshaping.ReachSpaceKeeper.Summary`).
@@ -305,6 +311,8 @@ class ReachRun:
     appeared_inside: int | None = None
     other_penetrating_steps: int | None = None
     evaluation_seconds: float | None = None
+    closest_to_itself: float | None = None
+    deepest_penetration: float | None = None
 
     @property
     def strategy(self) -> str:
@@ -574,6 +582,8 @@ def _Result(settings: RunSettings, learner, robot, data: dict, extra: dict) -> R
         wall_seconds=data["wall_seconds"],
         penetrating_steps=safety.penetrating_steps,
         barrier_periods=safety.barrier_periods,
+        closest_to_itself=safety.closest_approach[SELF],
+        deepest_penetration=safety.deepest_penetration,
         num_transitions=learner.num_transitions,
         num_states=learner.space.num_states,
         appeared_inside=None if counts is None else counts.appeared_inside,
