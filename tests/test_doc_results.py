@@ -201,6 +201,30 @@ class TestKeptBatteries(unittest.TestCase):
         self.assertIn(f"appeared {depth} mm inside the Katana's forearm", mobee)
         self.assertIn(f"by turning a joint {q[joint]:.2f} rad", mobee)
 
+    def test_the_runs_whose_arm_came_inside_itself_are_the_docs(self):
+        """docs/adaptive_space.md counts the reaching battery's finished runs whose robot came
+        inside itself (its last checkpoint's safety monitor: the closest approach of the robot's
+        own solids below zero), by robot and condition."""
+        runs = ROOT / "docs" / "results" / "adaptive_space_reaching" / "runs"
+        inside, finished = [], sorted(runs.glob("reach_*/result.json"))
+        for result in finished:
+            last = sorted((result.parent / "checkpoint").glob("g*"))[-1]
+            with np.load(last / "simulation" / "simulation.npz") as saved:
+                # (the monitor's state: per object, "(self)", "(other objects)", then the
+                # penetrating periods, the deepest penetration and the barrier's periods)
+                monitor = saved["safety_monitor/0"]
+            if monitor[-5] < 0:
+                inside.append(json.loads(result.read_text()))
+        robots = {r.get("robot", "icub") for r in inside}
+        maintained = sum(r["condition"] == "maintained" for r in inside)
+        self.assertEqual(robots, {"katana"})
+        doc = _Folded((ROOT / "docs" / "adaptive_space.md").read_text())
+        self.assertIn(
+            f"In {len(inside)} of its {len(finished)} finished runs, all the Katana's "
+            f"({maintained} maintained, {len(inside) - maintained} fixed)",
+            doc,
+        )
+
     def _CheckQuotedDifferences(self, prose: str, tables: str) -> None:
         for difference in _DIFFERENCE.findall(prose):
             with self.subTest(difference=difference):
