@@ -1,8 +1,7 @@
 """Makes one run of the adaptive-space reaching battery again, in this process, and records for
 every problem that began with solids penetrating (which the battery's watch, before adf6900,
 counted as one whose target appeared inside the robot) its target, its penetrating control
-periods, and, when the target appeared and when the problem ended, the pairs of solids
-penetrating
+periods, and, when its target appeared and when it was closed, the pairs of solids penetrating
 (``safety.Penetrations``), MoBeE's joints and its joint-limit and barrier forces (the run's
 joint limits with them).
 
@@ -93,7 +92,9 @@ def main() -> None:
                 shutil.copytree(support, folder / support.name)
         (folder / run.name).mkdir()
         result = run.function(RunFolder(folder / run.name), **run.kwargs)
-    commit = subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True)
+    commit = subprocess.run(
+        ["git", "describe", "--always", "--dirty", "--abbrev=40"], capture_output=True, text=True
+    )
     lower, upper = _Probe.limits
     probe = dict(run=run.name, commit=commit.stdout.strip(), result=result)
     probe["limits"] = dict(lower=lower.tolist(), upper=upper.tolist())

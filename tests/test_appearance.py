@@ -44,6 +44,7 @@ class AppearanceWatchTest(unittest.TestCase):
             watched = AppearanceWatch(robot)
             watched.SetProblem("inside")
             robot.penetrating += 3  # (the arm pushed out of the target: the draw's)
+            robot.target = None  # (its reach ended the problem: the target is gone)
             watched.SetProblem("outside")
             robot.penetrating += 5
             # A checkpoint's counts resume the watch in a new process.
@@ -51,6 +52,7 @@ class AppearanceWatchTest(unittest.TestCase):
             robot.penetrating += 2
             watched.SetProblem("inside")
             robot.penetrating += 4
+            robot.target = None
             watched.SetProblem("outside")
             robot.penetrating += 1
             watched.Close()
@@ -58,6 +60,16 @@ class AppearanceWatchTest(unittest.TestCase):
         self.assertEqual(watched.counts.appeared_inside, 2)
         self.assertEqual(watched.counts.other_penetrating_steps, 5 + 2 + 1)
         self.assertEqual(robot.target, "outside")
+        # (a target left inside the arm when its problem is closed: not the draw's)
+        robot = _Robot()
+        with mock.patch.object(appearance, "PenetratingPairs", _Pairs(robot)):
+            watched = AppearanceWatch(robot)
+            watched.SetProblem("inside")
+            robot.penetrating += 6
+            watched.Close()
+        self.assertEqual(
+            [watched.counts.appeared_inside, watched.counts.other_penetrating_steps], [0, 6]
+        )
         self.assertEqual(watched.State(), 7)  # (the rest of the robot, unwatched)
         watched.space = "reshaped"  # (a space keeper sets the robot's space through the watch)
         self.assertEqual(robot.space, "reshaped")
@@ -65,9 +77,10 @@ class AppearanceWatchTest(unittest.TestCase):
 
     def test_a_robot_inside_itself_is_not_set_aside_as_the_draws(self):
         """A target that appears while the arm is wedged inside itself is not counted as one
-        that appeared inside; one that appeared inside, alone, but whose problem ends with the
-        arm inside itself (the push out drove it there) has its periods counted among the
-        others; a target alone inside at both ends is the draw's."""
+        that appeared inside; nor is one that appeared inside, alone, but whose problem was
+        closed with the arm inside itself: both problems' periods count among the others; a
+        target alone inside when it appeared, nothing inside when its problem was closed, is
+        the draw's."""
         robot = _Robot()
         with mock.patch.object(appearance, "PenetratingPairs", _Pairs(robot)):
             watched = AppearanceWatch(robot)
@@ -79,7 +92,7 @@ class AppearanceWatchTest(unittest.TestCase):
             watched.SetProblem("inside")  # (appears while the arm is inside itself)
             robot.penetrating += 40
             watched.Close()
-        self.assertEqual(watched.counts.appeared_inside, 2)
+        self.assertEqual(watched.counts.appeared_inside, 1)
         self.assertEqual(watched.counts.other_penetrating_steps, 20 + 40)
 
     def test_a_reports_cell_sums_the_split_or_says_it_is_unknown(self):

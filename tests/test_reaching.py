@@ -77,6 +77,8 @@ class TestPredictors(unittest.TestCase):
         self.assertEqual(TransitionReward(0.3, 0.1 + 0.2), FAILED_TRANSITION_REWARD)
         self.assertGreater(0.1 + 0.2, 0.3)
         self.assertEqual(TransitionReward(0.3, 0.3 + 1e-9), 0.0)
+        self.assertEqual(TransitionReward(-5.0, -5.0 + 5e-13), FAILED_TRANSITION_REWARD)
+        self.assertEqual(TransitionReward(-5.0, -5.0 + 2e-12), 0.0)
 
     def test_distance_unit(self):
         from mobee_drake.reaching.predictors import PredictorConfig

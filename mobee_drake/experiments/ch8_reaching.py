@@ -290,8 +290,8 @@ class ReachRun:
         closest_to_itself: The closest the robot's solids came to each other (m; negative:
             inside each other), over the whole run (None: a run from before it was kept, or
             one whose own pairs never came within their fields).
-        deepest_penetration: The deepest penetration of any pair (m; None: as
-            ``closest_to_itself``).
+        deepest_penetration: The deepest penetration of any pair (m; None: a run from before
+            it was kept).
         mdp: ``--mdp simultaneous``: the MDP learned with the reaches (see ``_LearnedMdp``).
         space: A space that reshaped itself: its size at the end and its changes by rule
             (:meth:`~mobee_drake.reaching.reshaping.ReachSpaceKeeper.Summary`).

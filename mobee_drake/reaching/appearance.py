@@ -6,12 +6,14 @@ safety monitor counts the periods the two solids overlap as penetrating. Those p
 draw's, not a failure of MoBeE's safety: a run's penetrating periods are only a safety measure
 once they are split into the problems whose target appeared inside the robot and the rest.
 
-A problem's periods are set aside as the draw's only when its target's pairs alone penetrate
-when it appears, and none but its target's when it ends: a robot already inside itself or an
-object when a target appears, or left so at the problem's end (a push out of a target that
-drove the arm into itself), counts among the rest. (Before, any penetration at the target's
-appearance set the whole problem aside: a Katana wedged inside itself for most of a run counted
-as targets appearing inside it, docs/adaptive_space.md.)
+A problem is set aside as one whose target appeared inside the robot only when its target's
+pairs alone penetrate when it appears, and nothing does when it is closed (at the next
+problem's appearance: its target gone, the next evaluation's walk done): a robot already inside
+itself or an object when a target appears, or left so, counts among the rest. A problem that
+went inside itself and got out again before it was closed is still set aside; the run's closest
+approach of the robot to itself (the safety monitor's) shows that. (Before, any penetration at
+a target's appearance set the problem aside: a Katana wedged inside itself for the rest of its
+run counted as targets appearing inside it, docs/adaptive_space.md.)
 """
 
 import dataclasses as dc
@@ -26,10 +28,10 @@ from mobee_drake.station.safety import PenetratingPairs
 class AppearanceCounts:
     """What an :class:`AppearanceWatch` has seen so far (and where its current problem began)."""
 
-    # Problems whose target appeared inside the robot, nothing else penetrating.
+    # Problems set aside: their target alone appeared inside the robot, and nothing penetrated
+    # when they were closed.
     appeared_inside: int = 0
-    # Penetrating control periods of the other problems (and of those that ended with something
-    # but their target penetrating).
+    # Penetrating control periods of the other problems.
     other_penetrating_steps: int = 0
     # The open problem: whether its target appeared inside (None: none is open), and the
     # robot's penetrating periods when it appeared (its own are the difference at its end).
@@ -68,7 +70,9 @@ class AppearanceWatch:
     def Close(self) -> None:
         """Ends the current problem's count (call once after the last problem)."""
         c = self.counts
-        if c.current_inside is False or (c.current_inside and self._Pairs()[1]):
+        if c.current_inside and any(self._Pairs()):  # (left inside something: not the draw's)
+            c.current_inside, c.appeared_inside = False, c.appeared_inside - 1
+        if c.current_inside is False:
             c.other_penetrating_steps += self._Penetrating() - c.current_start
         c.current_inside = None
 
@@ -76,7 +80,7 @@ class AppearanceWatch:
         self.Close()
         self.robot.SetProblem(target)
         c = self.counts
-        target, others = self._Pairs()
-        c.current_inside = target and not others
+        target_inside, others_inside = self._Pairs()
+        c.current_inside = target_inside and not others_inside
         c.current_start = self._Penetrating()
         c.appeared_inside += c.current_inside
