@@ -9,7 +9,9 @@ import unittest
 
 import numpy as np
 
+from mobee_drake.atomic_files import CurrentGeneration
 from mobee_drake.experiments.adaptive_space_command import KeptReport
+from mobee_drake.experiments.arms import Arms, ReachTargets
 from mobee_drake.experiments.ch8_claims import ClaimsTables
 from mobee_drake.experiments.ch8_reaching import StoredResults
 from mobee_drake.experiments.doc_tables import GeneratedBlocks
@@ -155,8 +157,9 @@ class TestKeptBatteries(unittest.TestCase):
             (results / "adaptive_space_reaching/runs" / name / "result.json").read_text()
         )
         kept, split = probe["result"], {"appeared_inside", "other_penetrating_steps"}
-        differ = {k for k in kept | made if kept.get(k) != made.get(k)}
+        differ = {k for k in made if kept[k] != made[k]}  # (the probe's code keeps more)
         self.assertEqual(differ, {"wall_seconds", *split})
+        self.assertLess(kept["closest_to_itself"], 0.0)
         problems = probe["problems"]
         self.assertEqual(len(problems), made["appeared_inside"])  # (the old watch's count)
 
@@ -173,22 +176,35 @@ class TestKeptBatteries(unittest.TestCase):
         lengths = " or ".join(str(n) for n in sorted({p["periods"] for p in later}))
         lower, upper = (np.array(probe["limits"][side]) for side in ("lower", "upper"))
         q = np.array(first["at_end"]["q"])
-        joint = int(np.argmax(np.maximum(lower - q, q - upper)))
+        outside = np.maximum(lower - q, q - upper)
+        joint = int(np.argmax(outside))
+        others = [ORDINALS[j] for j in np.flatnonzero(outside > 0) if j != joint]
+        beyond = " and the ".join(others)
+        pushed = int(np.argmax(np.abs(first["at_start"]["f_barrier"])))
+        # (the last evaluation: its tries of every target, after the exploration)
+        job = json.loads((results / "adaptive_space_reaching/runs" / name / "job.json").read_text())
+        evaluated = job["evaluations"] * len(ReachTargets(Arms()["katana"]).Centres())
+        self.assertLessEqual(len(wedged), evaluated)
+        for p in later:  # (the arm did not move again)
+            np.testing.assert_allclose(p["at_end"]["q"], q, atol=0.01)
         doc = _Folded((ROOT / "docs" / "adaptive_space.md").read_text())
         for text in (
             f"counts {made['penetrating_steps']:,} penetrating periods, all among the "
             f"{len(problems)} problems",
-            f"{len(wedged)} of its {len(problems)} problems ended with the arm's own solids",
+            f"{len(wedged)} of its {len(problems)} problems were closed with the arm's own solids",
             f"({first['at_end']['pairs'][0].removeprefix('the robot: ')},",
             f"those hold {periods:,} of its {made['penetrating_steps']:,} penetrating periods",
             f"the {wedged[0] + 1}th such problem",
             f"({first['at_start']['pairs'][0].removeprefix('the robot: ')})",
-            f"the {('first', 'second', 'third', 'fourth', 'fifth', 'sixth')[joint]} of MoBeE's "
-            f"joints stood at {q[joint]:.2f} rad, its limits [{lower[joint]:.2f}, "
-            f"{upper[joint]:.2f}]",
+            f"{ORDINALS[joint]} of MoBeE's joints stood at {q[joint]:.2f} rad, its limits "
+            f"[{lower[joint]:.2f}, {upper[joint]:.2f}] (the {beyond} stood beyond theirs too)",
+            f"All {len(wedged)} fell in the run's last evaluation",
+            f"{len(wedged)} of the {evaluated} problems whose summed reward",
+            f"pushed the {ORDINALS[pushed]} joint with "
+            f"{first['at_start']['f_barrier'][pushed]:.0f}",
             f"force ({first['at_end']['f_lim'][joint]:.0f}) and the barrier's "
             f"({first['at_end']['f_barrier'][joint]:.0f})",
-            f"lasted {lengths} control periods",
+            f"counted {lengths} penetrating periods until the next was closed",
             f"with {probe['commit'][:7]}'s code",
             f"the same run counts {kept['appeared_inside']} problems whose target appeared "
             f"inside and {periods:,} periods among the others",
@@ -199,7 +215,7 @@ class TestKeptBatteries(unittest.TestCase):
         depth = first["at_start"]["pairs"][0].split("' ")[1].split(" mm")[0]
         mobee = _Folded((ROOT / "docs" / "mobee.md").read_text())
         self.assertIn(f"appeared {depth} mm inside the Katana's forearm", mobee)
-        self.assertIn(f"by turning a joint {q[joint]:.2f} rad", mobee)
+        self.assertIn(f"a joint stood at {q[joint]:.2f} rad", mobee)
 
     def test_the_runs_whose_arm_came_inside_itself_are_the_docs(self):
         """docs/adaptive_space.md counts the reaching battery's finished runs whose robot came
@@ -208,7 +224,7 @@ class TestKeptBatteries(unittest.TestCase):
         runs = ROOT / "docs" / "results" / "adaptive_space_reaching" / "runs"
         inside, finished = [], sorted(runs.glob("reach_*/result.json"))
         for result in finished:
-            last = sorted((result.parent / "checkpoint").glob("g*"))[-1]
+            last = CurrentGeneration(result.parent / "checkpoint")
             with np.load(last / "simulation" / "simulation.npz") as saved:
                 # (the monitor's state: per object, "(self)", "(other objects)", then the
                 # penetrating periods, the deepest penetration and the barrier's periods)
@@ -218,10 +234,23 @@ class TestKeptBatteries(unittest.TestCase):
         robots = {r.get("robot", "icub") for r in inside}
         maintained = sum(r["condition"] == "maintained" for r in inside)
         self.assertEqual(robots, {"katana"})
+        katana = [json.loads(f.read_text()) for f in finished if "katana" in f.parent.name]
+        by_space = {
+            space: (
+                sum(r.get("space", "rank3") == space for r in inside),
+                sum(r.get("space", "rank3") == space for r in katana),
+            )
+            for space in ("trm", "rank3")
+        }
         doc = _Folded((ROOT / "docs" / "adaptive_space.md").read_text())
         self.assertIn(
             f"In {len(inside)} of its {len(finished)} finished runs, all the Katana's "
             f"({maintained} maintained, {len(inside) - maintained} fixed)",
+            doc,
+        )
+        self.assertIn(
+            f"{by_space['trm'][0]} of the Katana's {by_space['trm'][1]} finished roadmap runs and "
+            f"{by_space['rank3'][0]} of its {by_space['rank3'][1]} lattice runs",
             doc,
         )
 
@@ -246,6 +275,9 @@ class TestKeptBatteries(unittest.TestCase):
         """docs/adaptive_space.md's verdict quotes differences with their intervals from its
         generated blocks ("+1.23 [+0.45, +2.01]"): each must be in a block."""
         self._CheckQuotedDifferences(*_ProseAndBlocks(ROOT / "docs" / "adaptive_space.md"))
+
+
+ORDINALS = ("first", "second", "third", "fourth", "fifth", "sixth")
 
 
 def _Rows(table: str) -> dict[str, list[str]]:
