@@ -278,9 +278,10 @@ class ReachRun:
             was counted); the exploration's is the difference.
         wall_seconds: Wall time of the run (over its resumptions).
         penetrating_steps: Control periods in which two solids penetrated.
-        appeared_inside: Problems (tries and evaluations) whose target appeared inside the
-            robot (:mod:`~mobee_drake.reaching.appearance`; None: a run from before they were
-            counted).
+        appeared_inside: Problems (tries and evaluations) set aside as the draw's: their target
+            appeared inside the robot (:mod:`~mobee_drake.reaching.appearance` says when; runs
+            before 1949f90 counted any penetration at the target's appearance; None: a run
+            from before they were counted).
         other_penetrating_steps: The penetrating periods of the other problems (None: as
             ``appeared_inside``).
         num_transitions: The MDP's transition state-actions (the reaches follow them).
