@@ -84,6 +84,9 @@ def main() -> None:
     if not runs:
         parser.error(f"{args.run}: not a run of the reaching battery")
     (run,) = runs
+    commit = subprocess.run(  # (the code imported now: "-dirty" if it was not committed)
+        ["git", "describe", "--always", "--dirty", "--abbrev=40"], capture_output=True, text=True
+    )
     ch8_reaching.AppearanceWatch = _Probe  # (the run's robot is watched by the probe)
     with tempfile.TemporaryDirectory() as scratch:
         folder = pathlib.Path(scratch) / "runs"
@@ -92,9 +95,6 @@ def main() -> None:
                 shutil.copytree(support, folder / support.name)
         (folder / run.name).mkdir()
         result = run.function(RunFolder(folder / run.name), **run.kwargs)
-    commit = subprocess.run(
-        ["git", "describe", "--always", "--dirty", "--abbrev=40"], capture_output=True, text=True
-    )
     lower, upper = _Probe.limits
     probe = dict(run=run.name, commit=commit.stdout.strip(), result=result)
     probe["limits"] = dict(lower=lower.tolist(), upper=upper.tolist())
