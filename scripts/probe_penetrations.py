@@ -18,14 +18,13 @@ compared with the battery's).
 import argparse
 import json
 import pathlib
-import shutil
 import subprocess
 import tempfile
 
 from mobee_drake.experiments import adaptive_space_command as command
 from mobee_drake.experiments import adaptive_space_reaching as reaching
 from mobee_drake.experiments import ch8_reaching
-from mobee_drake.experiments.battery import RunFolder
+from mobee_drake.experiments.battery import CopySharedRuns, RunFolder
 from mobee_drake.reaching import appearance
 from mobee_drake.station.safety import Penetrations
 
@@ -80,7 +79,8 @@ def main() -> None:
     parser.add_argument("--battery", type=pathlib.Path, required=True, help="its folder")
     parser.add_argument("--output", type=pathlib.Path, required=True, help="a JSON file")
     args = parser.parse_args()
-    runs = [job for job in _Jobs() if job.name == args.run]
+    jobs = _Jobs()
+    runs = [job for job in jobs if job.name == args.run]
     if not runs:
         parser.error(f"{args.run}: not a run of the reaching battery")
     (run,) = runs
@@ -88,13 +88,12 @@ def main() -> None:
         ["git", "describe", "--always", "--dirty", "--abbrev=40"], capture_output=True, text=True
     )
     ch8_reaching.AppearanceWatch = _Probe  # (the run's robot is watched by the probe)
+    support = [job for job in jobs if not job.name.startswith("reach_")]
     with tempfile.TemporaryDirectory() as scratch:
-        folder = pathlib.Path(scratch) / "runs"
-        for support in (args.battery / "runs").iterdir():
-            if not support.name.startswith("reach_"):
-                shutil.copytree(support, folder / support.name)
-        (folder / run.name).mkdir()
-        result = run.function(RunFolder(folder / run.name), **run.kwargs)
+        CopySharedRuns(support, args.battery, pathlib.Path(scratch))  # (roadmaps and MDPs)
+        folder = pathlib.Path(scratch) / "runs" / run.name
+        folder.mkdir()
+        result = run.function(RunFolder(folder), **run.kwargs)
     lower, upper = _Probe.limits
     probe = dict(run=run.name, commit=commit.stdout.strip(), result=result)
     probe["limits"] = dict(lower=lower.tolist(), upper=upper.tolist())
@@ -103,6 +102,7 @@ def main() -> None:
 
 
 def _Jobs():
+    """The jobs of the reaching battery of docs/adaptive_space.md's command."""
     parser = command._Parser()
     args = parser.parse_args("--part reaching --robots icub katana --seeds 10".split())
     maintenance = command._Maintenance(parser, args)

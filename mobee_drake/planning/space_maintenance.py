@@ -241,12 +241,12 @@ def _CheckModelFits(space: StateActionSpace, done: int) -> None:
     :data:`COUNTS_COPIES` copies, would need more memory than is available, naming the round
     and what would bound it, rather than fail deep in the carry with numpy's bare MemoryError
     (or the machine's OOM killer)."""
-    copy, available = 8 * space.num_state_actions * space.num_states, AvailableMemory()
-    if available is not None and COUNTS_COPIES * copy > available:
+    one_copy, available = 8 * space.num_state_actions * space.num_states, AvailableMemory()
+    if available is not None and COUNTS_COPIES * one_copy > available:
         raise SpaceTooLarge(
             f"space maintenance after {done} actions (or problem-tries): the round planned "
             f"{space.num_states} states and {space.num_state_actions:,} state-actions, whose "
-            f"outcome counts need {copy / 2**30:.1f} GiB a copy, and a round holds about "
+            f"outcome counts need {one_copy / 2**30:.1f} GiB a copy, and a round holds about "
             f"{COUNTS_COPIES}: more than the {available / 2**30:.1f} GiB available; bound the "
             "space (max_states, or a smaller join_within)"
         )

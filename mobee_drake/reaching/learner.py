@@ -44,9 +44,9 @@ Readings where the source is ambiguous (issue 33), each a named option with the 
 
 - ``plateau_rule``, when a transition failed (ch. 8.1: whenever the state it ends in has no higher
   value than the state it left, higher by more than rounding, ``VALUE_TIE``): ``strict``, that
-  rule as stated, so a move across a plateau of
-  equal value fails even when it arrives where it was sent; ``arrival``, a transition that ends in
-  the state it was sent to never fails (the rule's purpose, 8.1: to catch moves the target blocks);
+  rule as stated, so a move across a plateau of equal value fails even when it arrives where it
+  was sent; ``arrival``, a transition that ends in the state it was sent to never fails (the
+  rule's purpose, 8.1: to catch moves the target blocks);
   ``random-tie``, the strict rule with ties of value broken at random (what ``tie_break="random"``
   does), so a plateau's reach is chosen as often as its moves.
 - ``evaluation_history``, what an evaluation remembers of its own failures (ch. 8.3.3 is silent):
