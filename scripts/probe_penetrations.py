@@ -9,7 +9,7 @@ The battery's report splits the penetrating periods by whether a problem's targe
 inside the robot; this shows what the periods it sets aside were.
 
 Run from the project's root: ``python scripts/probe_penetrations.py
-reach_katana_random_maintained_seed1 --battery docs/results/adaptive_space_reaching --output
+reach_katana_random_maintained_seed1 --battery docs/results/adaptive_space_reaching_303aba8 --output
 probe.json`` (its roadmaps and MDPs are copied from the battery's folder into a scratch one; the
 run is made with the code this imports, and its result is written beside the records, to be
 compared with the battery's).

@@ -117,7 +117,7 @@ class TestKeptBatteries(unittest.TestCase):
             )
         }
         self._AssertTheBatterysRunsButForWallTime(
-            "adaptive_space_reaching_dense_t", "adaptive_space_reaching", 32, parted
+            "adaptive_space_reaching_dense_t", "adaptive_space_reaching_303aba8", 32, parted
         )
 
     def test_the_side_batterys_code_makes_the_batterys_runs(self):
@@ -126,10 +126,10 @@ class TestKeptBatteries(unittest.TestCase):
         the same arguments, measure for measure, but for its wall time."""
         results = ROOT / "docs" / "results"
         self._AssertTheBatterysRunsButForWallTime(
-            "adaptive_space_reaching_again", "adaptive_space_reaching", 1
+            "adaptive_space_reaching_again", "adaptive_space_reaching_303aba8", 1
         )
         (run,) = (results / "adaptive_space_reaching_again").glob("runs/*")
-        made = results / "adaptive_space_reaching" / "runs" / run.name
+        made = results / "adaptive_space_reaching_303aba8" / "runs" / run.name
         self.assertEqual((run / "job.json").read_text(), (made / "job.json").read_text())
         sittings = (results / "adaptive_space_reaching_again" / "sessions.jsonl").read_text()
         self.assertEqual(
@@ -154,7 +154,7 @@ class TestKeptBatteries(unittest.TestCase):
         name = "reach_katana_random_maintained_seed1"
         probe = json.loads((results / "adaptive_space_reaching_probe" / f"{name}.json").read_text())
         made = json.loads(
-            (results / "adaptive_space_reaching/runs" / name / "result.json").read_text()
+            (results / "adaptive_space_reaching_303aba8/runs" / name / "result.json").read_text()
         )
         kept, split = probe["result"], {"appeared_inside", "other_penetrating_steps"}
         differ = {k for k in made if kept[k] != made[k]}  # (the probe's code keeps more)
@@ -182,7 +182,9 @@ class TestKeptBatteries(unittest.TestCase):
         beyond = " and the ".join(others)
         pushed = int(np.argmax(np.abs(first["at_start"]["f_barrier"])))
         # (the last evaluation: its tries of every target, after the exploration)
-        job = json.loads((results / "adaptive_space_reaching/runs" / name / "job.json").read_text())
+        job = json.loads(
+            (results / "adaptive_space_reaching_303aba8/runs" / name / "job.json").read_text()
+        )
         evaluated = job["evaluations"] * len(ReachTargets(Arms()["katana"]).Centres())
         self.assertLessEqual(len(wedged), evaluated)
         for p in later:  # (the arm did not move again)
@@ -221,7 +223,7 @@ class TestKeptBatteries(unittest.TestCase):
         """docs/adaptive_space.md counts the reaching battery's finished runs whose robot came
         inside itself (its last checkpoint's safety monitor: the closest approach of the robot's
         own solids below zero), by robot and condition."""
-        runs = ROOT / "docs" / "results" / "adaptive_space_reaching" / "runs"
+        runs = ROOT / "docs" / "results" / "adaptive_space_reaching_303aba8" / "runs"
         inside, finished = [], sorted(runs.glob("reach_*/result.json"))
         for result in finished:
             last = CurrentGeneration(result.parent / "checkpoint")

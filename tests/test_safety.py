@@ -9,6 +9,7 @@ benchmark."""
 
 import contextlib
 import io
+import json
 import pathlib
 import re
 import shutil
@@ -21,14 +22,16 @@ from pydrake.multibody.tree import BodyIndex, JacobianWrtVariable
 
 from mobee_drake.experiments import bench_safety
 from mobee_drake.experiments.bench_safety import MOVERS, PRESETS, SCENES, BabblingRun, SceneRun
+from mobee_drake.experiments.ch8_reaching import ReachRobot, ReachScenario
 from mobee_drake.experiments.doc_tables import GeneratedTable, TableLayout
 from mobee_drake.mobee.barrier import BarrierForce, BarrierParams, JointTracking, StepModel
 from mobee_drake.mobee.flow import FlowParams
 from mobee_drake.mobee.levers import LeverBounds
 from mobee_drake.mobee.params import MobeeParams
+from mobee_drake.planning.state_space import Lattice
 from mobee_drake.scenario import BuildScenario, LoadScenario, RunScenario
 from mobee_drake.station.builder import POSITION_GAIN, VELOCITY_GAIN
-from mobee_drake.station.safety import StartsInPenetrationError
+from mobee_drake.station.safety import Penetrations, StartsInPenetrationError
 from mobee_drake.station.world_events import MakeSimulator
 
 PARAMS = BarrierParams(rate=0.2, clearance=0.005)
@@ -94,6 +97,57 @@ class TestBarrierForce(unittest.TestCase):
             n, np.array([-0.01, -0.01]), np.zeros(1), np.zeros(1), np.ones(1), np.ones(1), PARAMS
         )
         np.testing.assert_allclose(dT, 0.0, atol=1e-9)
+
+
+class TestBarrierRoom(unittest.TestCase):
+    """The room: the barrier's change moves no joint by more than a step in a period, nor beyond
+    its limits, unless MoBeE's other forces already take it there."""
+
+    def test_an_opening_wider_than_a_step_is_cut_to_the_step(self):
+        """A pair 2 mm short of the clearance on a 4 mm/rad lever asks 0.2 * 2 mm / 0.004 =
+        0.1 rad; the step (0.05 rad) gives half of it, all in that joint."""
+        n, gain = np.array([[0.004, 0.0]]), np.full(2, 1e-4)
+        room = (np.full(2, -0.05), np.full(2, 0.05))
+        dT = BarrierForce(
+            n, np.array([0.003]), np.zeros(2), np.zeros(2), np.ones(2), gain, PARAMS, room
+        )
+        np.testing.assert_allclose(gain * dT, [0.05, 0.0], atol=1e-12)
+        unbounded = BarrierForce(
+            n, np.array([0.003]), np.zeros(2), np.zeros(2), np.ones(2), gain, PARAMS
+        )
+        np.testing.assert_allclose(gain * unbounded, [0.1, 0.0], atol=1e-12)
+
+    def test_a_joint_at_its_limit_is_not_pushed_beyond(self):
+        """Two equal levers share the opening (0.4 mm) unbounded; with the first joint at its
+        upper limit the second opens it alone."""
+        n, gain = np.array([[1.0, 1.0]]), np.full(2, 1e-4)
+        d = np.array([0.003])
+        shared = BarrierForce(n, d, np.zeros(2), np.zeros(2), np.ones(2), gain, PARAMS)
+        np.testing.assert_allclose(gain * shared, [0.0002, 0.0002], atol=1e-12)
+        room = (np.full(2, -0.05), np.array([0.0, 0.05]))
+        alone = BarrierForce(n, d, np.zeros(2), np.zeros(2), np.ones(2), gain, PARAMS, room)
+        np.testing.assert_allclose(gain * alone, [0.0, 0.0004], atol=1e-12)
+
+    def test_a_push_larger_than_a_step_is_still_cancelled(self):
+        """The other forces would close the gap by 0.2 m (0.2 rad at a 1 m lever); the room never
+        keeps the barrier from cancelling them: the period closes by the allowed 3 mm."""
+        n, gain = np.array([[1.0, 0.0]]), np.full(2, 1e-4)
+        total = np.array([-2000.0, 0.0])
+        room = (np.full(2, -0.05), np.full(2, 0.05))
+        dT = BarrierForce(n, np.array([0.02]), np.zeros(2), total, np.ones(2), gain, PARAMS, room)
+        self.assertAlmostEqual((n @ (gain * (total + dT)))[0], -PARAMS.rate * 0.015)
+
+    def test_a_row_that_cannot_hold_leaves_the_least_shortfall_within_the_room(self):
+        """A pair deep inside asks 1 mm through levers of 0.1 and 0.02 m/rad on two joints:
+        unbounded, by (9.6, 1.9) mrad; within a step of 5 mrad it cannot hold, and both joints
+        give their whole step (0.5 + 0.1 mm, short by 0.4)."""
+        n, gain = np.array([[0.1, 0.02]]), np.full(2, 1e-4)
+        d = np.array([-0.02])
+        unbounded = BarrierForce(n, d, np.zeros(2), np.zeros(2), np.ones(2), gain, PARAMS)
+        np.testing.assert_allclose(gain * unbounded, np.array([0.1, 0.02]) / 10.4, atol=1e-12)
+        room = (np.full(2, -0.005), np.full(2, 0.005))
+        dT = BarrierForce(n, d, np.zeros(2), np.zeros(2), np.ones(2), gain, PARAMS, room)
+        np.testing.assert_allclose(gain * dT, [0.005, 0.005], atol=1e-9)
 
 
 class TestStepModels(unittest.TestCase):
@@ -343,6 +397,7 @@ class TestBarrierParameters(unittest.TestCase):
             (MobeeParams(barrier=BarrierParams(rate=1.0)), "barrier rate must be in (0, 1)"),
             (MobeeParams(barrier=BarrierParams(rate=0.0)), "barrier rate must be in (0, 1)"),
             (MobeeParams(barrier=BarrierParams(clearance=0.0)), "barrier clearance"),
+            (MobeeParams(barrier=BarrierParams(max_step=0.0)), "barrier max_step"),
             (MobeeParams(damping=0.0), "damping must be > 0 while the safety barrier is on"),
         ):
             with self.subTest(words), self.assertRaisesRegex(ValueError, re.escape(words)):
@@ -424,6 +479,38 @@ class TestSolidsPlacedInPenetration(unittest.TestCase):
         self.assertRegex(
             logs.output[0], r"a world event put solids in penetration at t = 0.1.*'ball'"
         )
+
+
+class TestTargetInsideTheArm(unittest.TestCase):
+    """The Katana's reach target appearing 31 mm inside its forearm, where the adaptive-space
+    battery's probe recorded it (docs/adaptive_space.md, "A run wedged inside itself"): the
+    barrier opens the pair within each joint's step and limits. Before the room, the sixth joint
+    went 5.5 rad beyond its limit within four periods; without the room now, the fourth and the
+    sixth leave theirs by tens of radians within three."""
+
+    PROBE = DOC.parent / "results/adaptive_space_reaching_probe"
+
+    def test_the_arm_leaves_the_target_within_its_steps_and_limits(self):
+        probe = json.loads((self.PROBE / "reach_katana_random_maintained_seed1.json").read_text())
+        problem = probe["problems"][44]
+        self.assertIn("31.3 mm inside 'reach_target'", problem["at_start"]["pairs"][0])
+        robot = ReachRobot(Lattice((0.25, 0.5, 0.75), 4), 0.05, robot="katana")
+        station, context = robot.station, robot.context
+        q = np.array(problem["at_start"]["q"])
+        integrator = station.mover.GetSubsystemByName("integrator")
+        integrator.GetMyMutableContextFromRoot(context).SetDiscreteState(
+            np.concatenate([q, np.zeros_like(q)])
+        )
+        robot.SetProblem(np.array(problem["target"]))
+        lower, upper = station.mobee.position_limits
+        max_step = ReachScenario(robot="katana").mobee.barrier.max_step
+        for _ in range(75):  # 1.5 s
+            robot.simulator.AdvanceTo(context.get_time() + 0.02)
+            q_next = station.robot_state.Eval(context)[: len(q)]
+            self.assertLessEqual(np.abs(q_next - q).max(), max_step)
+            self.assertTrue(np.all((lower <= q_next) & (q_next <= upper)), q_next)
+            q = q_next
+        self.assertEqual(Penetrations(station.diagram, context), [])
 
 
 class TestSafetyTables(unittest.TestCase):

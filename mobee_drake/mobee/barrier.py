@@ -26,13 +26,23 @@ metric of the virtual mass (Gauss's least constraint: ``min (dT)^T M^-1 dT``); t
 least-distance program, solved exactly by non-negative least squares (Lawson and Hanson, ch. 23).
 The barrier force ``f_barrier = dT`` is zero whenever MoBeE's own forces keep every gap from
 closing that fast, which is every period of ordinary operation.
+
+The rows are first order, so the barrier keeps its change where first order holds: it moves no
+joint by more than ``max_step`` in a period, nor beyond the joint's limits, unless MoBeE's other
+forces already take it there (the *room* of each joint: the change is free to cancel any motion,
+never to add one that leaves the room). A turn of ``dq`` moves a point at lever L off its
+predicted straight path by about ``L dq^2 / 2``: 0.6 mm for half a metre at the default 0.05 rad,
+within condition 2's ``rate * clearance``. Without the room, rows of a pair deep inside an object
+(a target appearing inside the forearm), whose normals nearly oppose each other, asked for
+changes of radians a period, and one drove a joint 100 rad beyond its limits
+(docs/mobee.md, "The safety guarantee", condition 4).
 """
 
 import dataclasses as dc
 
 import numpy as np
 from scipy.linalg import expm
-from scipy.optimize import nnls
+from scipy.optimize import lsq_linear, nnls
 
 # A pair whose gap the controlled joints move by less than this (m per rad, the normal's norm)
 # cannot be helped by them: its barrier would ask for forces without bound, and is left out.
@@ -49,6 +59,9 @@ class BarrierParams:
     rate: float = 0.2
     # The gap (m) the barrier keeps between solids (less than every field's margin).
     clearance: float = 0.005
+    # The most the barrier's change may move a joint in one period (rad), beyond what MoBeE's
+    # other forces move it (the rows are first order: see the module).
+    max_step: float = 0.05
 
     def Errors(self) -> list[str]:
         errors = []
@@ -56,6 +69,8 @@ class BarrierParams:
             errors.append(f"barrier rate must be in (0, 1), got {self.rate}")
         if not (0.0 < self.clearance < 1.0):
             errors.append(f"barrier clearance must be in (0, 1) m, got {self.clearance}")
+        if not (0.0 < self.max_step <= 1.0):
+            errors.append(f"barrier max_step must be in (0, 1] rad, got {self.max_step}")
         return errors
 
 
@@ -146,23 +161,27 @@ def BarrierForce(
     mass: np.ndarray,
     gain: np.ndarray,
     params: BarrierParams,
+    room: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> np.ndarray:
     """The barrier force dT (n) for the pairs' ``normals`` (k, n) and ``distances`` (k), given
     MoBeE's ``total`` (n) without it and the next period's displacement ``offset + gain T``
     (:class:`Displacement`), in the metric of the virtual ``mass`` (n), with the barrier's
-    ``params`` (see the module).
+    ``params`` (see the module), keeping the period's displacement within ``room`` (lower and
+    upper, n each, about 0) or within what the other forces make it already.
 
     Pairs whose normal nearly vanishes (shorter than :data:`MIN_LEVER`: the controlled joints
     hardly move them, e.g. a base link resting in a table) cannot be helped and are left out. If
-    the barriers contradict each other (solids pinched from two sides), the least-squares change
-    that meets them as nearly as possible is taken instead.
+    no change within the room meets every barrier (solids pinched from two sides, or a pair too
+    deep to open within a step), the change within the room that leaves the least squared
+    shortfall is taken instead.
     """
     # Row k: n_k . (offset + gain (T + dT)) >= -rate g_k; with u = dT / sqrt(M): G u >= r.
     root_mass = np.sqrt(mass)
     G = normals * (gain * root_mass)
     # (A penetrating pair is asked to open by at most rate * clearance a period.)
     gaps = np.maximum(distances - params.clearance, -params.clearance)
-    r = -params.rate * gaps - normals @ (offset + gain * total)
+    moved = offset + gain * total  # the period's displacement without the barrier
+    r = -params.rate * gaps - normals @ moved
     if not np.any(r > 0):  # MoBeE's total already keeps every barrier.
         return np.zeros_like(total)
     # Every barrier takes part (one that holds now may not once another is met), but for those
@@ -171,14 +190,50 @@ def BarrierForce(
     G, r = G[movable], r[movable]
     if not np.any(r > 0):
         return np.zeros_like(total)
-    # Least distance: min |u| with G u >= r, as NNLS on E = [G^T; r^T], f = e_last.
-    E = np.vstack([G.T, r])
+    # The room, as bounds on u (each contains 0: the other forces' motion is never cut).
+    step = gain * root_mass  # a joint's displacement per unit of u
+    bounds = (np.full_like(total, -np.inf), np.full_like(total, np.inf))
+    if room is not None:
+        bounds = (np.minimum(room[0] - moved, 0.0) / step, np.maximum(room[1] - moved, 0.0) / step)
+    u = _LeastDistance(G, r, bounds)
+    if u is None:
+        u = _LeastShortfall(G, r, bounds)
+    return u * root_mass
+
+
+def _LeastDistance(G: np.ndarray, r: np.ndarray, bounds) -> np.ndarray | None:
+    """The least |u| with G u >= r and u within ``bounds``, or None if no u meets them: NNLS
+    on E = [A^T; b^T], f = e_last (Lawson and Hanson, ch. 23), the bounds as rows of A u >= b."""
+    eye = np.eye(G.shape[1])
+    finite = [np.isfinite(bounds[0]), np.isfinite(bounds[1])]
+    A = np.vstack([G, eye[finite[0]], -eye[finite[1]]])
+    b = np.concatenate([r, bounds[0][finite[0]], -bounds[1][finite[1]]])
+    E = np.vstack([A.T, b])
     f = np.zeros(E.shape[0])
     f[-1] = 1.0
     weights, _ = nnls(E, f)
     residual = E @ weights - f
     if residual[-1] < -1e-12:
-        u = -residual[:-1] / residual[-1]
-    else:  # Infeasible: meet the barriers in the least-squares sense (normal equations: n x n).
-        u = np.linalg.lstsq(G.T @ G, G.T @ r, rcond=None)[0]
-    return u * root_mass
+        return -residual[:-1] / residual[-1]
+    return None
+
+
+def _LeastShortfall(G: np.ndarray, r: np.ndarray, bounds) -> np.ndarray:
+    """A u within ``bounds`` that leaves the least squared shortfall ``max(0, r - G u)``: the
+    bounded least-squares fit of the rows that fall short, taking in any row the fit leaves
+    short, until none is left out."""
+    short, free = r > 0, bounds[1] > bounds[0]  # (a joint without room stays put)
+    u = np.zeros(G.shape[1])
+    while True:
+        if free.any():
+            fit = lsq_linear(
+                G[short][:, free],
+                r[short],
+                bounds=(bounds[0][free], bounds[1][free]),
+                method="bvls",
+            )
+            u[free] = fit.x
+        left_out = ~short & (G @ u < r - 1e-12)
+        if not left_out.any():
+            return u
+        short |= left_out

@@ -547,9 +547,14 @@ class Mobee(LeafSystem):
         params, gain = self._params.barrier, self._displacement.gain
         offset = self._NextOffset(context, q, v)
         change = np.zeros_like(total)
+        # The room of each joint in the period: a step, within its limits.
+        room = (
+            np.maximum(-params.max_step, self._q_min - q),
+            np.minimum(params.max_step, self._q_max - q),
+        )
         rows, gaps = self._BarrierRows(context, pairs, normals, offset + gain * total)
         if rows is not None:
-            change = BarrierForce(rows, gaps, offset, total, self._mass, gain, params)
+            change = BarrierForce(rows, gaps, offset, total, self._mass, gain, params, room)
         # How far each solid may move (the largest lever of any of its points, any posture);
         # two solids close by at most the two largest together.
         reach = self._support.Lookahead(np.abs(offset + gain * (total + change)))
@@ -562,7 +567,7 @@ class Mobee(LeafSystem):
         far_rows, far_gaps = self._FieldNormals(context, far), far.distance
         if rows is not None:
             far_rows, far_gaps = np.vstack([rows, far_rows]), np.concatenate([gaps, far_gaps])
-        return BarrierForce(far_rows, far_gaps, offset, total, self._mass, gain, params)
+        return BarrierForce(far_rows, far_gaps, offset, total, self._mass, gain, params, room)
 
     def _BarrierRows(self, context, pairs: FieldPairs, normals, displacement: np.ndarray):
         """(normals (r, n), gaps (r,)) of the barrier's rows for ``pairs``, or (None, None) if
