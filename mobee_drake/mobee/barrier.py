@@ -172,8 +172,8 @@ def BarrierForce(
     Pairs whose normal nearly vanishes (shorter than :data:`MIN_LEVER`: the controlled joints
     hardly move them, e.g. a base link resting in a table) cannot be helped and are left out. If
     no change within the room meets every barrier (solids pinched from two sides, or a pair too
-    deep to open within a step), the change within the room that leaves the least squared
-    shortfall is taken instead.
+    deep to open within a step), a bounded least-squares fit of the barriers that fall short is
+    taken instead (:func:`_LeastShortfall`).
     """
     # Row k: n_k . (offset + gain (T + dT)) >= -rate g_k; with u = dT / sqrt(M): G u >= r.
     root_mass = np.sqrt(mass)
@@ -219,9 +219,11 @@ def _LeastDistance(G: np.ndarray, r: np.ndarray, bounds) -> np.ndarray | None:
 
 
 def _LeastShortfall(G: np.ndarray, r: np.ndarray, bounds) -> np.ndarray:
-    """A u within ``bounds`` that leaves the least squared shortfall ``max(0, r - G u)``: the
+    """A u within ``bounds`` that leaves little squared shortfall ``max(0, r - G u)``: the
     bounded least-squares fit of the rows that fall short, taking in any row the fit leaves
-    short, until none is left out."""
+    short, until none is left out. A row once taken in stays in: one the fit meets with room to
+    spare still pulls on it, so this is the least shortfall only where the rows taken in are
+    the ones left short, as for solids pinched from two sides."""
     short, free = r > 0, bounds[1] > bounds[0]  # (a joint without room stays put)
     u = np.zeros(G.shape[1])
     while True:
