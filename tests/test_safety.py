@@ -24,7 +24,13 @@ from mobee_drake.experiments import bench_safety
 from mobee_drake.experiments.bench_safety import MOVERS, PRESETS, SCENES, BabblingRun, SceneRun
 from mobee_drake.experiments.ch8_reaching import ReachRobot, ReachScenario
 from mobee_drake.experiments.doc_tables import GeneratedTable, TableLayout
-from mobee_drake.mobee.barrier import BarrierForce, BarrierParams, JointTracking, StepModel
+from mobee_drake.mobee.barrier import (
+    BarrierForce,
+    BarrierParams,
+    JointTracking,
+    Room,
+    StepModel,
+)
 from mobee_drake.mobee.flow import FlowParams
 from mobee_drake.mobee.levers import LeverBounds
 from mobee_drake.mobee.params import MobeeParams
@@ -148,6 +154,36 @@ class TestBarrierRoom(unittest.TestCase):
         room = (np.full(2, -0.005), np.full(2, 0.005))
         dT = BarrierForce(n, d, np.zeros(2), np.zeros(2), np.ones(2), gain, PARAMS, room)
         np.testing.assert_allclose(gain * dT, [0.005, 0.005], atol=1e-9)
+
+    def test_the_other_forces_motion_beyond_a_step_is_left_alone(self):
+        """The other forces turn the first joint by 0.2 rad, four steps; the pair needs only
+        the second: the change leaves the first alone (a room of one step around 0 would cut
+        its motion) and holds the pair at the allowed 3 mm."""
+        n, gain = np.array([[0.0, 1.0]]), np.full(2, 1e-4)
+        total = np.array([2000.0, -300.0])
+        room = (np.full(2, -0.05), np.full(2, 0.05))
+        dT = BarrierForce(n, np.array([0.02]), np.zeros(2), total, np.ones(2), gain, PARAMS, room)
+        self.assertEqual(dT[0], 0.0)
+        self.assertAlmostEqual((n @ (gain * (total + dT)))[0], -PARAMS.rate * 0.015)
+
+    def test_a_pair_above_the_clearance_holds_while_a_deep_one_opens_what_it_can(self):
+        """One joint: a pair 20 mm deep asks 1 mm through 4 mm/rad; opening it closes a pair
+        0.5 mm beyond the clearance, which may close by 0.2 of that, 0.1 mm, in the period. The
+        second holds: the joint turns 0.025 rad, the first opens 0.1 mm (a least-squares fit
+        of both rows within the step turns it by the whole step, and the second closes 0.2
+        mm)."""
+        n, gain = np.array([[0.004], [-0.004]]), np.full(1, 1e-4)
+        d = np.array([-0.02, 0.0055])
+        room = (np.full(1, -0.05), np.full(1, 0.05))
+        dT = BarrierForce(n, d, np.zeros(1), np.zeros(1), np.ones(1), gain, PARAMS, room)
+        np.testing.assert_allclose(gain * dT, [0.025], atol=1e-9)
+
+    def test_the_room_is_a_step_within_the_limits_and_holds_standing_still(self):
+        lower, upper = np.array([0.0, 0.0, 0.0, 0.0]), np.array([1.0, 1.0, 1.0, 1.0])
+        q = np.array([0.5, 0.98, 1.2, -0.01])  # free, near the upper limit, beyond each
+        below, above = Room(q, lower, upper, 0.05)
+        np.testing.assert_allclose(below, [-0.05, -0.05, -0.05, 0.0])
+        np.testing.assert_allclose(above, [0.05, 0.02, 0.0, 0.05])
 
 
 class TestStepModels(unittest.TestCase):
@@ -484,9 +520,8 @@ class TestSolidsPlacedInPenetration(unittest.TestCase):
 class TestTargetInsideTheArm(unittest.TestCase):
     """The Katana's reach target appearing 31 mm inside its forearm, where the adaptive-space
     battery's probe recorded it (docs/adaptive_space.md, "A run wedged inside itself"): the
-    barrier opens the pair within each joint's step and limits. Before the room, the sixth joint
-    went 5.5 rad beyond its limit within four periods; without the room now, the fourth and the
-    sixth leave theirs by tens of radians within three."""
+    barrier opens the pair within each joint's step and limits (before the room, it turned
+    joints by radians a period, out of their limits: docs/mobee.md)."""
 
     PROBE = DOC.parent / "results/adaptive_space_reaching_probe"
 
@@ -504,8 +539,8 @@ class TestTargetInsideTheArm(unittest.TestCase):
         robot.SetProblem(np.array(problem["target"]))
         lower, upper = station.mobee.position_limits
         max_step = ReachScenario(robot="katana").mobee.barrier.max_step
-        for _ in range(75):  # 1.5 s
-            robot.simulator.AdvanceTo(context.get_time() + 0.02)
+        for period in range(75):  # 1.5 s, sampled between updates (one update per sample)
+            robot.simulator.AdvanceTo((period + 0.5) * 0.02)
             q_next = station.robot_state.Eval(context)[: len(q)]
             self.assertLessEqual(np.abs(q_next - q).max(), max_step)
             self.assertTrue(np.all((lower <= q_next) & (q_next <= upper)), q_next)

@@ -30,12 +30,14 @@ closing that fast, which is every period of ordinary operation.
 The rows are first order, so the barrier keeps its change where first order holds: it moves no
 joint by more than ``max_step`` in a period, nor beyond the joint's limits, unless MoBeE's other
 forces already take it there (the *room* of each joint: the change is free to cancel any motion,
-never to add one that leaves the room). A turn of ``dq`` moves a point at lever L off its
-predicted straight path by about ``L dq^2 / 2``: 0.6 mm for half a metre at the default 0.05 rad,
-within condition 2's ``rate * clearance``. Without the room, rows of a pair deep inside an object
-(a target appearing inside the forearm), whose normals nearly oppose each other, asked for
-changes of radians a period, and one drove a joint 100 rad beyond its limits
-(docs/mobee.md, "The safety guarantee", condition 4).
+never to add one that leaves the room). A turn of one joint by ``dq`` moves a point at lever L
+off its predicted straight path by about ``L dq^2 / 2``: 0.6 mm for half a metre at the default
+0.05 rad, within condition 2's ``rate * clearance``; joints turning together add their errors.
+Where no change within the room meets every row, the rows of pairs at or beyond the clearance
+still hold (standing still meets them) and the pairs below it open as far as the room lets them.
+Before the room, a target appearing deep inside the Katana's forearm led to changes of radians a
+period and a joint 100 rad beyond its limits (docs/mobee.md, "The safety guarantee",
+condition 4).
 """
 
 import dataclasses as dc
@@ -153,6 +155,18 @@ class StepModel:
         )
 
 
+def Room(
+    q: np.ndarray, lower: np.ndarray, upper: np.ndarray, max_step: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The room of joints at ``q`` with limits (``lower``, ``upper``) in the next period: the
+    displacement (lower and upper, rad) a step of ``max_step`` allows within the limits, and
+    never less than standing still (a joint beyond a limit may stay where it is)."""
+    return (
+        np.minimum(0.0, np.maximum(-max_step, lower - q)),
+        np.maximum(0.0, np.minimum(max_step, upper - q)),
+    )
+
+
 def BarrierForce(
     normals: np.ndarray,
     distances: np.ndarray,
@@ -165,15 +179,16 @@ def BarrierForce(
 ) -> np.ndarray:
     """The barrier force dT (n) for the pairs' ``normals`` (k, n) and ``distances`` (k), given
     MoBeE's ``total`` (n) without it and the next period's displacement ``offset + gain T``
-    (:class:`Displacement`), in the metric of the virtual ``mass`` (n), with the barrier's
-    ``params`` (see the module), keeping the period's displacement within ``room`` (lower and
-    upper, n each, about 0) or within what the other forces make it already.
+    (:class:`Displacement`, ``gain`` > 0), in the metric of the virtual ``mass`` (n), with the
+    barrier's ``params`` (see the module), keeping the period's displacement within ``room``
+    (:func:`Room`: lower and upper, n each, containing 0) or within what the other forces make
+    it already.
 
     Pairs whose normal nearly vanishes (shorter than :data:`MIN_LEVER`: the controlled joints
     hardly move them, e.g. a base link resting in a table) cannot be helped and are left out. If
     no change within the room meets every barrier (solids pinched from two sides, or a pair too
-    deep to open within a step), a bounded least-squares fit of the barriers that fall short is
-    taken instead (:func:`_LeastShortfall`).
+    deep to open within a step), the pairs at or beyond the clearance are still held and those
+    below it open as far as they can (:func:`_Compromise`).
     """
     # Row k: n_k . (offset + gain (T + dT)) >= -rate g_k; with u = dT / sqrt(M): G u >= r.
     root_mass = np.sqrt(mass)
@@ -187,55 +202,94 @@ def BarrierForce(
     # Every barrier takes part (one that holds now may not once another is met), but for those
     # whose pair the joints cannot move.
     movable = np.linalg.norm(normals, axis=1) > MIN_LEVER
-    G, r = G[movable], r[movable]
+    G, r, gaps = G[movable], r[movable], gaps[movable]
     if not np.any(r > 0):
         return np.zeros_like(total)
-    # The room, as bounds on u (each contains 0: the other forces' motion is never cut).
+    # The room, as bounds on u (each contains the full stop, and 0: the other forces' motion is
+    # never cut).
     step = gain * root_mass  # a joint's displacement per unit of u
     bounds = (np.full_like(total, -np.inf), np.full_like(total, np.inf))
     if room is not None:
         bounds = (np.minimum(room[0] - moved, 0.0) / step, np.maximum(room[1] - moved, 0.0) / step)
     u = _LeastDistance(G, r, bounds)
     if u is None:
-        u = _LeastShortfall(G, r, bounds)
+        u = _Compromise(G, r, gaps < 0.0, bounds, stop=-moved / step)
     return u * root_mass
+
+
+# A row counts as met within this (m): the least-distance solution is exact up to rounding.
+ROW_TOLERANCE = 1e-10
+# Halvings of the fraction of the opening rows' reach that _Compromise looks for.
+BISECTIONS = 12
 
 
 def _LeastDistance(G: np.ndarray, r: np.ndarray, bounds) -> np.ndarray | None:
     """The least |u| with G u >= r and u within ``bounds``, or None if no u meets them: NNLS
-    on E = [A^T; b^T], f = e_last (Lawson and Hanson, ch. 23), the bounds as rows of A u >= b."""
+    on E = [A^T; b^T], f = e_last (Lawson and Hanson, ch. 23), the bounds as rows of A u >= b,
+    with u in units of the largest change one row alone asks (the answer's precision falls with
+    the square of its size), and checked against the rows."""
+    asking = r > 0
+    unit = np.max(r[asking] / np.linalg.norm(G[asking], axis=1)) if asking.any() else 1.0
     eye = np.eye(G.shape[1])
     finite = [np.isfinite(bounds[0]), np.isfinite(bounds[1])]
-    A = np.vstack([G, eye[finite[0]], -eye[finite[1]]])
-    b = np.concatenate([r, bounds[0][finite[0]], -bounds[1][finite[1]]])
+    A = np.vstack([G * unit, eye[finite[0]], -eye[finite[1]]])
+    b = np.concatenate([r, bounds[0][finite[0]] / unit, -bounds[1][finite[1]] / unit])
     E = np.vstack([A.T, b])
     f = np.zeros(E.shape[0])
     f[-1] = 1.0
     weights, _ = nnls(E, f)
     residual = E @ weights - f
-    if residual[-1] < -1e-12:
-        return -residual[:-1] / residual[-1]
-    return None
+    if not residual[-1] < 0.0:
+        return None
+    u = np.clip(-unit * residual[:-1] / residual[-1], *bounds)
+    return u if np.all(G @ u >= r - ROW_TOLERANCE) else None
+
+
+def _Compromise(G: np.ndarray, r: np.ndarray, opening: np.ndarray, bounds, stop) -> np.ndarray:
+    """The change when no u within ``bounds`` meets every row: the rows of pairs at or beyond
+    the clearance hold (the full stop ``stop``, within the bounds, meets them all), and the
+    ``opening`` rows (pairs below the clearance) are asked the largest common fraction of what
+    their bounded least-squares fit alone reaches beyond what the full stop gives them."""
+    if not opening.any():  # (the full stop meets every row: only rounding gets here)
+        return stop
+    reached = np.minimum(G[opening] @ _LeastShortfall(G[opening], r[opening], bounds), r[opening])
+    held = np.minimum(G[opening] @ stop, reached)
+
+    def Asked(fraction: float) -> np.ndarray:
+        asked = r.copy()
+        asked[opening] = held + fraction * (reached - held)
+        return asked
+
+    best = _LeastDistance(G, Asked(1.0), bounds)
+    if best is not None:
+        return best
+    low, high, best = 0.0, 1.0, _LeastDistance(G, Asked(0.0), bounds)
+    for _ in range(BISECTIONS):
+        middle = (low + high) / 2
+        u = _LeastDistance(G, Asked(middle), bounds)
+        if u is None:
+            high = middle
+        else:
+            low, best = middle, u
+    return stop if best is None else best
 
 
 def _LeastShortfall(G: np.ndarray, r: np.ndarray, bounds) -> np.ndarray:
-    """A u within ``bounds`` that leaves little squared shortfall ``max(0, r - G u)``: the
-    bounded least-squares fit of the rows that fall short, taking in any row the fit leaves
-    short, until none is left out. A row once taken in stays in: one the fit meets with room to
-    spare still pulls on it, so this is the least shortfall only where the rows taken in are
-    the ones left short, as for solids pinched from two sides."""
-    short, free = r > 0, bounds[1] > bounds[0]  # (a joint without room stays put)
+    """The u within ``bounds`` that leaves the least squared shortfall ``max(0, r - G u)``:
+    the bounded least squares of ``G u - s = r`` with a surplus ``s >= 0`` (a joint without
+    room stays put)."""
+    free = bounds[1] > bounds[0]
     u = np.zeros(G.shape[1])
-    while True:
-        if free.any():
-            fit = lsq_linear(
-                G[short][:, free],
-                r[short],
-                bounds=(bounds[0][free], bounds[1][free]),
-                method="bvls",
-            )
-            u[free] = fit.x
-        left_out = ~short & (G @ u < r - 1e-12)
-        if not left_out.any():
-            return u
-        short |= left_out
+    if free.any():
+        k = len(r)
+        fit = lsq_linear(
+            np.hstack([G[:, free], -np.eye(k)]),
+            r,
+            bounds=(
+                np.concatenate([bounds[0][free], np.zeros(k)]),
+                np.concatenate([bounds[1][free], np.full(k, np.inf)]),
+            ),
+            method="bvls",
+        )
+        u[free] = fit.x[: free.sum()]
+    return u

@@ -10,7 +10,7 @@ from pydrake.multibody.plant import MultibodyPlant
 from pydrake.systems.framework import LeafSystem, ValueProducer
 from pydrake.systems.primitives import MatrixGain
 
-from mobee_drake.mobee.barrier import BarrierForce, StepModel
+from mobee_drake.mobee.barrier import BarrierForce, Room, StepModel
 from mobee_drake.mobee.constraints import ClauseSet
 from mobee_drake.mobee.fields import NO_FIELD_PAIRS, FieldPairs, RobotFields, ToFieldContacts
 from mobee_drake.mobee.flow import ModulatedFlow
@@ -547,11 +547,7 @@ class Mobee(LeafSystem):
         params, gain = self._params.barrier, self._displacement.gain
         offset = self._NextOffset(context, q, v)
         change = np.zeros_like(total)
-        # The room of each joint in the period: a step, within its limits.
-        room = (
-            np.maximum(-params.max_step, self._q_min - q),
-            np.minimum(params.max_step, self._q_max - q),
-        )
+        room = Room(q, self._q_min, self._q_max, params.max_step)
         rows, gaps = self._BarrierRows(context, pairs, normals, offset + gain * total)
         if rows is not None:
             change = BarrierForce(rows, gaps, offset, total, self._mass, gain, params, room)
