@@ -96,7 +96,7 @@ class TestBarrierForce(unittest.TestCase):
         closing = n @ (gain * (total + dT))
         np.testing.assert_allclose(closing, -PARAMS.rate * (d - PARAMS.clearance))
 
-    def test_pinched_solids_get_the_least_squares_change(self):
+    def test_pinched_solids_stand_still(self):
         """Two barriers that ask for opposite motions of one joint cannot both hold."""
         n = np.array([[1.0], [-1.0]])
         dT = BarrierForce(
@@ -178,12 +178,25 @@ class TestBarrierRoom(unittest.TestCase):
         dT = BarrierForce(n, d, np.zeros(1), np.zeros(1), np.ones(1), gain, PARAMS, room)
         np.testing.assert_allclose(gain * dT, [0.025], atol=1e-9)
 
+    def test_a_pinched_pair_does_not_keep_another_deep_pair_from_opening(self):
+        """Two pairs 20 mm deep on 4 mm/rad levers of two joints; the first's joint also closes
+        a pair at the clearance (which may not close at all). The first stays; the second
+        opens its whole step, 0.2 mm, as it would alone."""
+        normals = np.array([[0.004, 0.0], [-0.004, 0.0], [0.0, 0.004]])
+        d, gain = np.array([-0.02, 0.005, -0.02]), np.full(2, 1e-4)
+        room = (np.full(2, -0.05), np.full(2, 0.05))
+        dT = BarrierForce(normals, d, np.zeros(2), np.zeros(2), np.ones(2), gain, PARAMS, room)
+        np.testing.assert_allclose(gain * dT, [0.0, 0.05], atol=1e-9)
+
     def test_the_room_is_a_step_within_the_limits_and_holds_standing_still(self):
         lower, upper = np.array([0.0, 0.0, 0.0, 0.0]), np.array([1.0, 1.0, 1.0, 1.0])
         q = np.array([0.5, 0.98, 1.2, -0.01])  # free, near the upper limit, beyond each
         below, above = Room(q, lower, upper, 0.05)
         np.testing.assert_allclose(below, [-0.05, -0.05, -0.05, 0.0])
         np.testing.assert_allclose(above, [0.05, 0.02, 0.0, 0.05])
+        n, d, gain = np.array([[1.0]]), np.array([0.003]), np.full(1, 1e-4)
+        with self.assertRaisesRegex(ValueError, r"room must contain standing still"):
+            BarrierForce(n, d, np.zeros(1), np.zeros(1), np.ones(1), gain, PARAMS, ([0.01], [0.05]))
 
 
 class TestStepModels(unittest.TestCase):

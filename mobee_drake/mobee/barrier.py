@@ -23,7 +23,7 @@ sliding or turning on a surface, another witness point taking over), the gap obe
 touch while ``e < rate * clearance`` (1 mm per period with the defaults).
 Among the totals that satisfy the rows, the barrier takes the one closest to MoBeE's, in the
 metric of the virtual mass (Gauss's least constraint: ``min (dT)^T M^-1 dT``); that is a
-least-distance program, solved exactly by non-negative least squares (Lawson and Hanson, ch. 23).
+least-distance program, solved by non-negative least squares (Lawson and Hanson, ch. 23).
 The barrier force ``f_barrier = dT`` is zero whenever MoBeE's own forces keep every gap from
 closing that fast, which is every period of ordinary operation.
 
@@ -34,7 +34,8 @@ never to add one that leaves the room). A turn of one joint by ``dq`` moves a po
 off its predicted straight path by about ``L dq^2 / 2``: 0.6 mm for half a metre at the default
 0.05 rad, within condition 2's ``rate * clearance``; joints turning together add their errors.
 Where no change within the room meets every row, the rows of pairs at or beyond the clearance
-still hold (standing still meets them) and the pairs below it open as far as the room lets them.
+still hold (standing still meets them), and each row of a pair below it gets as much of what a
+least-squares fit of those rows reaches as the others allow.
 Before the room, a target appearing deep inside the Katana's forearm led to changes of radians a
 period and a joint 100 rad beyond its limits (docs/mobee.md, "The safety guarantee",
 condition 4).
@@ -44,7 +45,7 @@ import dataclasses as dc
 
 import numpy as np
 from scipy.linalg import expm
-from scipy.optimize import lsq_linear, nnls
+from scipy.optimize import linprog, lsq_linear, nnls
 
 # A pair whose gap the controlled joints move by less than this (m per rad, the normal's norm)
 # cannot be helped by them: its barrier would ask for forces without bound, and is left out.
@@ -188,7 +189,8 @@ def BarrierForce(
     hardly move them, e.g. a base link resting in a table) cannot be helped and are left out. If
     no change within the room meets every barrier (solids pinched from two sides, or a pair too
     deep to open within a step), the pairs at or beyond the clearance are still held and those
-    below it open as far as they can (:func:`_Compromise`).
+    below it open by as much of their least-squares fit as the others allow
+    (:func:`_Compromise`).
     """
     # Row k: n_k . (offset + gain (T + dT)) >= -rate g_k; with u = dT / sqrt(M): G u >= r.
     root_mass = np.sqrt(mass)
@@ -210,6 +212,8 @@ def BarrierForce(
     step = gain * root_mass  # a joint's displacement per unit of u
     bounds = (np.full_like(total, -np.inf), np.full_like(total, np.inf))
     if room is not None:
+        if np.any(room[0] > 0.0) or np.any(room[1] < 0.0):
+            raise ValueError(f"the barrier's room must contain standing still (0), got {room}")
         bounds = (np.minimum(room[0] - moved, 0.0) / step, np.maximum(room[1] - moved, 0.0) / step)
     u = _LeastDistance(G, r, bounds)
     if u is None:
@@ -219,8 +223,6 @@ def BarrierForce(
 
 # A row counts as met within this (m): the least-distance solution is exact up to rounding.
 ROW_TOLERANCE = 1e-10
-# Halvings of the fraction of the opening rows' reach that _Compromise looks for.
-BISECTIONS = 12
 
 
 def _LeastDistance(G: np.ndarray, r: np.ndarray, bounds) -> np.ndarray | None:
@@ -237,41 +239,67 @@ def _LeastDistance(G: np.ndarray, r: np.ndarray, bounds) -> np.ndarray | None:
     E = np.vstack([A.T, b])
     f = np.zeros(E.shape[0])
     f[-1] = 1.0
-    weights, _ = nnls(E, f)
-    residual = E @ weights - f
-    if not residual[-1] < 0.0:
-        return None
-    u = np.clip(-unit * residual[:-1] / residual[-1], *bounds)
-    return u if np.all(G @ u >= r - ROW_TOLERANCE) else None
+    # (scipy's nnls can fail unannounced on nearly degenerate programs: BVLS is asked again.)
+    for Solve in (
+        lambda: nnls(E, f)[0],
+        lambda: lsq_linear(E, f, bounds=(0.0, np.inf), method="bvls").x,
+    ):
+        residual = E @ Solve() - f
+        if residual[-1] < 0.0:
+            u = np.clip(-unit * residual[:-1] / residual[-1], *bounds)
+            if np.all(G @ u >= r - ROW_TOLERANCE):
+                return u
+    return None
 
 
 def _Compromise(G: np.ndarray, r: np.ndarray, opening: np.ndarray, bounds, stop) -> np.ndarray:
     """The change when no u within ``bounds`` meets every row: the rows of pairs at or beyond
-    the clearance hold (the full stop ``stop``, within the bounds, meets them all), and the
-    ``opening`` rows (pairs below the clearance) are asked the largest common fraction of what
-    their bounded least-squares fit alone reaches beyond what the full stop gives them."""
+    the clearance hold (the full stop ``stop``, within the bounds, meets them all), and each of
+    the ``opening`` rows (pairs below the clearance) is asked a fraction of the way from the
+    lesser of what the full stop and their bounded least-squares fit give it to what the fit
+    gives it (:func:`_Fractions`). A row that the fit closes (one of two nearly opposite rows
+    of a pair deep inside) may close by that much."""
     if not opening.any():  # (the full stop meets every row: only rounding gets here)
         return stop
     reached = np.minimum(G[opening] @ _LeastShortfall(G[opening], r[opening], bounds), r[opening])
     held = np.minimum(G[opening] @ stop, reached)
+    fractions = _Fractions(G, r, opening, held, reached - held, bounds)
+    asked = r.copy()
+    for shrink in (1.0, 1.0 - 1e-6, 0.0):  # (the linear programs' tolerance, then the least)
+        asked[opening] = held + shrink * fractions * (reached - held)
+        u = _LeastDistance(G, asked, bounds)
+        if u is not None:
+            return u
+    return stop
 
-    def Asked(fraction: float) -> np.ndarray:
-        asked = r.copy()
-        asked[opening] = held + fraction * (reached - held)
-        return asked
 
-    best = _LeastDistance(G, Asked(1.0), bounds)
-    if best is not None:
-        return best
-    low, high, best = 0.0, 1.0, _LeastDistance(G, Asked(0.0), bounds)
-    for _ in range(BISECTIONS):
-        middle = (low + high) / 2
-        u = _LeastDistance(G, Asked(middle), bounds)
-        if u is None:
-            high = middle
-        else:
-            low, best = middle, u
-    return stop if best is None else best
+def _Fractions(G, r, opening, held, span, bounds) -> np.ndarray:
+    """The fraction t_i of each opening row's ``span`` beyond ``held`` that the change can give
+    it with the other rows held, within ``bounds``: the largest common fraction first, then
+    each row as far beyond it as the others allow (the largest sum). Two linear programs in
+    (u, t)."""
+    n, k = G.shape[1], int(opening.sum())
+    hard = ~opening
+    # -G_o u + span_i t_i <= -held_i, and -G_h u <= -r_h.
+    A = np.block([[-G[opening], np.diag(span)], [-G[hard], np.zeros((hard.sum(), k))]])
+    b = np.concatenate([-held, -r[hard]])
+    room = [(None if np.isinf(lo) else lo, None if np.isinf(hi) else hi) for lo, hi in zip(*bounds)]
+    common = linprog(
+        np.r_[np.zeros(n), -1.0],
+        A_ub=np.hstack([A[:, :n], A[:, n:].sum(axis=1, keepdims=True)]),
+        b_ub=b,
+        bounds=[*room, (0.0, 1.0)],
+        method="highs",
+    )
+    least = common.x[-1] if common.status == 0 else 0.0
+    each = linprog(
+        np.r_[np.zeros(n), -np.ones(k)],
+        A_ub=A,
+        b_ub=b,
+        bounds=[*room, *[(least, 1.0)] * k],
+        method="highs",
+    )
+    return each.x[n:] if each.status == 0 else np.full(k, least)
 
 
 def _LeastShortfall(G: np.ndarray, r: np.ndarray, bounds) -> np.ndarray:
