@@ -196,7 +196,16 @@ class TestBarrierRoom(unittest.TestCase):
         np.testing.assert_allclose(above, [0.05, 0.02, 0.0, 0.05])
         n, d, gain = np.array([[1.0]]), np.array([0.003]), np.full(1, 1e-4)
         with self.assertRaisesRegex(ValueError, r"room must contain standing still"):
-            BarrierForce(n, d, np.zeros(1), np.zeros(1), np.ones(1), gain, PARAMS, ([0.01], [0.05]))
+            BarrierForce(
+                n,
+                d,
+                np.zeros(1),
+                np.zeros(1),
+                np.ones(1),
+                gain,
+                PARAMS,
+                (np.array([0.01]), np.array([0.05])),
+            )
 
 
 class TestStepModels(unittest.TestCase):
