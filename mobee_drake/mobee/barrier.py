@@ -283,12 +283,12 @@ def _Fractions(G, r, opening, held, span, bounds) -> np.ndarray:
     # -G_o u + span_i t_i <= -held_i, and -G_h u <= -r_h.
     A = np.block([[-G[opening], np.diag(span)], [-G[hard], np.zeros((hard.sum(), k))]])
     b = np.concatenate([-held, -r[hard]])
-    room = [(None if np.isinf(lo) else lo, None if np.isinf(hi) else hi) for lo, hi in zip(*bounds)]
+    box = [(None if np.isinf(lo) else lo, None if np.isinf(hi) else hi) for lo, hi in zip(*bounds)]
     common = linprog(
         np.r_[np.zeros(n), -1.0],
         A_ub=np.hstack([A[:, :n], A[:, n:].sum(axis=1, keepdims=True)]),
         b_ub=b,
-        bounds=[*room, (0.0, 1.0)],
+        bounds=[*box, (0.0, 1.0)],
         method="highs",
     )
     least = common.x[-1] if common.status == 0 else 0.0
@@ -296,7 +296,7 @@ def _Fractions(G, r, opening, held, span, bounds) -> np.ndarray:
         np.r_[np.zeros(n), -np.ones(k)],
         A_ub=A,
         b_ub=b,
-        bounds=[*room, *[(least, 1.0)] * k],
+        bounds=[*box, *[(least, 1.0)] * k],
         method="highs",
     )
     return each.x[n:] if each.status == 0 else np.full(k, least)
