@@ -342,7 +342,8 @@ class TestPairedAndFamilies(unittest.TestCase):
     def test_paired_by_seed_without_spread_or_values(self):
         """A comparison equal in every pair is not tested (nor counted by Holm); one differing
         by the same in every pair gets Wilcoxon's exact p; a pair without a value is left out
-        of its comparison alone; ties are counted."""
+        of its comparison alone; ties are counted; a measure that repeats an earlier one in every
+        run is the same comparison, not tested again."""
         Run = collections.namedtuple("Run", "seed value same shifted sparse")
         rng = np.random.default_rng(3)
         control = rng.normal(0, 1, 6)
@@ -356,6 +357,7 @@ class TestPairedAndFamilies(unittest.TestCase):
                for s, v in enumerate(control)]  # fmt: skip
         names = ("value", "same", "shifted", "sparse")
         measures = {m: lambda r, m=m: getattr(r, m) for m in names}
+        measures["value again"] = measures["value"]  # (as "without the -10s" with none)
         lines = PairedBySeed({"arm": (on, off)}, measures, "On minus off")
         self.assertEqual(lines[1], "On minus off, paired by seed (Holm over the 2):")
         kept = np.isfinite(treated)
@@ -377,7 +379,8 @@ class TestPairedAndFamilies(unittest.TestCase):
         self.assertEqual(
             lines[5:],
             ["", "Equal in every pair, not tested: arm, same.", "",
-             "Not compared (fewer than two pairs with values): arm, sparse."],
+             "The same as an earlier measure in every run, not tested again: arm, value again "
+             "(as value).", "", "Not compared (fewer than two pairs with values): arm, sparse."],
         )  # fmt: skip
         self.assertEqual(
             PairedBySeed({"arm": (on, off)}, {"same": measures["same"]}, "On minus off"),

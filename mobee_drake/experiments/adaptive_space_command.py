@@ -281,9 +281,10 @@ def _ReachingReport(
             centres = _BuiltCentres(arms[robot], robot, space, output)
             if centres is not None:
                 targets[robot][1][space] = TargetGaps(arms[robot], centres)
-            targets[robot][2][space] = [
-                TargetGaps(arms[robot], ended) for ended in EndedSpaces(runs, output, robot, space)
-            ]
+            targets[robot][2][space] = {
+                strategy: [TargetGaps(arms[robot], centres) for centres in ended]
+                for strategy, ended in EndedSpaces(runs, output, robot, space).items()
+            }
     nearness = _Nearness(args.robots, args.reach_spaces, output)
     run_jobs = [job for _, jobs in stages for job in jobs if job.name.startswith("reach_")]
     run_jobs += fixed
@@ -322,17 +323,19 @@ def _SharedRuns(args, stages: list, fixed: list[Job], output: pathlib.Path, kept
     return shared
 
 
-def EndedSpaces(runs: list, output: pathlib.Path, robot: str, space: str) -> list[np.ndarray]:
-    """The centres of the space each maintained run of ``robot`` that began on ``space`` ended
-    with (its checkpoint's; fractions of range)."""
-    ended = []
-    for r in runs:
+def EndedSpaces(
+    runs: list, output: pathlib.Path, robot: str, space: str
+) -> dict[str, list[np.ndarray]]:
+    """Per strategy, the centres of the space each maintained run of ``robot`` that began on
+    ``space`` ended with (its checkpoint's; fractions of range), by seed."""
+    ended = collections.defaultdict(list)
+    for r in sorted(runs, key=lambda r: (r.strategy, r.seed)):
         if (r.robot, r.space, r.condition) == (robot, space, "maintained"):
             name = reaching_part.RunName(robot, space, r.strategy, "maintained", r.seed)
             generation = CurrentGeneration(output / "runs" / name / "checkpoint")
             with np.load(generation / "learner.npz") as saved:
-                ended.append(saved["space_centres"])
-    return ended
+                ended[r.strategy].append(saved["space_centres"])
+    return dict(ended)
 
 
 def ReachSpaceHistories(runs: list, output: pathlib.Path) -> dict[str, list]:

@@ -22,8 +22,9 @@ alone: an evaluation's walk to its start depends on the space), the space's size
 changes, and the penetrating periods (:mod:`~mobee_drake.reaching.appearance`'s split).
 Maintained minus fixed on each space, and the roadmap, fixed and maintained, minus the fixed
 lattice, are compared paired by seed in two families, each Holm-corrected over its comparisons
-(the robots, spaces and strategies): what was learned (the summed reward with penalties) and
-what it cost (the robot hours of the exploration, the wall seconds)."""
+(the robots, spaces and strategies): what was learned (the summed reward, with the -10s and
+without; where the two are the same in every run, the second is not tested again) and what it
+cost (the robot hours of the exploration, the wall seconds)."""
 
 import collections
 import dataclasses as dc
@@ -313,15 +314,21 @@ def _ClosestCell(runs) -> str:
     return f"{near} / {1000 * max(r.deepest_penetration for r in runs):.1f}"
 
 
-def _GapsText(space: str, gaps: np.ndarray, ended: list[np.ndarray]) -> str:
-    """How near a space's valid states put the marker to the targets (``gaps``, m, per target)
-    and, if any ran, how near the maintained runs' spaces did at their end (``ended``, per run)."""
-    text = f"{space}: a median {100 * np.median(gaps):.1f} cm (at most {100 * gaps.max():.1f} cm)"
+def _GapsText(space: str, gaps: np.ndarray, ended: dict[str, list[np.ndarray]]) -> str:
+    """How near a space's valid states put the marker to the targets' centres (``gaps``, m, per
+    target) and, if any ran, how near the spaces the maintained runs ended with did (``ended``,
+    per strategy, per run): the median over the runs of each run's median."""
+    text = f"{space}, a median {100 * np.median(gaps):.1f} cm (at most {100 * gaps.max():.1f} cm)"
     if ended:
-        medians = 100 * np.mean([np.median(g) for g in ended])
+        medians = ", ".join(
+            f"{strategy} {100 * np.median([np.median(g) for g in runs]):.1f} cm "
+            f"({len(runs)} run{'s' * (len(runs) != 1)})"
+            for strategy, runs in ended.items()
+        )
+        farthest = max(g.max() for runs in ended.values() for g in runs)
         text += (
-            f", and at the maintained runs' end a median {medians:.1f} cm (mean over "
-            f"{len(ended)} runs; at most {100 * max(g.max() for g in ended):.1f} cm)"
+            f", and on the spaces the maintained runs ended with, the median of the runs' "
+            f"medians {medians} (at most {100 * farthest:.1f} cm)"
         )
     return text
 
@@ -350,9 +357,9 @@ def Report(
     group = BySetting(runs, ("robot", "space", "strategy", "condition"))
     lines = [
         "| robot | space | strategy | condition | runs | problem-tries | summed reward | without "
-        f"the -10s | robot hours (exploring) | states | transitions | changes ({'/'.join(RULES)}) "
-        f"| {PENETRATION_HEADER} | closest to itself / deepest penetration (mm) | wall s per "
-        "run |",
+        "the -10s | robot hours in all (exploring alone) | states | transitions | changes "
+        f"({'/'.join(RULES)}) | {PENETRATION_HEADER} | closest to itself / deepest penetration "
+        "of any pair (mm) | wall s per run |",
         "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|---:|",
     ]
     for (robot, space, strategy, condition), rs in group.items():
@@ -398,8 +405,8 @@ def Report(
     for robot, (grid, gaps, ended) in (targets or {}).items():
         levels = ", ".join(f"{axis} {'/'.join(f'{v:.2f}' for v in getattr(grid, axis))}"
                            for axis in "xyz")  # fmt: skip
-        nearest = "; ".join(_GapsText(space, g, ended.get(space, [])) for space, g in gaps.items())
-        lines += ["", f"{robot}: targets of radius {grid.radius:g} m at {levels} m; the valid "
-                  f"state nearest each puts the marker, before the reach, {nearest} from "
-                  "it."]  # fmt: skip
+        nearest = "; ".join(_GapsText(space, g, ended.get(space, {})) for space, g in gaps.items())
+        lines += ["", f"{robot}: targets of radius {grid.radius:g} m at {levels} m. From each "
+                  f"target's centre to the marker at the valid state nearest it (where a reach "
+                  f"starts): {nearest}."]  # fmt: skip
     return "\n".join(lines) + f"\n\nCommand: `{command}`."

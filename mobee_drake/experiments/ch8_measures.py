@@ -97,8 +97,8 @@ def RobotTimeRatio(by_strategy: dict[str, list[ReachRun]]) -> float:
 
 # A report's column of penetrations (see PenetrationCell).
 PENETRATION_HEADER = (
-    "penetrating periods: all / of problems whose target did not appear inside the robot "
-    "(problems whose target did)"
+    "penetrating periods, summed over the runs: all / outside the problems whose target "
+    "appeared inside the robot (such problems)"
 )
 
 

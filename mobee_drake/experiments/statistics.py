@@ -367,8 +367,11 @@ def Holm(p_values) -> np.ndarray:
 
 @dc.dataclass
 class PairedComparison:
-    """Group a against group b on matched runs (the same seed: the same MDP and evaluation
-    seeds), the MDP a block (the fields of :func:`ComparePaired`)."""
+    """Group a against group b on matched runs (the same seed: in ch. 8's battery the same MDP
+    and evaluation seeds; where the groups learn on different spaces, the same seeds alone), the
+    MDP a block (the fields of :func:`ComparePaired`). The interval is the difference's own
+    95 % interval, not adjusted for other comparisons (the p-value its text is given may be:
+    :func:`PairedBySeed` gives Holm's)."""
 
     n: int
     blocks: int
@@ -482,10 +485,12 @@ def PairedBySeed(families: dict, measures: dict, heading: str) -> list[str]:
     tied" follows if any are). A pair without a finite value is left out of its comparison (the
     line says how many). A comparison equal in every pair is not tested (the lines end by
     naming it); one whose every pair differs by the same amount has no spread for the t-test,
-    and Wilcoxon's p stands in. A family with fewer than two seeds on both sides, or a
-    comparison with fewer than two pairs with values, is named as not compared; no lines when
-    there were no families."""
-    compared, notes, equal = {}, {}, []
+    and Wilcoxon's p stands in. A measure whose values are an earlier measure's in every run
+    of the family's pairs is the same comparison again: not tested a second time (nor counted by
+    Holm), and named. A family with fewer than two seeds on both sides, or a comparison with
+    fewer than two pairs with values, is named as not compared; no lines when there were no
+    families."""
+    compared, notes, equal, repeated = {}, {}, [], []
     not_compared = {
         "fewer than two seeds on both sides": [],
         "fewer than two pairs with values": [],
@@ -497,11 +502,19 @@ def PairedBySeed(families: dict, measures: dict, heading: str) -> list[str]:
             continue
         treated, control = (sorted((r for r in rs if r.seed in seeds), key=lambda r: r.seed)
                             for rs in (treated, control))  # fmt: skip
+        earlier = {}
         for name, f in measures.items():
             a = np.array([f(r) for r in treated], dtype=float)
             b = np.array([f(r) for r in control], dtype=float)
             kept = np.isfinite(a) & np.isfinite(b)
             label = f"{family}, {name}" if family else name
+            same = [m for m, (a0, b0) in earlier.items()
+                    if np.array_equal(a, a0, equal_nan=True)
+                    and np.array_equal(b, b0, equal_nan=True)]  # fmt: skip
+            earlier[name] = (a, b)
+            if same:
+                repeated.append(f"{label} (as {same[0]})")
+                continue
             tied = int(np.sum(a[kept] == b[kept]))  # (as ComparePaired's a_larger: d > 0)
             if np.sum(kept) < 2:
                 not_compared["fewer than two pairs with values"].append(label)
@@ -527,9 +540,13 @@ def PairedBySeed(families: dict, measures: dict, heading: str) -> list[str]:
     if equal:
         lead = "Equal" if compared else f"{heading}, paired by seed: equal"
         lines += ["", f"{lead} in every pair, not tested: {'; '.join(equal)}."]
+    if repeated:
+        lead = "The same" if compared or equal else f"{heading}: the same"
+        lines += ["", f"{lead} as an earlier measure in every run, not tested again: "
+                  f"{'; '.join(repeated)}."]  # fmt: skip
     for reason, labels in not_compared.items():
         if labels:
-            lead = "Not compared" if compared or equal else f"{heading}: not compared"
+            lead = "Not compared" if compared or equal or repeated else f"{heading}: not compared"
             named = "; ".join(label for label in labels if label)
             lines += ["", f"{lead} ({reason})" + (f": {named}." if named else ".")]
     return lines
