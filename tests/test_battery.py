@@ -38,6 +38,7 @@ from mobee_drake.experiments.battery import (
     RunBattery,
     RunFolder,
 )
+from mobee_drake.experiments.platform_record import PlatformRecord
 
 TESTS = str(pathlib.Path(__file__).parent)
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -103,6 +104,8 @@ class LocalBatteryTest(TemporaryFolder):
             self.assertRegex(sitting["began"], r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ$")
         self.assertEqual(sittings[0]["backend"], "LocalProcesses(workers=2)")
         self.assertEqual(sittings[0]["blas_environment"]["OMP_NUM_THREADS"], "3")
+        self.assertEqual(sittings[0]["platform"], PlatformRecord())
+        self.assertEqual(sittings[0]["platform"]["numpy"], np.__version__)
         self.assertEqual(sittings[1]["backend"], "InProcess()")
         # Files that are not a checkout's (an installed copy, even inside a repository, as a
         # venv's may be): no commit claimed.

@@ -24,6 +24,7 @@ from mobee_drake.experiments import bench_safety
 from mobee_drake.experiments.bench_safety import MOVERS, PRESETS, SCENES, BabblingRun, SceneRun
 from mobee_drake.experiments.ch8_reaching import ReachRobot, ReachScenario
 from mobee_drake.experiments.doc_tables import GeneratedTable, TableLayout
+from mobee_drake.experiments.platform_record import PlatformRecord
 from mobee_drake.mobee.barrier import (
     BarrierForce,
     BarrierParams,
@@ -594,6 +595,8 @@ class TestSafetyTables(unittest.TestCase):
             )
             self.assertEqual(len(results.scenes), 2 * 2 * len(SCENES) * 2 * len(MOVERS))
             self.assertEqual(len(results.babbling), 2 * 2)
+            self.assertEqual(results.platform, PlatformRecord())  # (what it ran on)
+            self.assertEqual(results.platform["numpy"], np.__version__)
             # The doc's tables are the results' (--report-only rewrites them from the file).
             shutil.copy(DOC, doc)
             with contextlib.redirect_stdout(io.StringIO()):

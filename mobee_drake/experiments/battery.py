@@ -105,6 +105,7 @@ from typing import ClassVar
 from mobee_drake import __version__
 from mobee_drake.atomic_files import StrictJson, WriteJsonAtomically, WriteTextAtomically
 from mobee_drake.experiments.arguments import PositiveInt
+from mobee_drake.experiments.platform_record import PlatformRecord
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.progress import ProgressBar, Say
 from mobee_drake.yaml_io import YamlDifferences
@@ -721,14 +722,16 @@ def _SourceCommit() -> dict:
 
 def _RecordSession(output: pathlib.Path, backend: Backend) -> None:
     """Appends to ``output``'s :data:`SESSIONS` a line on this sitting of the battery: when it
-    began, the package's version and source commit, the backend and the BLAS variables of the
-    environment (the workers' thread counts follow from them, see the module)."""
+    began, the package's version and source commit, the backend, the BLAS variables of the
+    environment (the workers' thread counts follow from them, see the module) and the platform
+    (:func:`~mobee_drake.experiments.platform_record.PlatformRecord`)."""
     record = dict(
         began=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         version=__version__,
         **_SourceCommit(),
         backend=repr(backend),
         blas_environment={name: os.environ.get(name) for name in BLAS_THREADS},
+        platform=PlatformRecord(),
     )
     try:
         with open(output / SESSIONS, "a") as stream:

@@ -34,6 +34,7 @@ from pydrake.systems.framework import BasicVector, LeafSystem
 from mobee_drake.atomic_files import StrictJson, WriteTextAtomically
 from mobee_drake.experiments.arguments import CommandParser, PositiveFloat
 from mobee_drake.experiments.doc_tables import CheckDocBlocks, WriteGeneratedTable
+from mobee_drake.experiments.platform_record import PlatformRecord
 from mobee_drake.owned_folders import OwnedFolder
 from mobee_drake.scenario import LoadScenario, Scenario
 from mobee_drake.station.builder import MakeMobeeStation
@@ -353,11 +354,14 @@ def _Line(s: Safety) -> str:
 
 @dc.dataclass
 class SafetyResults:
-    """The benchmark's results file: the command that ran it and every run."""
+    """The benchmark's results file: the command that ran it, the platform it ran on
+    (:func:`~mobee_drake.experiments.platform_record.PlatformRecord`; empty in files from before
+    it was kept) and every run."""
 
     command: str
     scenes: list[SceneResult] = dc.field(default_factory=list)
     babbling: list[BabblingResult] = dc.field(default_factory=list)
+    platform: dict = dc.field(default_factory=dict)
 
     def Record(self, result: SceneResult | BabblingResult) -> None:
         (self.scenes if isinstance(result, SceneResult) else self.babbling).append(result)
@@ -374,6 +378,7 @@ class SafetyResults:
             babbling=[
                 BabblingResult(**{**r, "safety": Safety(**r["safety"])}) for r in data["babbling"]
             ],
+            platform=data.get("platform", {}),
         )
 
     def Tables(self) -> dict[str, str]:
@@ -433,7 +438,7 @@ def main(argv=None) -> None:
                 parser.error(f"--output {folder}: holds no safety.json to report")
             results = SafetyResults.Load(path)
         else:
-            results = SafetyResults(command.strip())
+            results = SafetyResults(command.strip(), platform=PlatformRecord())
 
             def Record(result) -> None:  # Saved after every run: an interrupt loses one run.
                 results.Record(result)
