@@ -7,6 +7,7 @@ or fewer (docs/mobee.md, "Reading the tables"): the record lets a reader tell su
 a change of code."""
 
 import importlib.metadata
+import json
 import pathlib
 import platform
 
@@ -51,3 +52,7 @@ def PlatformRecord() -> dict:
         blas=_Blas(),
         cpu=_Cpu(),
     )
+
+
+if __name__ == "__main__":  # (a line for the record of a battery run from older code)
+    print(json.dumps(PlatformRecord()))
