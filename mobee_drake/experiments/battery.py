@@ -724,7 +724,8 @@ def _RecordSession(output: pathlib.Path, backend: Backend) -> None:
     """Appends to ``output``'s :data:`SESSIONS` a line on this sitting of the battery: when it
     began, the package's version and source commit, the backend, the BLAS variables of the
     environment (the workers' thread counts follow from them, see the module) and the platform
-    (:func:`~mobee_drake.experiments.platform_record.PlatformRecord`)."""
+    (:func:`~mobee_drake.experiments.platform_record.PlatformRecord`: this process's, which on
+    Ray is the driver's, not the workers')."""
     record = dict(
         began=time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         version=__version__,

@@ -1,15 +1,17 @@
 """What a result was computed on, for its record beside the commit: the Python, numpy, scipy and
-Drake versions, numpy's BLAS and the CPU.
+Drake versions, each BLAS loaded with the kernel it chose at run time, and the CPU.
 
 Runs repeat exactly on one machine and library build, but a long simulation can turn on the
-last bit of a sum, so the same code on another build can count a few penetrating periods more
-or fewer (docs/mobee.md, "Reading the tables"): the record lets a reader tell such a drift from
-a change of code."""
+last bit of a sum, so the same code on another build, or with another BLAS kernel (another CPU,
+or ``OPENBLAS_CORETYPE``), can count a few penetrating periods more or fewer (docs/mobee.md,
+"Reading the tables"): the record lets a reader tell such a drift from a change of code."""
 
 import importlib.metadata
 import json
 import pathlib
 import platform
+
+from threadpoolctl import threadpool_info
 
 
 def _Version(package: str) -> str | None:
@@ -19,27 +21,41 @@ def _Version(package: str) -> str | None:
         return None
 
 
-def _Blas() -> str | None:
-    """The BLAS numpy was built with, as its build describes it (OpenBLAS's configuration
-    names its kernels)."""
-    import numpy as np
+def _Blas() -> list[dict]:
+    """Each BLAS numpy and scipy loaded (scipy ships its own): its library, version and the
+    kernel it chose at run time (``architecture``: from the CPU, or ``OPENBLAS_CORETYPE``), in
+    the libraries' order (not the order they were loaded in)."""
+    import numpy  # noqa: F401
+    import scipy.linalg  # noqa: F401
 
-    try:
-        blas = np.show_config(mode="dicts")["Build Dependencies"]["blas"]
-    except (KeyError, TypeError):
-        return None
-    return blas.get("openblas configuration") or f"{blas.get('name')} {blas.get('version')}"
+    loaded = [
+        dict(
+            library=pathlib.Path(info["filepath"]).name,
+            version=info.get("version"),
+            architecture=info.get("architecture"),
+        )
+        for info in threadpool_info()
+        if info.get("user_api") == "blas"
+    ]
+    return sorted(loaded, key=lambda blas: blas["library"])
 
 
 def _Cpu() -> str:
-    """The CPU's model name (Linux's /proc/cpuinfo; the platform's processor elsewhere)."""
+    """The CPU: its model name, family, model and stepping (Linux's /proc/cpuinfo; the
+    platform's processor elsewhere)."""
+    fields = {}
     try:
         for line in pathlib.Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
+            key, _, value = line.partition(":")
+            fields.setdefault(key.strip(), value.strip())
     except OSError:
         pass
-    return platform.processor() or platform.machine()
+    if "model name" not in fields:
+        return platform.processor() or platform.machine()
+    return (
+        f"{fields['model name']} (family {fields.get('cpu family')}, model "
+        f"{fields.get('model')}, stepping {fields.get('stepping')})"
+    )
 
 
 def PlatformRecord() -> dict:
