@@ -2,8 +2,10 @@
 
 import json
 import os
+import pathlib
 import subprocess
 import sys
+import tempfile
 import unittest
 
 from mobee_drake.experiments.platform_record import PlatformRecord
@@ -26,6 +28,23 @@ class TestPlatformRecord(unittest.TestCase):
             record["python"], ".".join(map(str, sys.version_info[:3]))
         )  # (and numpy's, scipy's and Drake's versions, the CPU)
         self.assertTrue(all(record[name] for name in ("numpy", "scipy", "drake", "cpu")))
+
+    def test_a_sitting_of_older_code_gets_its_line(self):
+        """Given a battery folder, the command appends its last sitting's line."""
+        with tempfile.TemporaryDirectory() as folder:
+            sessions = pathlib.Path(folder, "sessions.jsonl")
+            sessions.write_text(
+                '{"began": "2026-01-01T00:00:00Z"}\n{"began": "2026-01-02T00:00:00Z"}\n'
+            )
+            for _ in range(2):
+                subprocess.run(
+                    [sys.executable, "-m", "mobee_drake.experiments.platform_record", folder],
+                    capture_output=True, check=True,
+                )  # fmt: skip
+            lines = [json.loads(line) for line in open(pathlib.Path(folder, "platforms.jsonl"))]
+        self.assertEqual(
+            lines, [{"began": "2026-01-02T00:00:00Z", "platform": PlatformRecord()}] * 2
+        )
 
     def test_each_openblas_names_the_kernel_it_chose(self):
         """OpenBLAS picks its kernel at run time: the record names the one chosen (here forced

@@ -10,6 +10,7 @@ import importlib.metadata
 import json
 import pathlib
 import platform
+import sys
 
 from threadpoolctl import threadpool_info
 
@@ -70,5 +71,19 @@ def PlatformRecord() -> dict:
     )
 
 
-if __name__ == "__main__":  # (a line for the record of a battery run from older code)
-    print(json.dumps(PlatformRecord()))
+def RecordSitting(folder: pathlib.Path) -> str:
+    """For a battery run by code older than the record: appends to ``folder``'s
+    ``platforms.jsonl`` a line on its last sitting (its ``began`` from ``sessions.jsonl``, and
+    this process's platform, which must be the sitting's); the line."""
+    sittings = (folder / "sessions.jsonl").read_text().splitlines()
+    line = json.dumps({"began": json.loads(sittings[-1])["began"], "platform": PlatformRecord()})
+    with open(folder / "platforms.jsonl", "a") as stream:
+        stream.write(line + "\n")
+    return line
+
+
+if __name__ == "__main__":  # python -m ...platform_record [BATTERY_FOLDER]
+    if len(sys.argv) > 1:
+        print(RecordSitting(pathlib.Path(sys.argv[1])))
+    else:
+        print(json.dumps(PlatformRecord()))
