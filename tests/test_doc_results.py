@@ -10,11 +10,14 @@ import unittest
 import numpy as np
 
 from mobee_drake.atomic_files import CurrentGeneration
-from mobee_drake.experiments.adaptive_space_command import KeptReport
+from mobee_drake.experiments.adaptive_space import AGENT, LATTICES
+from mobee_drake.experiments.adaptive_space_command import KeptReport, SpaceChanges
+from mobee_drake.experiments.adaptive_space_figures import History
 from mobee_drake.experiments.arms import Arms, ReachTargets
 from mobee_drake.experiments.ch8_claims import ClaimsTables
 from mobee_drake.experiments.ch8_reaching import StoredResults
 from mobee_drake.experiments.doc_tables import GeneratedBlocks
+from mobee_drake.planning.state_space import Lattice
 
 ROOT = pathlib.Path(__file__).parents[1]
 
@@ -257,6 +260,7 @@ class TestKeptBatteries(unittest.TestCase):
         )
 
     def _CheckQuotedDifferences(self, prose: str, tables: str) -> None:
+        self.assertTrue(_DIFFERENCE.findall(prose))  # (a change of format would check nothing)
         for difference in _DIFFERENCE.findall(prose):
             with self.subTest(difference=difference):
                 self.assertIn(difference, tables)
@@ -291,6 +295,35 @@ def _Rows(table: str) -> dict[str, list[str]]:
             cells = [c.strip() for c in line.strip("|").split("|")]
             rows[cells[0]] = cells[1:]
     return rows
+
+
+class TestAdaptiveSpaceCounts(unittest.TestCase):
+    """The counts docs/adaptive_space.md's exploration verdict takes from the battery's kept runs
+    (their checkpoints' changes), not from its blocks."""
+
+    def test_the_pruned_states_grown_first_and_the_roadmaps_one_shortcut(self):
+        runs = ROOT / "docs" / "results" / "adaptive_space" / "runs"
+        arm = Arms()["icub"]
+        changes = SpaceChanges(runs / "icub_rank4_maintained_seed0" / "model", AGENT)
+        history = History("icub, rank4", arm, Lattice(LATTICES["rank4"], 4).centres, changes)
+        doc = _Folded((ROOT / "docs" / "adaptive_space.md").read_text())
+        self.assertIn(
+            f"in the first seed's run {history.added_then_removed} of its "
+            f"{len(history.removed)}, the figure above",
+            doc,
+        )
+        shortcuts = {
+            robot: [
+                json.loads(r.read_text())["changes"]
+                for r in sorted(runs.glob(f"{robot}_trm_maintained_seed*/result.json"))
+            ]
+            for robot in ("icub", "katana")
+        }
+        self.assertEqual(len(shortcuts["icub"]), 10)
+        self.assertFalse(any(any(c.values()) for c in shortcuts["icub"]))  # (nothing changed)
+        katana = [c for c in shortcuts["katana"] if any(c.values())]
+        self.assertEqual(katana, [dict.fromkeys(katana[0], 0) | {"shortcut": 1}])
+        self.assertIn("on the Katana made one shortcut in one run", doc)
 
 
 class TestReactiveQuotes(unittest.TestCase):
