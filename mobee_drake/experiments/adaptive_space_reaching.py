@@ -24,7 +24,8 @@ Maintained minus fixed on each space, and the roadmap, fixed and maintained, min
 lattice, are compared paired by seed in two families, each Holm-corrected over its comparisons
 (the robots, spaces and strategies): what was learned (the summed reward, with the -10s and
 without; where the two are the same in every run, the second is not tested again) and what it
-cost (the robot hours of the exploration, the wall seconds)."""
+cost (the robot hours of the exploration; wall time, made over many sittings, is reported but
+not compared)."""
 
 import collections
 import dataclasses as dc
@@ -352,8 +353,8 @@ def Report(
     nearest state's marker, :func:`~mobee_drake.experiments.arms.TargetGaps`; and per space,
     the same on the space each maintained run ended with), the targets and how near each space
     comes to them, and the runs without a result (``missing``, :func:`MissingRuns`'s); with
-    ``fixed_from``, the fixed runs were read from that battery's folder, made in its sittings,
-    so their wall time is not compared (markdown)."""
+    ``fixed_from``, the fixed runs were read from that battery's folder, made in its sittings
+    (markdown). Wall time is not compared: runs of many sittings need not share a load."""
     group = BySetting(runs, ("robot", "space", "strategy", "condition"))
     lines = [
         "| robot | space | strategy | condition | runs | problem-tries | summed reward | without "
@@ -378,14 +379,18 @@ def Report(
         "robot hours exploring": lambda r: (
             np.nan if r.exploring_hours is None else r.exploring_hours
         ),
-        "wall s per run": lambda r: r.wall_seconds,
     }
+    lines += [
+        "",
+        "Wall time is in the table but not compared: a battery's runs are made over many "
+        "sittings, beside other work and on the machine each sitting had (`sessions.jsonl`), so "
+        "a pair's two runs need not have run under the same load.",
+    ]
     if fixed_from:
-        del costs["wall s per run"]
         lines += [
             "",
             f"The fixed runs are read from {fixed_from}, not made again: made in that battery's "
-            "sittings, with its code, so their wall time is not compared with this battery's.",
+            "sittings, with its code.",
         ]
     lines += _MissingLines(missing or {})
     lines += RoadmapLines(roadmaps or {}) + NearnessLines(nearness or {})
