@@ -10,14 +10,12 @@ import unittest
 import numpy as np
 
 from mobee_drake.atomic_files import CurrentGeneration
-from mobee_drake.experiments.adaptive_space import AGENT, LATTICES
-from mobee_drake.experiments.adaptive_space_command import KeptReport, SpaceChanges
-from mobee_drake.experiments.adaptive_space_figures import History
+from mobee_drake.experiments.adaptive_space import AdaptiveSpaceRun
+from mobee_drake.experiments.adaptive_space_command import KeptReport, SpaceHistories
 from mobee_drake.experiments.arms import Arms, ReachTargets
 from mobee_drake.experiments.ch8_claims import ClaimsTables
 from mobee_drake.experiments.ch8_reaching import StoredResults
 from mobee_drake.experiments.doc_tables import GeneratedBlocks
-from mobee_drake.planning.state_space import Lattice
 
 ROOT = pathlib.Path(__file__).parents[1]
 
@@ -302,10 +300,13 @@ class TestAdaptiveSpaceCounts(unittest.TestCase):
     (their checkpoints' changes), not from its blocks."""
 
     def test_the_pruned_states_grown_first_and_the_roadmaps_one_shortcut(self):
-        runs = ROOT / "docs" / "results" / "adaptive_space" / "runs"
-        arm = Arms()["icub"]
-        changes = SpaceChanges(runs / "icub_rank4_maintained_seed0" / "model", AGENT)
-        history = History("icub, rank4", arm, Lattice(LATTICES["rank4"], 4).centres, changes)
+        output = ROOT / "docs" / "results" / "adaptive_space"
+        runs = output / "runs"
+        kept = [
+            AdaptiveSpaceRun(**json.loads(r.read_text()))
+            for r in sorted(runs.glob("icub_rank4_*/result.json"))
+        ]
+        (history,) = SpaceHistories(kept, output)["icub"]  # (the figure's: the first seed's)
         doc = _Folded((ROOT / "docs" / "adaptive_space.md").read_text())
         self.assertIn(
             f"in the first seed's run {history.added_then_removed} of its "
