@@ -74,10 +74,8 @@ def PlatformRecord() -> dict:
 def RecordSitting(folder: pathlib.Path) -> str:
     """For a battery run by code older than the record: appends to ``folder``'s
     ``platforms.jsonl`` a line on its last sitting (its ``began`` from the battery's
-    sessions file, and this process's platform, which must be the sitting's); the line."""
-    from mobee_drake.experiments.battery import SESSIONS  # (battery.py imports this module)
-
-    sittings = (folder / SESSIONS).read_text().splitlines()
+    ``sessions.jsonl``, and this process's platform, which must be the sitting's); the line."""
+    sittings = (folder / "sessions.jsonl").read_text().splitlines()
     line = json.dumps({"began": json.loads(sittings[-1])["began"], "platform": PlatformRecord()})
     with open(folder / "platforms.jsonl", "a") as stream:
         stream.write(line + "\n")
